@@ -1,0 +1,1 @@
+//! Multi-chart parameterization seeded by the motion clusters (filled in by the atlas issue).

@@ -1,0 +1,182 @@
+//! Command-line interface: argument definitions and dispatch to [`crate::commands`].
+
+use crate::commands;
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+/// mcgv-video: compress animated triangle meshes into one `.mcgv` file (Multi-Chart Geometry Video).
+#[derive(Debug, Parser)]
+#[command(name = "mcgv-video", version, about, long_about = None)]
+pub struct Cli {
+    /// The command to run.
+    #[command(subcommand)]
+    pub command: Command,
+    /// No progress bars or chatter; errors still go to stderr.
+    #[arg(long, short, global = true)]
+    pub quiet: bool,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Compress an animation (OBJ sequence, PC2 + OBJ, glTF) into a .mcgv file.
+    Encode(EncodeArgs),
+    /// Decode a .mcgv file to an OBJ sequence (a folder) or a PC2 point cache.
+    Decode(DecodeArgs),
+    /// Show a .mcgv file's bit budget per part; optionally write its images as PNG.
+    Inspect(InspectArgs),
+    /// Compare two animations (any input form, or a .mcgv) and print the error measures.
+    Eval(EvalArgs),
+    /// Print vertices, frames, faces, components, manifoldness and bounding box of an animation.
+    Info(InfoArgs),
+}
+
+/// How to read an animation: options that apply to every input form.
+#[derive(Debug, Clone, Default, Args)]
+pub struct InputArgs {
+    /// Rate at which glTF animations are baked to frames (default: the animation's keyframe rate, or 30).
+    #[arg(long)]
+    pub fps: Option<f64>,
+    /// glTF animation (clip) to bake, by name or index (default: the first).
+    #[arg(long)]
+    pub clip: Option<String>,
+    /// Base OBJ giving the connectivity of a PC2 point cache (default: the .obj beside the .pc2).
+    #[arg(long)]
+    pub base: Option<PathBuf>,
+}
+
+/// `encode` arguments.
+#[derive(Debug, Args)]
+pub struct EncodeArgs {
+    /// Input animation: a folder or glob of .obj files, a .pc2 (with --base), or a .gltf/.glb.
+    pub input: String,
+    /// Output .mcgv file.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Image codec for the residuals.
+    #[arg(long, value_enum, default_value_t = CodecChoice::Jpeg)]
+    pub codec: CodecChoice,
+    /// Rate knob for every codec, 1..100 (higher = better quality, more bits).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub quality: Option<u8>,
+    /// MPEG-4 quantiser 1..31 (lower = better); overrides --quality for mpeg4.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=31))]
+    pub qscale: Option<u8>,
+    /// Number of motion clusters K.
+    #[arg(long, default_value_t = 20)]
+    pub clusters: usize,
+    /// Bits per quantised affine coefficient.
+    #[arg(long, default_value_t = 17)]
+    pub affine_bits: u8,
+    /// Geometry-image lattice, WIDTHxHEIGHT (multiples of 8).
+    #[arg(long, default_value = "256x256")]
+    pub lattice: String,
+    /// How free pixels of the geometry images are filled.
+    #[arg(long)]
+    pub padding: Option<String>,
+    /// MPEG-4 group of pictures: an I-frame every N frames.
+    #[arg(long, default_value_t = 50)]
+    pub gop: usize,
+    /// Let the first-frame coder reorder vertices for fewer bits (default keeps the input order).
+    #[arg(long)]
+    pub reorder: bool,
+    /// Print the result as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_args: InputArgs,
+}
+
+/// The residual image codecs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CodecChoice {
+    /// JPEG per frame: every frame decodes on its own.
+    Jpeg,
+    /// MPEG-4 Part 2: an I-frame, then P-frames.
+    Mpeg4,
+}
+
+/// `decode` arguments.
+#[derive(Debug, Args)]
+pub struct DecodeArgs {
+    /// The .mcgv file.
+    pub input: PathBuf,
+    /// Output: a folder for an OBJ sequence (frame_0000.obj …), or a file ending in .pc2.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Decode only this frame (numbered from 0).
+    #[arg(long)]
+    pub frame: Option<usize>,
+}
+
+/// `inspect` arguments.
+#[derive(Debug, Args)]
+pub struct InspectArgs {
+    /// The .mcgv file.
+    pub input: PathBuf,
+    /// Write residual images (raw, padded, decoded), the atlas and the segmentation as PNG here.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Frames whose images to write with --png (default: 0).
+    #[arg(long, value_delimiter = ',')]
+    pub frames: Vec<usize>,
+    /// Print the result as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `eval` arguments.
+#[derive(Debug, Args)]
+pub struct EvalArgs {
+    /// The original animation.
+    pub original: String,
+    /// The animation to compare with it (any input form, or a .mcgv).
+    pub decoded: String,
+    /// Print the result as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// How to read the inputs.
+    #[command(flatten)]
+    pub input_args: InputArgs,
+}
+
+/// `info` arguments.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// The animation (any input form).
+    pub input: String,
+    /// Print the result as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_args: InputArgs,
+}
+
+/// Runs the CLI and returns the process exit code: 0 on success, 1 on error (message on stderr),
+/// 2 on a usage error (clap's own).
+pub fn main() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let result = match &cli.command {
+        Command::Encode(a) => commands::encode::run(a, cli.quiet),
+        Command::Decode(a) => commands::decode::run(a, cli.quiet),
+        Command::Inspect(a) => commands::inspect::run(a, cli.quiet),
+        Command::Eval(a) => commands::eval::run(a, cli.quiet),
+        Command::Info(a) => commands::info::run(a, cli.quiet),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("mcgv-video: error: {e}");
+            1
+        }
+    }
+}

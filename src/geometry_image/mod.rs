@@ -1,0 +1,1 @@
+//! geometry_image (see DESIGN.md).

@@ -1,0 +1,120 @@
+//! Animated triangle meshes: one connectivity shared by all frames, one position set per frame.
+//!
+//! Readers and writers for OBJ sequences, PC2 point caches and glTF live in the submodules;
+//! [`topology`] holds the adjacency helpers the later stages need.
+
+pub mod io;
+pub mod topology;
+
+pub use io::{read_animation, write_obj_sequence, write_pc2, ReadOptions};
+
+use crate::error::{Error, Result};
+
+/// A 3D position.
+pub type Point = [f32; 3];
+
+/// A triangle: three vertex indices.
+pub type Triangle = [u32; 3];
+
+/// An animated mesh: triangles shared by all frames and `F` frames of `V` positions.
+///
+/// Invariants (checked by [`AnimatedMesh::new`]): at least one frame and one vertex, every frame has
+/// the same number of vertices, every index is in range, every coordinate is finite.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnimatedMesh {
+    triangles: Vec<Triangle>,
+    frames: Vec<Vec<Point>>,
+}
+
+impl AnimatedMesh {
+    /// Builds an animated mesh, checking the invariants; the error names the offending frame or face.
+    pub fn new(triangles: Vec<Triangle>, frames: Vec<Vec<Point>>) -> Result<Self> {
+        let first = frames
+            .first()
+            .ok_or_else(|| Error::Mesh("the animation has no frames".into()))?;
+        let v = first.len();
+        if v == 0 {
+            return Err(Error::Mesh("the mesh has no vertices".into()));
+        }
+        if v > u32::MAX as usize {
+            return Err(Error::Mesh(format!(
+                "{v} vertices is more than this tool can index"
+            )));
+        }
+        for (f, frame) in frames.iter().enumerate() {
+            if frame.len() != v {
+                return Err(Error::Mesh(format!(
+                    "frame {f} has {} vertices but frame 0 has {v}",
+                    frame.len()
+                )));
+            }
+            if let Some(i) = frame.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                return Err(Error::Mesh(format!(
+                    "frame {f}, vertex {i}: coordinate is not a finite number"
+                )));
+            }
+        }
+        for (t, tri) in triangles.iter().enumerate() {
+            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= v) {
+                return Err(Error::Mesh(format!(
+                    "face {t} refers to vertex {bad}, but the mesh has {v} vertices"
+                )));
+            }
+        }
+        Ok(Self { triangles, frames })
+    }
+
+    /// The triangles, shared by every frame.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// All frames, each `V` positions.
+    pub fn frames(&self) -> &[Vec<Point>] {
+        &self.frames
+    }
+
+    /// The positions of frame `f` (panics if `f` is out of range: callers index with `0..frame_count()`).
+    pub fn frame(&self, f: usize) -> &[Point] {
+        &self.frames[f]
+    }
+
+    /// Number of vertices `V`.
+    pub fn vertex_count(&self) -> usize {
+        self.frames[0].len()
+    }
+
+    /// Number of frames `F`.
+    pub fn frame_count(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Consumes the mesh, giving back triangles and frames.
+    pub fn into_parts(self) -> (Vec<Triangle>, Vec<Vec<Point>>) {
+        (self.triangles, self.frames)
+    }
+
+    /// Length of the diagonal of frame 0's axis-aligned bounding box: the unit every error is measured in.
+    pub fn bbox_diagonal(&self) -> f64 {
+        let (lo, hi) = bounding_box(&self.frames[0]);
+        let d: f64 = (0..3).map(|a| (hi[a] - lo[a]) as f64).map(|x| x * x).sum();
+        d.sqrt()
+    }
+}
+
+/// The axis-aligned bounding box `(min, max)` of a point set; `([0;3],[0;3])` for an empty set.
+pub fn bounding_box(points: &[Point]) -> (Point, Point) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    if points.is_empty() {
+        ([0.0; 3], [0.0; 3])
+    } else {
+        (lo, hi)
+    }
+}
