@@ -1,1 +1,4 @@
-//! stream (see DESIGN.md).
+//! The `.mcgv` stream: container, byte serialisation, entropy coding and the parts it holds.
+
+pub mod bytes;
+pub mod container;
