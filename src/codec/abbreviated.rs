@@ -47,7 +47,8 @@ mod tests {
     fn split_finds_the_scan_and_join_restores() {
         // SOI, a COM segment (len 4: "hi"), SOS (len 8), scan bytes, EOI.
         let jpeg = [
-            0xFF, 0xD8, 0xFF, 0xFE, 0, 4, b'h', b'i', 0xFF, 0xDA, 0, 8, 1, 1, 0, 0, 63, 0, 0x12, 0x34, 0xFF, 0xD9,
+            0xFF, 0xD8, 0xFF, 0xFE, 0, 4, b'h', b'i', 0xFF, 0xDA, 0, 8, 1, 1, 0, 0, 63, 0, 0x12,
+            0x34, 0xFF, 0xD9,
         ];
         let (head, scan) = split(&jpeg).unwrap();
         assert_eq!(scan, &[0x12, 0x34, 0xFF, 0xD9]);

@@ -17,6 +17,12 @@ pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 /// The container version this build writes and reads.
 pub const VERSION: u16 = 1;
 
+/// Bytes of a part header: tag, checksum kind, length, CRC.
+pub const PART_HEADER_LEN: usize = 17;
+
+/// Bytes of the file header: magic, version, reserved, part count.
+pub const FILE_HEADER_LEN: usize = 16;
+
 /// Largest number of parts a file may declare: refuses absurd headers before allocating.
 const MAX_PARTS: u32 = 64;
 
@@ -91,6 +97,19 @@ impl ContainerWriter {
     /// Adds a part; parts are written in the order added.
     pub fn add(&mut self, tag: Tag, payload: Vec<u8>, checksum: Checksum) {
         self.parts.push((tag, payload, checksum));
+    }
+
+    /// Bytes each part takes in the file (payload plus its part header), by part name, in file order.
+    pub fn part_sizes(&self) -> Vec<(String, u64)> {
+        self.parts
+            .iter()
+            .map(|(tag, payload, _)| {
+                (
+                    tag.name().to_string(),
+                    (PART_HEADER_LEN + payload.len()) as u64,
+                )
+            })
+            .collect()
     }
 
     /// The whole file as bytes.

@@ -2,4 +2,5 @@
 
 pub mod bytes;
 pub mod container;
+pub mod frame_index;
 pub mod header;
