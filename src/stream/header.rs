@@ -67,6 +67,14 @@ pub struct Header {
     pub first_frame_bits: u8,
     /// Name of the padding method the encoder used (informational: the decoder does not pad).
     pub padding: String,
+    /// The `--clusters` asked for (segmentation may use fewer); lets `inspect` re-run the analysis.
+    pub requested_clusters: u32,
+    /// Whether the first-frame coder was allowed to reorder vertices.
+    pub reorder: bool,
+    /// Charts in the atlas (informational).
+    pub charts: u32,
+    /// Lattice pixels covered by chart blocks (informational: packing efficiency).
+    pub chart_pixels: u32,
 }
 
 /// Upper bound on any count in the header, far above any real animation and far below what would let
@@ -74,6 +82,11 @@ pub struct Header {
 const MAX_COUNT: u32 = 1 << 28;
 
 impl Header {
+    /// Packing efficiency of the atlas: chart pixels / lattice pixels.
+    pub fn packing_efficiency(&self) -> f64 {
+        self.chart_pixels as f64 / (self.lattice_width as f64 * self.lattice_height as f64)
+    }
+
     /// Serialises the header.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = ByteWriter::new();
@@ -89,7 +102,11 @@ impl Header {
             .u32(self.gop)
             .u8(self.affine_bits)
             .u8(self.first_frame_bits)
-            .blob(self.padding.as_bytes());
+            .blob(self.padding.as_bytes())
+            .u32(self.requested_clusters)
+            .u8(self.reorder as u8)
+            .u32(self.charts)
+            .u32(self.chart_pixels);
         w.into_bytes()
     }
 
@@ -110,6 +127,10 @@ impl Header {
             affine_bits: r.u8()?,
             first_frame_bits: r.u8()?,
             padding: String::from_utf8_lossy(r.blob()?).into_owned(),
+            requested_clusters: r.u32()?,
+            reorder: r.u8()? != 0,
+            charts: r.u32()?,
+            chart_pixels: r.u32()?,
         };
         r.finish()?;
         for (what, n) in [
@@ -171,6 +192,10 @@ mod tests {
             affine_bits: 17,
             first_frame_bits: 12,
             padding: "cg".into(),
+            requested_clusters: 20,
+            reorder: false,
+            charts: 31,
+            chart_pixels: 40_000,
         }
     }
 
