@@ -1,0 +1,297 @@
+//! A bounding-volume hierarchy over one frame's triangles, for nearest-triangle queries.
+//!
+//! Written here rather than taken from a crate: the `bvh` crate's `nearest_to` starts every query
+//! from an unbounded search and stores `f32` shapes of its own type, and `parry3d` brings a second math
+//! stack (glam) and `f32` only. The surface measures make tens of millions of queries whose answer is
+//! almost always the triangle the previous sample hit (or the same-numbered triangle, when the
+//! connectivity is shared), so the query takes a *hint* triangle whose distance bounds the search from
+//! the start; that bound is what makes a 200-frame sequence take seconds. The tree itself is a plain
+//! median split: built per frame in O(n log n), a few milliseconds for 14k triangles.
+
+use super::triangle::{point_triangle_distance_squared, Vec3};
+use crate::mesh::{Point, Triangle};
+
+/// Triangles per leaf: a few exact distance tests are cheaper than another level of boxes.
+const LEAF_SIZE: usize = 4;
+
+/// Deepest possible tree: median splits halve the count, so 2³² triangles need at most 32 levels.
+const MAX_DEPTH: usize = 64;
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    lo: Vec3,
+    hi: Vec3,
+    /// Leaf: first triangle slot in `order`; inner: index of the left child (the right one follows
+    /// the left subtree, at `right`).
+    first: u32,
+    /// Leaf: number of triangles (> 0); inner: 0.
+    count: u32,
+    /// Inner: index of the right child.
+    right: u32,
+}
+
+impl Node {
+    fn distance_squared(&self, p: Vec3) -> f64 {
+        let mut d2 = 0.0;
+        for ((lo, hi), x) in self.lo.iter().zip(&self.hi).zip(&p) {
+            let d = (lo - x).max(x - hi).max(0.0);
+            d2 += d * d;
+        }
+        d2
+    }
+}
+
+/// The nearest triangle to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Nearest {
+    /// Index of the triangle in the slice the tree was built from.
+    pub triangle: u32,
+    /// Squared distance from the query point to that triangle.
+    pub distance_squared: f64,
+}
+
+/// Nearest-triangle index over one set of triangle positions.
+#[derive(Debug, Clone)]
+pub struct TriangleBvh {
+    nodes: Vec<Node>,
+    /// Corner positions per triangle, indexed by the caller's triangle number.
+    corners: Vec<[Vec3; 3]>,
+    /// Triangle numbers in leaf order.
+    order: Vec<u32>,
+}
+
+impl TriangleBvh {
+    /// Builds the tree over `triangles` placed at `positions`; `None` when there are no triangles.
+    ///
+    /// Every index must be in range of `positions` (as [`crate::AnimatedMesh`] guarantees);
+    /// a triangle with an out-of-range index is placed at the origin rather than panicking.
+    pub fn new(triangles: &[Triangle], positions: &[Point]) -> Option<Self> {
+        if triangles.is_empty() {
+            return None;
+        }
+        let at = |i: u32| -> Vec3 {
+            positions
+                .get(i as usize)
+                .map_or([0.0; 3], |p| [p[0] as f64, p[1] as f64, p[2] as f64])
+        };
+        let corners: Vec<[Vec3; 3]> = triangles
+            .iter()
+            .map(|t| [at(t[0]), at(t[1]), at(t[2])])
+            .collect();
+        let centroids: Vec<Vec3> = corners
+            .iter()
+            .map(|c| {
+                let mut m = [0.0; 3];
+                for (a, v) in m.iter_mut().enumerate() {
+                    *v = (c[0][a] + c[1][a] + c[2][a]) / 3.0;
+                }
+                m
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
+        build(&mut nodes, &mut order, 0, &corners, &centroids);
+        Some(Self {
+            nodes,
+            corners,
+            order,
+        })
+    }
+
+    /// Number of triangles in the tree.
+    pub fn len(&self) -> usize {
+        self.corners.len()
+    }
+
+    /// Always false: a tree is never built over no triangles.
+    pub fn is_empty(&self) -> bool {
+        self.corners.is_empty()
+    }
+
+    fn triangle_distance_squared(&self, t: u32, p: Vec3) -> f64 {
+        match self.corners.get(t as usize) {
+            Some(c) => point_triangle_distance_squared(p, c[0], c[1], c[2]),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// The triangle nearest to `p`. `hint`, a triangle likely to be near (out-of-range hints are
+    /// ignored), only speeds the search up: the answer is exact either way.
+    pub fn nearest(&self, p: Vec3, hint: Option<u32>) -> Nearest {
+        let mut best = Nearest {
+            triangle: 0,
+            distance_squared: f64::INFINITY,
+        };
+        if let Some(h) = hint {
+            let d = self.triangle_distance_squared(h, p);
+            if d.is_finite() {
+                best = Nearest {
+                    triangle: h,
+                    distance_squared: d,
+                };
+            }
+        }
+        let mut stack = [0u32; MAX_DEPTH];
+        let mut top = 0usize;
+        let mut node = 0u32;
+        while let Some(n) = self.nodes.get(node as usize) {
+            if n.count > 0 {
+                let leaf = self
+                    .order
+                    .get(n.first as usize..(n.first + n.count) as usize)
+                    .unwrap_or(&[]);
+                for &t in leaf {
+                    let d = self.triangle_distance_squared(t, p);
+                    if d < best.distance_squared {
+                        best = Nearest {
+                            triangle: t,
+                            distance_squared: d,
+                        };
+                    }
+                }
+            } else {
+                let (l, r) = (n.first, n.right);
+                let dl = self.box_distance(l, p);
+                let dr = self.box_distance(r, p);
+                let (near, d_near, far, d_far) = if dl <= dr {
+                    (l, dl, r, dr)
+                } else {
+                    (r, dr, l, dl)
+                };
+                if d_near < best.distance_squared {
+                    if d_far < best.distance_squared && top < MAX_DEPTH {
+                        stack[top] = far;
+                        top += 1;
+                    }
+                    node = near;
+                    continue;
+                }
+            }
+            // Pop the next subtree that can still hold something nearer than the best so far.
+            let mut next = None;
+            while top > 0 {
+                top -= 1;
+                let candidate = stack[top];
+                if self.box_distance(candidate, p) < best.distance_squared {
+                    next = Some(candidate);
+                    break;
+                }
+            }
+            match next {
+                Some(c) => node = c,
+                None => break,
+            }
+        }
+        best
+    }
+
+    fn box_distance(&self, node: u32, p: Vec3) -> f64 {
+        self.nodes
+            .get(node as usize)
+            .map_or(f64::INFINITY, |n| n.distance_squared(p))
+    }
+}
+
+/// Builds the subtree over `order[..]` (whose first slot is `offset` in the whole order) and returns
+/// its node index.
+fn build(
+    nodes: &mut Vec<Node>,
+    order: &mut [u32],
+    offset: usize,
+    corners: &[[Vec3; 3]],
+    centroids: &[Vec3],
+) -> u32 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut clo = [f64::INFINITY; 3];
+    let mut chi = [f64::NEG_INFINITY; 3];
+    for &t in order.iter() {
+        if let (Some(c), Some(m)) = (corners.get(t as usize), centroids.get(t as usize)) {
+            for a in 0..3 {
+                for v in c {
+                    lo[a] = lo[a].min(v[a]);
+                    hi[a] = hi[a].max(v[a]);
+                }
+                clo[a] = clo[a].min(m[a]);
+                chi[a] = chi[a].max(m[a]);
+            }
+        }
+    }
+    let index = nodes.len() as u32;
+    nodes.push(Node {
+        lo,
+        hi,
+        first: offset as u32,
+        count: order.len() as u32,
+        right: 0,
+    });
+    if order.len() <= LEAF_SIZE {
+        return index;
+    }
+    let extent = [chi[0] - clo[0], chi[1] - clo[1], chi[2] - clo[2]];
+    let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
+        0
+    } else if extent[1] >= extent[2] {
+        1
+    } else {
+        2
+    };
+    let mid = order.len() / 2;
+    let key = |t: &u32| centroids.get(*t as usize).map_or(0.0, |m| m[axis]);
+    order.select_nth_unstable_by(mid, |x, y| key(x).total_cmp(&key(y)));
+    let (left, right) = order.split_at_mut(mid);
+    let l = build(nodes, left, offset, corners, centroids);
+    let r = build(nodes, right, offset + mid, corners, centroids);
+    if let Some(n) = nodes.get_mut(index as usize) {
+        n.first = l;
+        n.count = 0;
+        n.right = r;
+    }
+    index
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_xoshiro::rand_core::{RngCore, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    fn uniform(rng: &mut Xoshiro256PlusPlus) -> f32 {
+        (rng.next_u32() >> 8) as f32 / (1u32 << 24) as f32
+    }
+
+    #[test]
+    fn nearest_matches_a_linear_scan() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        let positions: Vec<Point> = (0..600)
+            .map(|_| [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)])
+            .collect();
+        let triangles: Vec<Triangle> = (0..200u32)
+            .map(|i| [3 * i, 3 * i + 1, (3 * i + 2) % 600])
+            .chain([[0, 0, 1], [5, 5, 5]])
+            .collect();
+        let Some(bvh) = TriangleBvh::new(&triangles, &positions) else {
+            panic!("no tree over 202 triangles");
+        };
+        assert_eq!(bvh.len(), 202);
+        for k in 0..2000 {
+            let p = [
+                uniform(&mut rng) as f64 * 1.4 - 0.2,
+                uniform(&mut rng) as f64 * 1.4 - 0.2,
+                uniform(&mut rng) as f64 * 1.4 - 0.2,
+            ];
+            let want = (0..triangles.len() as u32)
+                .map(|t| bvh.triangle_distance_squared(t, p))
+                .fold(f64::INFINITY, f64::min);
+            let hint = if k % 2 == 0 { Some(k % 202) } else { None };
+            let got = bvh.nearest(p, hint);
+            assert_eq!(got.distance_squared, want);
+            assert_eq!(bvh.triangle_distance_squared(got.triangle, p), want);
+        }
+    }
+
+    #[test]
+    fn no_triangles_no_tree() {
+        assert!(TriangleBvh::new(&[], &[[0.0; 3]]).is_none());
+    }
+}
