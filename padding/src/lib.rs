@@ -159,7 +159,9 @@ fn fill_block_mean(grid: &BlockGrid, rect: grid::BlockRect, image: &mut [f32], f
     let (sum, count) = grid
         .pixels(rect)
         .filter(|&i| fixed[i])
-        .fold((0.0f64, 0usize), |(s, c), i| (s + f64::from(image[i]), c + 1));
+        .fold((0.0f64, 0usize), |(s, c), i| {
+            (s + f64::from(image[i]), c + 1)
+        });
     if count == 0 {
         return;
     }
