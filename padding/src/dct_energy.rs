@@ -8,7 +8,7 @@
 //! fixed ones), E is minimised by Pᵀ DᵀWD P x = −Pᵀ DᵀWD f, an SPD system (W ≥ 0 with only DC unweighted, D orthogonal)
 //! solved by CG. Pixels of a block lying outside the image are treated as free.
 
-use crate::cg::{self, CgScratch};
+use crate::cg::{self, CgLimits, CgScratch};
 use crate::grid::{BlockGrid, BlockRect};
 use crate::PadStats;
 
@@ -70,15 +70,13 @@ impl Default for DctEnergy {
 
 impl DctEnergy {
     /// Pads the free pixels of one block that holds at least one fixed pixel.
-    #[allow(clippy::too_many_arguments)]
     pub fn pad_block(
         &mut self,
         grid: &BlockGrid,
         rect: BlockRect,
         image: &mut [f32],
         fixed: &[bool],
-        tolerance: f64,
-        max_iterations: usize,
+        limits: CgLimits,
         stats: &mut PadStats,
     ) {
         let width = grid.width;
@@ -138,8 +136,7 @@ impl DctEnergy {
             },
             &self.rhs,
             &mut self.x,
-            tolerance,
-            max_iterations,
+            limits,
             &mut self.scratch,
         );
         stats.record(report);
