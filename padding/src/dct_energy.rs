@@ -1,0 +1,198 @@
+//! Padding aimed at the codec rather than at smoothness: per 8×8 block, free pixels minimise the
+//! AC coefficients' energy weighted by JPEG's quantiser, E = Σ_{k≠0} (c_k / Q_k)², fixed pixels held.
+//!
+//! c_k / Q_k is what the codec rounds and entropy-codes, so a small E means few, small quantised
+//! coefficients. The Annex K luminance table is the weight; JPEG's quality setting scales that table
+//! uniformly (up to rounding and clamping), which leaves the minimiser unchanged, so one table serves
+//! every quality. With c = D·b (D the orthonormal 2-D DCT) and b = P·x + f (x the free pixels, f the
+//! fixed ones), E is minimised by Pᵀ DᵀWD P x = −Pᵀ DᵀWD f, an SPD system (W ≥ 0 with only DC unweighted, D orthogonal)
+//! solved by CG. Pixels of a block lying outside the image are treated as free.
+
+use crate::cg::{self, CgLimits, CgScratch};
+use crate::grid::{BlockGrid, BlockRect};
+use crate::PadStats;
+
+/// The block side this method works on (JPEG's DCT size).
+pub(crate) const SIDE: usize = 8;
+const N: usize = SIDE * SIDE;
+
+/// ITU-T T.81 Annex K luminance quantisation table, row-major.
+const ANNEX_K_LUMA: [f64; N] = [
+    16., 11., 10., 16., 24., 40., 51., 61., 12., 12., 14., 19., 26., 58., 60., 55., 14., 13., 16.,
+    24., 40., 57., 69., 56., 14., 17., 22., 29., 51., 87., 80., 62., 18., 22., 37., 56., 68., 109.,
+    103., 77., 24., 35., 55., 64., 81., 104., 113., 92., 49., 64., 78., 87., 103., 121., 120.,
+    101., 72., 92., 95., 98., 112., 100., 103., 99.,
+];
+
+/// Orthonormal DCT-II basis and weights, plus per-block work space.
+#[derive(Debug)]
+pub(crate) struct DctEnergy {
+    /// basis[k * SIDE + n] = α_k cos(π (2n+1) k / 16).
+    basis: [f64; N],
+    weight: [f64; N],
+    unknowns: Vec<usize>,
+    rhs: Vec<f64>,
+    x: Vec<f64>,
+    scratch: CgScratch,
+}
+
+impl Default for DctEnergy {
+    fn default() -> Self {
+        let mut basis = [0.0; N];
+        for k in 0..SIDE {
+            let alpha = if k == 0 {
+                (1.0 / SIDE as f64).sqrt()
+            } else {
+                (2.0 / SIDE as f64).sqrt()
+            };
+            for n in 0..SIDE {
+                basis[k * SIDE + n] = alpha
+                    * (std::f64::consts::PI * (2 * n + 1) as f64 * k as f64 / (2 * SIDE) as f64)
+                        .cos();
+            }
+        }
+        let mut weight = ANNEX_K_LUMA.map(|q| 1.0 / (q * q));
+        // DC is coded as a difference from the previous block's DC, so its size is not its cost;
+        // weighting it would drag padded values towards 0. With DC free, a single fixed pixel still
+        // pins the system: a nonzero free-pixel vector with only a DC component would be a constant
+        // block that is 0 on the fixed pixels.
+        weight[0] = 0.0;
+        DctEnergy {
+            basis,
+            weight,
+            unknowns: Vec::new(),
+            rhs: Vec::new(),
+            x: Vec::new(),
+            scratch: CgScratch::default(),
+        }
+    }
+}
+
+impl DctEnergy {
+    /// Pads the free pixels of one block that holds at least one fixed pixel.
+    pub fn pad_block(
+        &mut self,
+        grid: &BlockGrid,
+        rect: BlockRect,
+        image: &mut [f32],
+        fixed: &[bool],
+        limits: CgLimits,
+        stats: &mut PadStats,
+    ) {
+        let width = grid.width;
+        let mut known = [0.0f64; N];
+        let mut is_fixed = [false; N];
+        let mut fixed_sum = 0.0;
+        let mut fixed_count = 0usize;
+        self.unknowns.clear();
+        for y in 0..SIDE {
+            for x in 0..SIDE {
+                let local = y * SIDE + x;
+                let inside = x < rect.w && y < rect.h;
+                let pixel = (rect.y0 + y) * width + rect.x0 + x;
+                if inside && fixed[pixel] {
+                    is_fixed[local] = true;
+                    known[local] = f64::from(image[pixel]);
+                    fixed_sum += known[local];
+                    fixed_count += 1;
+                } else {
+                    self.unknowns.push(local);
+                }
+            }
+        }
+        if fixed_count == 0 || self.unknowns.is_empty() {
+            return;
+        }
+        let (basis, weight) = (&self.basis, &self.weight);
+        let operator = |block: &[f64; N], out: &mut [f64; N]| {
+            let mut coefficients = [0.0; N];
+            transform(basis, block, &mut coefficients, false);
+            coefficients
+                .iter_mut()
+                .zip(weight)
+                .for_each(|(c, w)| *c *= w);
+            transform(basis, &coefficients, out, true);
+        };
+        let mut image_of_known = [0.0; N];
+        operator(&known, &mut image_of_known);
+        self.rhs.clear();
+        self.rhs
+            .extend(self.unknowns.iter().map(|&u| -image_of_known[u]));
+        self.x.clear();
+        self.x
+            .resize(self.unknowns.len(), fixed_sum / fixed_count as f64);
+        let unknowns = &self.unknowns;
+        let report = cg::solve(
+            |v, out| {
+                let mut block = [0.0; N];
+                for (&u, &value) in unknowns.iter().zip(v) {
+                    block[u] = value;
+                }
+                let mut result = [0.0; N];
+                operator(&block, &mut result);
+                for (o, &u) in out.iter_mut().zip(unknowns) {
+                    *o = result[u];
+                }
+            },
+            &self.rhs,
+            &mut self.x,
+            limits,
+            &mut self.scratch,
+        );
+        stats.record(report);
+        for (&u, &value) in self.unknowns.iter().zip(&self.x) {
+            let (x, y) = (u % SIDE, u / SIDE);
+            if x < rect.w && y < rect.h && !is_fixed[u] {
+                image[(rect.y0 + y) * width + rect.x0 + x] = value as f32;
+            }
+        }
+    }
+}
+
+/// Separable 2-D DCT (`inverse == false`: c = D b Dᵀ) or its transpose (b = Dᵀ c D).
+fn transform(basis: &[f64; N], input: &[f64; N], output: &mut [f64; N], inverse: bool) {
+    let entry = |k: usize, n: usize| {
+        if inverse {
+            basis[n * SIDE + k]
+        } else {
+            basis[k * SIDE + n]
+        }
+    };
+    let mut rows = [0.0; N];
+    for y in 0..SIDE {
+        for k in 0..SIDE {
+            rows[y * SIDE + k] = (0..SIDE).map(|n| entry(k, n) * input[y * SIDE + n]).sum();
+        }
+    }
+    for k in 0..SIDE {
+        for x in 0..SIDE {
+            output[k * SIDE + x] = (0..SIDE).map(|n| entry(k, n) * rows[n * SIDE + x]).sum();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transform_is_orthonormal() {
+        let dct = DctEnergy::default();
+        let block: [f64; N] = std::array::from_fn(|i| ((i * 37) % 11) as f64 - 5.0);
+        let mut c = [0.0; N];
+        let mut back = [0.0; N];
+        transform(&dct.basis, &block, &mut c, false);
+        transform(&dct.basis, &c, &mut back, true);
+        let energy_b: f64 = block.iter().map(|v| v * v).sum();
+        let energy_c: f64 = c.iter().map(|v| v * v).sum();
+        assert!((energy_b - energy_c).abs() < 1e-9 * energy_b);
+        for (a, b) in block.iter().zip(&back) {
+            assert!((a - b).abs() < 1e-9);
+        }
+        // A flat block has only a DC coefficient, 8× its value.
+        let flat = [3.0; N];
+        transform(&dct.basis, &flat, &mut c, false);
+        assert!((c[0] - 24.0).abs() < 1e-9);
+        assert!(c[1..].iter().all(|v| v.abs() < 1e-9));
+    }
+}

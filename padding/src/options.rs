@@ -1,0 +1,115 @@
+//! The padding methods and their tuning knobs.
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::PaddingError;
+
+/// How free pixels are filled. Every method keeps fixed pixels bit-exact and, given a previous frame,
+/// copies its co-located content into blocks that hold no fixed pixel (so a P-frame codec skips them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// The paper (MCGV §3.3, eq. 5–6): per block, minimise the 8-connected Dirichlet energy ψ(B)
+    /// with fixed pixels held, solved by conjugate gradient.
+    Cg,
+    /// Baseline: every free pixel gets the mid-range of the fixed values (mid-grey; 0 for a centred residual).
+    MidGrey,
+    /// Baseline: free pixels of a block get the mean of that block's fixed pixels.
+    Mean,
+    /// Baseline: multigrid push–pull over the whole image (the hole filling of MPEG V-PCC).
+    PushPull,
+    /// ψ minimised over the whole image rather than per block, so padding is smooth across block
+    /// borders and fills empty blocks too (CG warm-started by push–pull).
+    Laplace,
+    /// Per 8×8 block, minimise the AC energy weighted by JPEG's quantiser, Σ_{k≠0} (c_k / Q_k)²:
+    /// what is left after quantisation is what costs bits.
+    DctEnergy,
+}
+
+impl Method {
+    /// Every method, in the order the bench reports them.
+    pub const ALL: [Method; 6] = [
+        Method::MidGrey,
+        Method::Mean,
+        Method::PushPull,
+        Method::Cg,
+        Method::Laplace,
+        Method::DctEnergy,
+    ];
+
+    /// The names accepted by [`FromStr`] (the `--padding` values).
+    pub const NAMES: [&'static str; 6] = ["midgrey", "mean", "pushpull", "cg", "laplace", "dct"];
+
+    /// The `--padding` name of this method.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::MidGrey => "midgrey",
+            Method::Mean => "mean",
+            Method::PushPull => "pushpull",
+            Method::Cg => "cg",
+            Method::Laplace => "laplace",
+            Method::DctEnergy => "dct",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = PaddingError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let lower = s.trim().to_ascii_lowercase();
+        let method = match lower.as_str() {
+            "cg" => Method::Cg,
+            "midgrey" | "mid-grey" | "zero" | "grey" => Method::MidGrey,
+            "mean" => Method::Mean,
+            "pushpull" | "push-pull" => Method::PushPull,
+            "laplace" => Method::Laplace,
+            "dct" | "dct-energy" | "dctenergy" => Method::DctEnergy,
+            _ => return Err(PaddingError::UnknownMethod(s.to_string())),
+        };
+        Ok(method)
+    }
+}
+
+/// Settings of [`crate::pad`]. `Default` is what the encoder should use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaddingOptions {
+    /// Which filler to run.
+    pub method: Method,
+    /// Side of the square coding blocks (8 for JPEG / MPEG-4 Part 2). Edge blocks may be partial.
+    pub block: usize,
+    /// Conjugate gradient stops when ‖r‖₂ ≤ tolerance · ‖b‖₂. The default 1e-5 puts the padded values
+    /// well under 0.01 grey level from the exact minimiser, far below the 0.5 of 8-bit rounding.
+    pub tolerance: f32,
+    /// Cap on conjugate gradient iterations per system. A block system has at most 64 unknowns, so
+    /// CG ends in ≤ 64 steps in exact arithmetic; the whole-image system (`Laplace`) is the one the
+    /// cap bounds in practice, and there the push–pull warm start leaves little to do.
+    pub max_iterations: usize,
+}
+
+impl Default for PaddingOptions {
+    fn default() -> Self {
+        PaddingOptions {
+            method: Method::Cg,
+            block: 8,
+            tolerance: 1e-5,
+            max_iterations: 400,
+        }
+    }
+}
+
+impl PaddingOptions {
+    /// Default settings with the given method.
+    pub fn with_method(method: Method) -> Self {
+        PaddingOptions {
+            method,
+            ..PaddingOptions::default()
+        }
+    }
+}
