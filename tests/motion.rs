@@ -134,8 +134,7 @@ fn connected_parts_are_recovered_up_to_their_seams() {
     let (mesh, truth) = connected_parts();
     let partition = segment(&mesh, &options(4)).unwrap();
     let score = rand_index(partition.labels(), &truth);
-    eprintln!("{:?}", partition.labels().iter().step_by(RING_SIZE).collect::<Vec<_>>());
-    assert!(score > 0.9, "Rand index {score}");
+    assert!(score > 0.98, "Rand index {score}");
 
     // With the true parts, the predictor leaves only quantisation noise; the motion is far larger.
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();

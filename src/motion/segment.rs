@@ -1,13 +1,13 @@
 //! Motion-based segmentation (MCGV §3.1): per-vertex affine motion of its k-ring, clustered by k-means.
 
-use super::fit::{AffineSolver, UnitFrame};
+use super::fit::{apply, AffineCoefficients, AffineSolver, UnitFrame};
 use crate::error::{Error, Result};
 use crate::mesh::topology::{KRingScratch, VertexAdjacency};
 use crate::mesh::AnimatedMesh;
 use linfa::traits::{Fit, Predict};
 use linfa::DatasetBase;
 use linfa_clustering::{KMeans, KMeansInit};
-use ndarray::{Array2, ArrayView1};
+use ndarray::{Array2, ArrayView1, Axis};
 use rand_xoshiro::rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256Plus;
 use rayon::prelude::*;
@@ -129,31 +129,130 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     if k == 1 {
         return Partition::new(vec![0; v_count], 1);
     }
-    let features = motion_features(mesh, opts);
-    let spread = feature_spread(&features);
+    let sampled = SampledMotion::new(mesh, opts.feature_frames);
+    let (features, misfit) = motion_features(mesh, &sampled, opts.ring);
+    let inliers = affine_rings(&misfit);
+    let training = if inliers.len() >= k {
+        features.select(Axis(0), &inliers)
+    } else {
+        features.clone()
+    };
+    let spread = feature_spread(&training);
     if spread == 0.0 {
         // Every vertex moves alike: k-means would only split ties.
         return Partition::new(vec![0; v_count], 1);
     }
-    let dataset = DatasetBase::from(features);
+    let training = DatasetBase::from(training);
     let model = KMeans::params_with_rng(k, Xoshiro256Plus::seed_from_u64(opts.seed))
         .init_method(KMeansInit::KMeansPlusPlus)
         .n_runs(1)
         .max_n_iterations(opts.max_iterations)
         .tolerance((1e-5 * spread).max(f32::MIN_POSITIVE))
-        .fit(&dataset)
+        .fit(&training)
         .map_err(|e| Error::Usage(format!("k-means failed: {e}")))?;
-    let labels: Vec<usize> = model.predict(dataset.records()).to_vec();
-    let labels = dissolve_small_clusters(labels, dataset.records(), model.centroids(), k);
+    let mut labels: Vec<usize> = model.predict(&features).to_vec();
+    if inliers.len() >= k && inliers.len() < v_count {
+        assign_by_trajectory(&mut labels, &inliers, &sampled, k);
+    }
+    let labels = dissolve_small_clusters(labels, &features, model.centroids(), k);
     compact(labels)
 }
 
-/// The per-vertex motion descriptors α^v, one row per vertex, 12 per sampled frame.
-fn motion_features(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Array2<f32> {
+/// Frame 0 and the sampled frames of an animation, in the unit frame of frame 0.
+struct SampledMotion {
+    rest: Vec<[f64; 3]>,
+    frames: Vec<Vec<[f64; 3]>>,
+}
+
+impl SampledMotion {
+    fn new(mesh: &AnimatedMesh, wanted: usize) -> Self {
+        let unit = UnitFrame::of(mesh.frame(0));
+        let to_unit = |f: &[crate::mesh::Point]| f.iter().map(|p| unit.to_unit(p)).collect();
+        Self {
+            rest: to_unit(mesh.frame(0)),
+            frames: feature_frames(mesh.frame_count(), wanted)
+                .into_iter()
+                .map(|f| to_unit(mesh.frame(f)))
+                .collect(),
+        }
+    }
+}
+
+/// The vertices whose ring moves affinely, up to the typical deviation: those whose ring misfit is
+/// at most a few times the median. The others straddle parts that move differently (seams); their
+/// torn fits are far-off points that would pull k-means centroids away from the real parts.
+fn affine_rings(misfit: &[f32]) -> Vec<usize> {
+    let mut sorted = misfit.to_vec();
+    sorted.sort_by(f32::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    // The floor is float noise in unit coordinates: exact motion must not make every vertex an outlier.
+    let threshold = 4.0 * median + 1e-6;
+    (0..misfit.len()).filter(|&v| misfit[v] <= threshold).collect()
+}
+
+/// Gives each vertex outside `inliers` the cluster whose affine maps (fitted on that cluster's
+/// inliers, eq. 2) predict its sampled trajectory best: the criterion the predictor will be judged by.
+fn assign_by_trajectory(labels: &mut [usize], inliers: &[usize], motion: &SampledMotion, k: usize) {
+    let mut members = vec![Vec::new(); k];
+    for &v in inliers {
+        if let Some(m) = members.get_mut(labels[v]) {
+            m.push(v);
+        }
+    }
+    let maps: Vec<Option<Vec<AffineCoefficients>>> = members
+        .iter()
+        .map(|m| {
+            if m.is_empty() {
+                return None;
+            }
+            let source: Vec<[f64; 3]> = m.iter().map(|&v| motion.rest[v]).collect();
+            let solver = AffineSolver::new(&source, RING_LAMBDA);
+            Some(
+                motion
+                    .frames
+                    .iter()
+                    .map(|f| solver.solve(m.iter().map(|&v| f[v])))
+                    .collect(),
+            )
+        })
+        .collect();
+    let mut is_inlier = vec![false; labels.len()];
+    inliers.iter().for_each(|&v| is_inlier[v] = true);
+    labels
+        .par_iter_mut()
+        .enumerate()
+        .filter(|(v, _)| !is_inlier[*v])
+        .for_each(|(v, label)| {
+            let cost = |track: &Vec<AffineCoefficients>| -> f64 {
+                track
+                    .iter()
+                    .zip(&motion.frames)
+                    .map(|(h, f)| {
+                        let q = apply(h, motion.rest[v]);
+                        (0..3).map(|a| (q[a] - f[v][a]).powi(2)).sum::<f64>()
+                    })
+                    .sum()
+            };
+            if let Some((best, _)) = maps
+                .iter()
+                .enumerate()
+                .filter_map(|(c, m)| m.as_ref().map(|m| (c, cost(m))))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+            {
+                *label = best;
+            }
+        });
+}
+
+/// The per-vertex motion descriptors α^v (one row per vertex, 12 per sampled frame) and how far each
+/// vertex's ring is from moving affinely (RMS fit error, unit coordinates).
+fn motion_features(
+    mesh: &AnimatedMesh,
+    motion: &SampledMotion,
+    ring: usize,
+) -> (Array2<f32>, Vec<f32>) {
     let v_count = mesh.vertex_count();
-    let frames = feature_frames(mesh.frame_count(), opts.feature_frames);
-    let unit = UnitFrame::of(mesh.frame(0));
-    let rest: Vec<[f64; 3]> = mesh.frame(0).iter().map(|p| unit.to_unit(p)).collect();
+    let rest = &motion.rest;
     let radius = (rest
         .iter()
         .map(|p| p.iter().map(|c| c * c).sum::<f64>())
@@ -162,27 +261,43 @@ fn motion_features(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Array2<f32> {
         .sqrt()
         .max(1e-6);
     let adjacency = VertexAdjacency::new(v_count, mesh.triangles());
-    let dim = 12 * frames.len();
+    let dim = 12 * motion.frames.len();
     let mut data = vec![0f32; v_count * dim];
-    data.par_chunks_mut(dim).enumerate().for_each_init(
-        || (KRingScratch::new(v_count), Vec::new()),
-        |(scratch, source), (v, row)| {
-            let ring = scratch.k_ring(&adjacency, v, opts.ring);
-            source.clear();
-            source.extend(ring.iter().map(|&u| rest[u as usize]));
-            let solver = AffineSolver::new(source, RING_LAMBDA);
-            for (slot, &f) in row.chunks_exact_mut(12).zip(&frames) {
-                let target = mesh.frame(f);
-                let h = solver.solve(ring.iter().map(|&u| unit.to_unit(&target[u as usize])));
-                for (c, (out, value)) in slot.iter_mut().zip(h).enumerate() {
-                    let weight = if c % 4 == 3 { 1.0 } else { radius };
-                    *out = (value * weight) as f32;
+    let mut misfit = vec![0f32; v_count];
+    data.par_chunks_mut(dim)
+        .zip(misfit.par_iter_mut())
+        .enumerate()
+        .for_each_init(
+            || (KRingScratch::new(v_count), Vec::new()),
+            |(scratch, source), (v, (row, misfit))| {
+                let ring = scratch.k_ring(&adjacency, v, ring);
+                source.clear();
+                source.extend(ring.iter().map(|&u| rest[u as usize]));
+                let solver = AffineSolver::new(source, RING_LAMBDA);
+                let mut error = 0.0;
+                for (slot, target) in row.chunks_exact_mut(12).zip(&motion.frames) {
+                    let h = solver.solve(ring.iter().map(|&u| target[u as usize]));
+                    error += ring
+                        .iter()
+                        .map(|&u| {
+                            let q = apply(&h, rest[u as usize]);
+                            let t = target[u as usize];
+                            (0..3).map(|a| (q[a] - t[a]).powi(2)).sum::<f64>()
+                        })
+                        .sum::<f64>();
+                    for (c, (out, value)) in slot.iter_mut().zip(h).enumerate() {
+                        let weight = if c % 4 == 3 { 1.0 } else { radius };
+                        *out = (value * weight) as f32;
+                    }
                 }
-            }
-        },
-    );
+                let samples = (ring.len() * motion.frames.len()).max(1);
+                *misfit = (error / samples as f64).sqrt() as f32;
+            },
+        );
     // The shape is (V, dim) by construction.
-    Array2::from_shape_vec((v_count, dim), data).unwrap_or_else(|_| Array2::zeros((v_count, dim)))
+    let features = Array2::from_shape_vec((v_count, dim), data)
+        .unwrap_or_else(|_| Array2::zeros((v_count, dim)));
+    (features, misfit)
 }
 
 /// Up to `wanted` frames spread evenly over `1..frame_count` (frame 0 is the identity for every vertex).
@@ -197,7 +312,7 @@ fn feature_frames(frame_count: usize, wanted: usize) -> Vec<usize> {
 
 /// RMS distance of the feature rows to their mean: the scale k-means' tolerance is relative to.
 fn feature_spread(features: &Array2<f32>) -> f32 {
-    let Some(mean) = features.mean_axis(ndarray::Axis(0)) else {
+    let Some(mean) = features.mean_axis(Axis(0)) else {
         return 0.0;
     };
     let total: f64 = features
