@@ -1,0 +1,130 @@
+//! Segmentation and piecewise affine prediction on real sequences: K, residual energy against raw
+//! motion energy, largest residual, and the time of each stage.
+//!
+//! `cargo bench --bench motion [-- DIR_OR_FILE ...]`; with no arguments, every sequence found under
+//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped).
+
+use mcgv_video::mesh::Point;
+use mcgv_video::motion::{
+    energy, residuals, segment, AffineTrack, SegmentOptions, DEFAULT_AFFINE_BITS,
+};
+use mcgv_video::AnimatedMesh;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
+    let inputs: Vec<PathBuf> = if args.is_empty() {
+        default_inputs()
+    } else {
+        args.iter().map(PathBuf::from).collect()
+    };
+    println!(
+        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>9} {:>9}",
+        "sequence", "V", "F", "K", "resid/motion", "max % diag", "segment s", "predict s"
+    );
+    for input in inputs {
+        let name = input
+            .file_name()
+            .map_or_else(|| input.display().to_string(), |n| n.to_string_lossy().into());
+        match load(&input) {
+            Ok(mesh) => measure(&name, &mesh),
+            Err(e) => println!("{name:<22} skipped: {e}"),
+        }
+    }
+}
+
+fn default_inputs() -> Vec<PathBuf> {
+    let unpacked = Path::new("/work/media-unpacked");
+    let mut inputs: Vec<PathBuf> = ["chickenCrossing", "pcow", "pdance", "horse-gallop", "horse-collapse"]
+        .iter()
+        .map(|n| unpacked.join(n))
+        .collect();
+    inputs.push(PathBuf::from("/work/shared/media/walking_cat/OBJ"));
+    inputs.into_iter().filter(|p| p.exists()).collect()
+}
+
+fn measure(name: &str, mesh: &AnimatedMesh) {
+    let start = Instant::now();
+    let partition = match segment(mesh, &SegmentOptions::default()) {
+        Ok(p) => p,
+        Err(e) => return println!("{name:<22} segmentation failed: {e}"),
+    };
+    let segment_time = start.elapsed().as_secs_f64();
+
+    // The reference is the original frame 0: the decoded one is not available to this stage alone.
+    let start = Instant::now();
+    let reference = mesh.frame(0);
+    let track = match AffineTrack::fit(mesh.frames(), reference, &partition, DEFAULT_AFFINE_BITS) {
+        Ok(t) => t,
+        Err(e) => return println!("{name:<22} prediction failed: {e}"),
+    };
+    let mut residual_energy = 0.0;
+    let mut motion_energy = 0.0;
+    let mut largest = 0f64;
+    for f in 0..mesh.frame_count() {
+        let Ok(predicted) = track.predict(f, reference, &partition) else {
+            return println!("{name:<22} prediction of frame {f} failed");
+        };
+        let e = residuals(mesh.frame(f), &predicted);
+        residual_energy += energy(&e);
+        motion_energy += energy(&residuals(mesh.frame(f), reference));
+        largest = e
+            .iter()
+            .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+            .fold(largest, f64::max);
+    }
+    let predict_time = start.elapsed().as_secs_f64();
+    println!(
+        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>9.3} {:>9.3}",
+        mesh.vertex_count(),
+        mesh.frame_count(),
+        partition.clusters(),
+        residual_energy / motion_energy.max(f64::MIN_POSITIVE),
+        100.0 * largest / mesh.bbox_diagonal(),
+        segment_time,
+        predict_time
+    );
+}
+
+// TEMPORARY: a minimal OBJ-sequence loader until the project's readers land on main; delete it then
+// and call `mcgv_video::mesh::read_animation` instead (the project keeps one OBJ reader).
+fn load(dir: &Path) -> Result<AnimatedMesh, String> {
+    let mut files: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
+        .map_err(|e| e.to_string())?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .map(|p| {
+            let digits: String = p
+                .file_stem()
+                .map(|s| s.to_string_lossy().chars().filter(char::is_ascii_digit).collect())
+                .unwrap_or_default();
+            (digits.parse().unwrap_or(0), p)
+        })
+        .collect();
+    files.sort();
+    let mut triangles = Vec::new();
+    let mut frames: Vec<Vec<Point>> = Vec::new();
+    for (_, path) in &files {
+        let (models, _) = tobj::load_obj(
+            path,
+            &tobj::LoadOptions {
+                triangulate: true,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut points = Vec::new();
+        let mut tris = Vec::new();
+        for m in &models {
+            let base = points.len() as u32;
+            points.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+            tris.extend(m.mesh.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
+        }
+        if frames.is_empty() {
+            triangles = tris;
+        }
+        frames.push(points);
+    }
+    AnimatedMesh::new(triangles, frames).map_err(|e| e.to_string())
+}

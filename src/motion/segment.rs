@@ -1,0 +1,412 @@
+//! Motion-based segmentation (MCGV §3.1): per-vertex affine motion of its k-ring, clustered by k-means.
+
+use super::fit::{apply, AffineCoefficients, AffineSolver, UnitFrame};
+use crate::error::{Error, Result};
+use crate::mesh::topology::{KRingScratch, VertexAdjacency};
+use crate::mesh::AnimatedMesh;
+use linfa::traits::{Fit, Predict};
+use linfa::DatasetBase;
+use linfa_clustering::{KMeans, KMeansInit};
+use ndarray::{Array2, ArrayView1, Axis};
+use rand_xoshiro::rand_core::SeedableRng;
+use rand_xoshiro::Xoshiro256Plus;
+use rayon::prelude::*;
+
+/// Fewest vertices a cluster needs so that its affine map (12 unknowns, 3 equations per vertex) is determined.
+pub const MIN_CLUSTER_SIZE: usize = 4;
+
+/// Regularisation of the per-vertex fits, relative to the ring's spread: large enough that nearly
+/// flat rings do not turn noise into wild out-of-plane coefficients, small enough not to bias real motion.
+const RING_LAMBDA: f64 = 1e-3;
+
+/// How to segment.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SegmentOptions {
+    /// Number of clusters asked for (K, default 20); fewer come out when vertices are few or motion is simple.
+    pub clusters: usize,
+    /// Neighbourhood of each vertex's affine fit, in edges (default 3, as in the paper).
+    pub ring: usize,
+    /// Seed of the k-means++ initialisation: the same input and seed give the same partition.
+    pub seed: u64,
+    /// At most this many frames, evenly spaced, describe each vertex's motion (default 64): k-means
+    /// cost grows with the feature length, and smooth motion is well sampled by far fewer frames.
+    pub feature_frames: usize,
+    /// Cap on Lloyd iterations of k-means (default 100).
+    pub max_iterations: u64,
+}
+
+impl Default for SegmentOptions {
+    fn default() -> Self {
+        Self {
+            clusters: 20,
+            ring: 3,
+            seed: 0,
+            feature_frames: 64,
+            max_iterations: 100,
+        }
+    }
+}
+
+/// A cluster id per vertex. Labels are compact: every cluster in `0..clusters()` has at least one vertex.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Partition {
+    labels: Vec<u32>,
+    clusters: usize,
+}
+
+impl Partition {
+    /// Checks and wraps labels (e.g. read from a stream): at least one vertex, every label below
+    /// `clusters`, and every cluster used.
+    pub fn new(labels: Vec<u32>, clusters: usize) -> Result<Self> {
+        if labels.is_empty() {
+            return Err(Error::Stream("partition has no vertices".into()));
+        }
+        let mut used = vec![false; clusters];
+        for (v, &l) in labels.iter().enumerate() {
+            match used.get_mut(l as usize) {
+                Some(u) => *u = true,
+                None => {
+                    return Err(Error::Stream(format!(
+                        "partition: vertex {v} has cluster {l}, but there are only {clusters}"
+                    )))
+                }
+            }
+        }
+        if let Some(k) = used.iter().position(|&u| !u) {
+            return Err(Error::Stream(format!(
+                "partition: cluster {k} of {clusters} has no vertex"
+            )));
+        }
+        Ok(Self { labels, clusters })
+    }
+
+    /// The cluster of each vertex.
+    pub fn labels(&self) -> &[u32] {
+        &self.labels
+    }
+
+    /// Number of clusters.
+    pub fn clusters(&self) -> usize {
+        self.clusters
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.labels.len()
+    }
+
+    /// The vertices of each cluster, in increasing order.
+    pub fn members(&self) -> Vec<Vec<u32>> {
+        let mut members = vec![Vec::new(); self.clusters];
+        for (v, &l) in self.labels.iter().enumerate() {
+            if let Some(m) = members.get_mut(l as usize) {
+                m.push(v as u32);
+            }
+        }
+        members
+    }
+}
+
+/// Segments the vertices into clusters of similar affine motion (MCGV §3.1, eq. 1).
+///
+/// Each vertex is described by the affine maps, frame 0 → frame i, that best fit its `ring`-ring,
+/// written in the unit frame of frame 0 (bounding-box centre at the origin, diagonal 1). The linear
+/// part is weighted by the RMS radius of the shape so that both parts measure displacement: a change
+/// δ of a linear coefficient moves a typical vertex by about that radius × δ. Then k-means
+/// (k-means++ seeded by `opts.seed`, one run). Clusters with fewer than [`MIN_CLUSTER_SIZE`]
+/// vertices are dissolved, smallest first, into the nearest remaining centroid; empty ones vanish.
+pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> {
+    if opts.clusters == 0 {
+        return Err(Error::Usage("the number of clusters must be at least 1".into()));
+    }
+    if opts.feature_frames == 0 || opts.max_iterations == 0 {
+        return Err(Error::Usage(
+            "segmentation needs at least one feature frame and one k-means iteration".into(),
+        ));
+    }
+    let v_count = mesh.vertex_count();
+    let k = opts.clusters.min(v_count);
+    if k == 1 {
+        return Partition::new(vec![0; v_count], 1);
+    }
+    let sampled = SampledMotion::new(mesh, opts.feature_frames);
+    let (features, misfit) = motion_features(mesh, &sampled, opts.ring);
+    let inliers = affine_rings(&misfit);
+    let training = if inliers.len() >= k {
+        features.select(Axis(0), &inliers)
+    } else {
+        features.clone()
+    };
+    let spread = feature_spread(&training);
+    if spread == 0.0 {
+        // Every vertex moves alike: k-means would only split ties.
+        return Partition::new(vec![0; v_count], 1);
+    }
+    let training = DatasetBase::from(training);
+    let model = KMeans::params_with_rng(k, Xoshiro256Plus::seed_from_u64(opts.seed))
+        .init_method(KMeansInit::KMeansPlusPlus)
+        .n_runs(1)
+        .max_n_iterations(opts.max_iterations)
+        .tolerance((1e-5 * spread).max(f32::MIN_POSITIVE))
+        .fit(&training)
+        .map_err(|e| Error::Usage(format!("k-means failed: {e}")))?;
+    let mut labels: Vec<usize> = model.predict(&features).to_vec();
+    if inliers.len() >= k && inliers.len() < v_count {
+        assign_by_trajectory(&mut labels, &inliers, &sampled, k);
+    }
+    let labels = dissolve_small_clusters(labels, &features, model.centroids(), k);
+    compact(labels)
+}
+
+/// Frame 0 and the sampled frames of an animation, in the unit frame of frame 0.
+struct SampledMotion {
+    rest: Vec<[f64; 3]>,
+    frames: Vec<Vec<[f64; 3]>>,
+}
+
+impl SampledMotion {
+    fn new(mesh: &AnimatedMesh, wanted: usize) -> Self {
+        let unit = UnitFrame::of(mesh.frame(0));
+        let to_unit = |f: &[crate::mesh::Point]| f.iter().map(|p| unit.to_unit(p)).collect();
+        Self {
+            rest: to_unit(mesh.frame(0)),
+            frames: feature_frames(mesh.frame_count(), wanted)
+                .into_iter()
+                .map(|f| to_unit(mesh.frame(f)))
+                .collect(),
+        }
+    }
+}
+
+/// The vertices whose ring moves affinely, up to the typical deviation: those whose ring misfit is
+/// at most a few times the median. The others straddle parts that move differently (seams); their
+/// torn fits are far-off points that would pull k-means centroids away from the real parts.
+fn affine_rings(misfit: &[f32]) -> Vec<usize> {
+    let mut sorted = misfit.to_vec();
+    sorted.sort_by(f32::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    // The floor is float noise in unit coordinates: exact motion must not make every vertex an outlier.
+    let threshold = 4.0 * median + 1e-6;
+    (0..misfit.len()).filter(|&v| misfit[v] <= threshold).collect()
+}
+
+/// Gives each vertex outside `inliers` the cluster whose affine maps (fitted on that cluster's
+/// inliers, eq. 2) predict its sampled trajectory best: the criterion the predictor will be judged by.
+fn assign_by_trajectory(labels: &mut [usize], inliers: &[usize], motion: &SampledMotion, k: usize) {
+    let mut members = vec![Vec::new(); k];
+    for &v in inliers {
+        if let Some(m) = members.get_mut(labels[v]) {
+            m.push(v);
+        }
+    }
+    let maps: Vec<Option<Vec<AffineCoefficients>>> = members
+        .iter()
+        .map(|m| {
+            if m.is_empty() {
+                return None;
+            }
+            let source: Vec<[f64; 3]> = m.iter().map(|&v| motion.rest[v]).collect();
+            let solver = AffineSolver::new(&source, RING_LAMBDA);
+            Some(
+                motion
+                    .frames
+                    .iter()
+                    .map(|f| solver.solve(m.iter().map(|&v| f[v])))
+                    .collect(),
+            )
+        })
+        .collect();
+    let mut is_inlier = vec![false; labels.len()];
+    inliers.iter().for_each(|&v| is_inlier[v] = true);
+    labels
+        .par_iter_mut()
+        .enumerate()
+        .filter(|(v, _)| !is_inlier[*v])
+        .for_each(|(v, label)| {
+            let cost = |track: &Vec<AffineCoefficients>| -> f64 {
+                track
+                    .iter()
+                    .zip(&motion.frames)
+                    .map(|(h, f)| {
+                        let q = apply(h, motion.rest[v]);
+                        (0..3).map(|a| (q[a] - f[v][a]).powi(2)).sum::<f64>()
+                    })
+                    .sum()
+            };
+            if let Some((best, _)) = maps
+                .iter()
+                .enumerate()
+                .filter_map(|(c, m)| m.as_ref().map(|m| (c, cost(m))))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+            {
+                *label = best;
+            }
+        });
+}
+
+/// The per-vertex motion descriptors α^v (one row per vertex, 12 per sampled frame) and how far each
+/// vertex's ring is from moving affinely (RMS fit error, unit coordinates).
+fn motion_features(
+    mesh: &AnimatedMesh,
+    motion: &SampledMotion,
+    ring: usize,
+) -> (Array2<f32>, Vec<f32>) {
+    let v_count = mesh.vertex_count();
+    let rest = &motion.rest;
+    let radius = (rest
+        .iter()
+        .map(|p| p.iter().map(|c| c * c).sum::<f64>())
+        .sum::<f64>()
+        / v_count as f64)
+        .sqrt()
+        .max(1e-6);
+    let adjacency = VertexAdjacency::new(v_count, mesh.triangles());
+    let dim = 12 * motion.frames.len();
+    let mut data = vec![0f32; v_count * dim];
+    let mut misfit = vec![0f32; v_count];
+    data.par_chunks_mut(dim)
+        .zip(misfit.par_iter_mut())
+        .enumerate()
+        .for_each_init(
+            || (KRingScratch::new(v_count), Vec::new()),
+            |(scratch, source), (v, (row, misfit))| {
+                let ring = scratch.k_ring(&adjacency, v, ring);
+                source.clear();
+                source.extend(ring.iter().map(|&u| rest[u as usize]));
+                let solver = AffineSolver::new(source, RING_LAMBDA);
+                let mut error = 0.0;
+                for (slot, target) in row.chunks_exact_mut(12).zip(&motion.frames) {
+                    let h = solver.solve(ring.iter().map(|&u| target[u as usize]));
+                    error += ring
+                        .iter()
+                        .map(|&u| {
+                            let q = apply(&h, rest[u as usize]);
+                            let t = target[u as usize];
+                            (0..3).map(|a| (q[a] - t[a]).powi(2)).sum::<f64>()
+                        })
+                        .sum::<f64>();
+                    for (c, (out, value)) in slot.iter_mut().zip(h).enumerate() {
+                        let weight = if c % 4 == 3 { 1.0 } else { radius };
+                        *out = (value * weight) as f32;
+                    }
+                }
+                let samples = (ring.len() * motion.frames.len()).max(1);
+                *misfit = (error / samples as f64).sqrt() as f32;
+            },
+        );
+    // The shape is (V, dim) by construction.
+    let features = Array2::from_shape_vec((v_count, dim), data)
+        .unwrap_or_else(|_| Array2::zeros((v_count, dim)));
+    (features, misfit)
+}
+
+/// Up to `wanted` frames spread evenly over `1..frame_count` (frame 0 is the identity for every vertex).
+fn feature_frames(frame_count: usize, wanted: usize) -> Vec<usize> {
+    if frame_count <= 1 {
+        return vec![0];
+    }
+    let last = frame_count - 1;
+    let m = wanted.min(last);
+    (1..=m).map(|j| (j * last + m / 2) / m).collect()
+}
+
+/// RMS distance of the feature rows to their mean: the scale k-means' tolerance is relative to.
+fn feature_spread(features: &Array2<f32>) -> f32 {
+    let Some(mean) = features.mean_axis(Axis(0)) else {
+        return 0.0;
+    };
+    let total: f64 = features
+        .rows()
+        .into_iter()
+        .map(|r| squared_distance(r, mean.view()) as f64)
+        .sum();
+    (total / features.nrows().max(1) as f64).sqrt() as f32
+}
+
+fn squared_distance(a: ArrayView1<f32>, b: ArrayView1<f32>) -> f32 {
+    a.iter().zip(b.iter()).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
+/// Moves the vertices of clusters too small for an affine fit to the nearest surviving centroid,
+/// smallest cluster first (ties: lowest id), until every non-empty cluster is big enough or one is left.
+fn dissolve_small_clusters(
+    mut labels: Vec<usize>,
+    features: &Array2<f32>,
+    centroids: &Array2<f32>,
+    k: usize,
+) -> Vec<usize> {
+    let mut sizes = vec![0usize; k];
+    for &l in &labels {
+        if let Some(s) = sizes.get_mut(l) {
+            *s += 1;
+        }
+    }
+    loop {
+        let alive = sizes.iter().filter(|&&s| s > 0).count();
+        let victim = sizes
+            .iter()
+            .enumerate()
+            .filter(|&(_, &s)| s > 0 && s < MIN_CLUSTER_SIZE)
+            .min_by_key(|&(c, &s)| (s, c))
+            .map(|(c, _)| c);
+        let Some(victim) = victim.filter(|_| alive > 1) else {
+            return labels;
+        };
+        sizes[victim] = 0;
+        for (v, label) in labels.iter_mut().enumerate() {
+            if *label != victim {
+                continue;
+            }
+            let row = features.row(v);
+            let nearest = (0..k)
+                .filter(|&c| sizes[c] > 0)
+                .map(|c| (c, squared_distance(row, centroids.row(c))))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or(victim, |(c, _)| c);
+            *label = nearest;
+        }
+        sizes.iter_mut().for_each(|s| *s = 0);
+        for &l in &labels {
+            if let Some(s) = sizes.get_mut(l) {
+                *s += 1;
+            }
+        }
+    }
+}
+
+/// Renumbers labels `0..n` in order of first appearance.
+fn compact(labels: Vec<usize>) -> Result<Partition> {
+    let mut map = std::collections::HashMap::new();
+    let compact: Vec<u32> = labels
+        .into_iter()
+        .map(|l| {
+            let next = map.len() as u32;
+            *map.entry(l).or_insert(next)
+        })
+        .collect();
+    Partition::new(compact, map.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn feature_frames_are_spread_and_distinct() {
+        assert_eq!(feature_frames(1, 64), vec![0]);
+        assert_eq!(feature_frames(5, 64), vec![1, 2, 3, 4]);
+        let f = feature_frames(201, 64);
+        assert_eq!(f.len(), 64);
+        assert_eq!(f.last(), Some(&200));
+        assert!(f.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    #[test]
+    fn partition_rejects_bad_labels() {
+        assert!(Partition::new(vec![0, 2], 2).is_err());
+        assert!(Partition::new(vec![0, 0], 2).is_err());
+        assert!(Partition::new(vec![], 1).is_err());
+        let p = Partition::new(vec![1, 0, 1], 2).unwrap();
+        assert_eq!(p.members(), vec![vec![1], vec![0, 2]]);
+    }
+}

@@ -1,0 +1,262 @@
+//! Segmentation and piecewise affine prediction on synthetic animations with a known answer.
+
+use mcgv_video::mesh::{Point, Triangle};
+use mcgv_video::motion::{
+    energy, render_partition_png, residuals, segment, AffineTrack, Partition, SegmentOptions,
+};
+use mcgv_video::AnimatedMesh;
+
+const FRAMES: usize = 12;
+const RING_SIZE: usize = 16;
+
+/// A closed-around tube along x from `x0` to `x1`, `rings` rings of `RING_SIZE` vertices, appended.
+fn tube(points: &mut Vec<Point>, tris: &mut Vec<Triangle>, x0: f32, x1: f32, rings: usize) {
+    let base = points.len() as u32;
+    for r in 0..rings {
+        let x = x0 + (x1 - x0) * r as f32 / (rings - 1) as f32;
+        for s in 0..RING_SIZE {
+            let a = std::f32::consts::TAU * s as f32 / RING_SIZE as f32;
+            // A slight bulge keeps the surface from being a ruled one.
+            let radius = 1.0 + 0.2 * (x * 1.3).sin();
+            points.push([x, radius * a.cos(), radius * a.sin()]);
+        }
+    }
+    let n = RING_SIZE as u32;
+    for r in 0..rings as u32 - 1 {
+        for s in 0..n {
+            let (a, b) = (base + r * n + s, base + r * n + (s + 1) % n);
+            let (c, d) = (a + n, b + n);
+            tris.push([a, b, d]);
+            tris.push([a, d, c]);
+        }
+    }
+}
+
+/// Part `k`'s affine map at time `t` ∈ [0, 1]: a rotation about its own axis, a stretch and a shift.
+fn part_map(k: usize, t: f32) -> impl Fn(Point) -> Point {
+    let angle = t * (0.6 + 0.5 * k as f32) * if k % 2 == 0 { 1.0 } else { -1.0 };
+    let stretch = 1.0 + 0.3 * t * (k as f32 - 1.5);
+    let shift = [0.5 * t * k as f32, 1.5 * t * (k as f32 * 0.7).sin(), -t * k as f32];
+    let axis = k % 3;
+    move |p: Point| {
+        let (c, s) = (angle.cos(), angle.sin());
+        let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+        let mut q = p;
+        q[i] = c * p[i] - s * p[j];
+        q[j] = s * p[i] + c * p[j];
+        q[axis] *= stretch;
+        [q[0] + shift[0], q[1] + shift[1], q[2] + shift[2]]
+    }
+}
+
+/// An animation whose vertices move exactly by their part's affine map; returns it with the true parts.
+fn piecewise_affine(points: Vec<Point>, tris: Vec<Triangle>, part: &[usize]) -> AnimatedMesh {
+    let frames = (0..FRAMES)
+        .map(|f| {
+            let t = f as f32 / (FRAMES - 1) as f32;
+            points
+                .iter()
+                .zip(part)
+                .map(|(&p, &k)| part_map(k, t)(p))
+                .collect()
+        })
+        .collect();
+    AnimatedMesh::new(tris, frames).unwrap()
+}
+
+/// One tube cut into four parts along x.
+fn connected_parts() -> (AnimatedMesh, Vec<usize>) {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, 0.0, 8.0, 81);
+    let part: Vec<usize> = points.iter().map(|p| ((p[0] / 2.0) as usize).min(3)).collect();
+    (piecewise_affine(points, tris, &part), part)
+}
+
+/// Four separate tubes, one per part.
+fn separate_parts() -> (AnimatedMesh, Vec<usize>) {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    let mut part = Vec::new();
+    for k in 0..4 {
+        tube(&mut points, &mut tris, 2.5 * k as f32, 2.5 * k as f32 + 2.0, 9);
+        part.resize(points.len(), k);
+    }
+    (piecewise_affine(points, tris, &part), part)
+}
+
+/// Fraction of vertex pairs on which two labelings agree (same/different): the Rand index.
+fn rand_index(a: &[u32], b: &[usize]) -> f64 {
+    let (mut agree, mut total) = (0u64, 0u64);
+    for i in 0..a.len() {
+        for j in i + 1..a.len() {
+            agree += u64::from((a[i] == a[j]) == (b[i] == b[j]));
+            total += 1;
+        }
+    }
+    agree as f64 / total as f64
+}
+
+fn options(clusters: usize) -> SegmentOptions {
+    SegmentOptions {
+        clusters,
+        ..SegmentOptions::default()
+    }
+}
+
+fn max_residual(mesh: &AnimatedMesh, track: &AffineTrack, partition: &Partition) -> f64 {
+    (0..mesh.frame_count())
+        .flat_map(|f| {
+            let predicted = track.predict(f, mesh.frame(0), partition).unwrap();
+            residuals(mesh.frame(f), &predicted)
+        })
+        .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn separate_parts_are_recovered_and_predicted_to_quantisation_level() {
+    let (mesh, truth) = separate_parts();
+    let partition = segment(&mesh, &options(4)).unwrap();
+    assert_eq!(partition.clusters(), 4);
+    assert_eq!(rand_index(partition.labels(), &truth), 1.0);
+
+    let diag = mesh.bbox_diagonal();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
+    let worst = max_residual(&mesh, &track, &partition);
+    assert!(worst < 2e-5 * diag, "largest residual {worst} vs diagonal {diag}");
+    // Fewer bits: coarser, but still following the motion (the ranges are what make bits count).
+    let coarse = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 8).unwrap();
+    let coarse_worst = max_residual(&mesh, &coarse, &partition);
+    assert!(coarse_worst > worst && coarse_worst < 1e-2 * diag, "{coarse_worst}");
+}
+
+#[test]
+fn connected_parts_are_recovered_up_to_their_seams() {
+    let (mesh, truth) = connected_parts();
+    let partition = segment(&mesh, &options(4)).unwrap();
+    let score = rand_index(partition.labels(), &truth);
+    assert!(score > 0.98, "Rand index {score}");
+
+    // With the true parts, the predictor leaves only quantisation noise; the motion is far larger.
+    let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
+    let exact = Partition::new(labels, 4).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, 17).unwrap();
+    let diag = mesh.bbox_diagonal();
+    assert!(max_residual(&mesh, &track, &exact) < 2e-5 * diag);
+    let last = mesh.frame(FRAMES - 1);
+    let motion: Vec<[f32; 3]> = residuals(last, mesh.frame(0));
+    let predicted = track.predict(FRAMES - 1, mesh.frame(0), &exact).unwrap();
+    assert!(energy(&residuals(last, &predicted)) < 1e-9 * energy(&motion));
+}
+
+#[test]
+fn segmentation_is_deterministic() {
+    let (mesh, _) = connected_parts();
+    let a = segment(&mesh, &options(6)).unwrap();
+    let b = segment(&mesh, &options(6)).unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn quantised_form_round_trips_and_rejects_corruption() {
+    let (mesh, truth) = separate_parts();
+    let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
+    let partition = Partition::new(labels, 4).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
+    let again = AffineTrack::from_quantised(track.quantised().clone()).unwrap();
+    for f in [0, 5, FRAMES - 1] {
+        assert_eq!(
+            track.predict(f, mesh.frame(0), &partition).unwrap(),
+            again.predict(f, mesh.frame(0), &partition).unwrap()
+        );
+    }
+    let mut too_big = track.quantised().clone();
+    too_big.values[3] = 1 << 17;
+    assert!(AffineTrack::from_quantised(too_big).is_err());
+    let mut short = track.quantised().clone();
+    short.values.pop();
+    assert!(AffineTrack::from_quantised(short).is_err());
+    let mut nan = track.quantised().clone();
+    nan.ranges[0].1 = f32::NAN;
+    assert!(AffineTrack::from_quantised(nan).is_err());
+    assert!(track.predict(FRAMES, mesh.frame(0), &partition).is_err());
+}
+
+fn assert_finite_everywhere(mesh: &AnimatedMesh, clusters: usize) {
+    let partition = segment(mesh, &options(clusters)).unwrap();
+    assert_eq!(partition.vertex_count(), mesh.vertex_count());
+    assert!(partition.clusters() >= 1 && partition.clusters() <= clusters);
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
+    for f in 0..mesh.frame_count() {
+        let predicted = track.predict(f, mesh.frame(0), &partition).unwrap();
+        assert!(predicted.iter().flatten().all(|c| c.is_finite()));
+    }
+}
+
+#[test]
+fn degenerate_inputs_give_finite_answers() {
+    // A flat grid that slides and shears in its plane, and a moving line of vertices.
+    let n = 6u32;
+    let grid: Vec<Point> = (0..n * n).map(|i| [(i % n) as f32, (i / n) as f32, 0.0]).collect();
+    let mut tris = Vec::new();
+    for y in 0..n - 1 {
+        for x in 0..n - 1 {
+            let a = y * n + x;
+            tris.push([a, a + 1, a + n + 1]);
+            tris.push([a, a + n + 1, a + n]);
+        }
+    }
+    let slide = |p: Point, t: f32| [p[0] + t * p[1], p[1] + t, 0.0];
+    let frames = (0..4).map(|f| grid.iter().map(|&p| slide(p, f as f32 * 0.3)).collect());
+    assert_finite_everywhere(&AnimatedMesh::new(tris, frames.collect()).unwrap(), 5);
+
+    let line: Vec<Point> = (0..8).map(|i| [i as f32, 0.0, 0.0]).collect();
+    let line_tris: Vec<Triangle> = (0..7).map(|i| [i, i + 1, i + 1]).collect();
+    let frames = (0..3).map(|f| line.iter().map(|p| [p[0] * (1.0 + f as f32), f as f32, 0.0]).collect());
+    assert_finite_everywhere(&AnimatedMesh::new(line_tris, frames.collect()).unwrap(), 3);
+
+    // Isolated vertices, more clusters than vertices, a single frame, no motion at all.
+    let loose: Vec<Point> = vec![[0.0, 0.0, 0.0], [1.0, 2.0, 3.0], [4.0, 1.0, 0.0]];
+    let moved: Vec<Point> = loose.iter().map(|p| [p[0] + 1.0, p[1], -p[2]]).collect();
+    assert_finite_everywhere(&AnimatedMesh::new(vec![], vec![loose.clone(), moved]).unwrap(), 20);
+    assert_finite_everywhere(&AnimatedMesh::new(vec![], vec![loose.clone()]).unwrap(), 2);
+    let (mesh, _) = separate_parts();
+    let still = AnimatedMesh::new(mesh.triangles().to_vec(), vec![mesh.frame(0).to_vec(); 3]).unwrap();
+    let partition = segment(&still, &options(4)).unwrap();
+    assert_eq!(partition.clusters(), 1);
+}
+
+#[test]
+fn small_clusters_are_dissolved() {
+    let (mesh, _) = separate_parts();
+    // 144 vertices, 60 clusters asked: some would be tiny.
+    let partition = segment(&mesh, &options(60)).unwrap();
+    let sizes: Vec<usize> = partition.members().iter().map(Vec::len).collect();
+    assert!(sizes.iter().all(|&s| s >= 4), "{sizes:?}");
+}
+
+#[test]
+fn bad_requests_are_errors() {
+    let (mesh, truth) = separate_parts();
+    assert!(segment(&mesh, &options(0)).is_err());
+    let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
+    let partition = Partition::new(labels, 4).unwrap();
+    assert!(AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 0).is_err());
+    assert!(AffineTrack::fit(mesh.frames(), &mesh.frame(0)[1..], &partition, 17).is_err());
+}
+
+#[test]
+fn partition_picture_shows_every_cluster() {
+    let (mesh, truth) = separate_parts();
+    let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("partition.png");
+    render_partition_png(mesh.frame(0), mesh.triangles(), &labels, 96, &path).unwrap();
+    let image = image::open(&path).unwrap().to_rgb8();
+    assert_eq!(image.dimensions(), (96, 96));
+    let mut colours: Vec<[u8; 3]> = image.pixels().map(|p| p.0).collect();
+    colours.sort();
+    colours.dedup();
+    // Background plus four hues, each in a few shades.
+    assert!(colours.len() >= 5, "{} colours", colours.len());
+    assert!(render_partition_png(mesh.frame(0), mesh.triangles(), &labels[1..], 96, &path).is_err());
+}
