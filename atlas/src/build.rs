@@ -114,9 +114,11 @@ fn suggest_side(vertices: usize, opts: &AtlasOptions) -> u32 {
     side
 }
 
-/// Each vertex goes to one chart: the chart of the first face (in triangle
-/// order) that uses it and belongs to the vertex's own cluster, or failing
-/// that the chart of the first charted face that uses it.
+/// Each vertex goes to one chart: among the charts with a face on it, the
+/// one with most faces among those whose faces are in the vertex's own
+/// cluster, else the one with most faces; ties go to the lower chart id.
+/// Preferring big charts empties the slivers uvunwrap leaves along seams,
+/// which are then dropped instead of each costing a block.
 fn assign_owners(
     triangles: &[[u32; 3]],
     partition: &[u32],
@@ -124,26 +126,33 @@ fn assign_owners(
     flat: &Flattening,
     vertices: usize,
 ) -> Vec<Option<(u32, [f64; 2])>> {
-    let mut owner: Vec<Option<(u32, [f64; 2], bool)>> = vec![None; vertices];
+    let mut chart_faces = vec![0usize; flat.charts as usize];
+    for c in flat.face_chart.iter().flatten() {
+        chart_faces[*c as usize] += 1;
+    }
+    // Rank: (own cluster, faces in chart, lower id first).
+    type Rank = (bool, usize, std::cmp::Reverse<u32>);
+    let mut owner: Vec<Option<(Rank, u32, [f64; 2])>> = vec![None; vertices];
     for (f, tri) in triangles.iter().enumerate() {
         let Some(chart) = flat.face_chart[f] else {
             continue;
         };
         for (k, &v) in tri.iter().enumerate() {
             let own_cluster = partition.get(v as usize) == face_cluster.get(f);
+            let rank = (
+                own_cluster,
+                chart_faces[chart as usize],
+                std::cmp::Reverse(chart),
+            );
             let slot = &mut owner[v as usize];
-            let replace = match slot {
-                None => true,
-                Some((_, _, had_own)) => !*had_own && own_cluster,
-            };
-            if replace {
-                *slot = Some((chart, flat.corner_uv[f][k], own_cluster));
+            if slot.as_ref().is_none_or(|(r, _, _)| rank > *r) {
+                *slot = Some((rank, chart, flat.corner_uv[f][k]));
             }
         }
     }
     owner
         .into_iter()
-        .map(|o| o.map(|(c, uv, _)| (c, uv)))
+        .map(|o| o.map(|(_, c, uv)| (c, uv)))
         .collect()
 }
 
