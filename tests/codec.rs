@@ -363,6 +363,57 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
         quality_to_qscale(75),
         quality_to_qscale(90)
     );
+    let sample = jpeg::encode(&planes[0], 75)?;
+    println!(
+        "jpeg header (SOI … end of SOS header) {} of {} bytes",
+        jpeg_header_len(&sample),
+        sample.len()
+    );
+    // The same picture with the standard (Annex K) Huffman tables, identical in every file.
+    let mut standard = Vec::new();
+    jpeg_encoder::Encoder::new(&mut standard, 75)
+        .encode(&planes[0].data, 256, 256, jpeg_encoder::ColorType::Luma)
+        .map_err(|e| mcgv_video::Error::Codec(e.to_string()))?;
+    println!(
+        "jpeg q75 standard Huffman tables: header {} of {} bytes",
+        jpeg_header_len(&standard),
+        standard.len()
+    );
+    let still = vec![planes[0].clone(); 4];
+    let still_packets = encode_all(&still, &Mpeg4Options { qscale: 8, gop: 30 })?;
+    println!(
+        "mpeg4 packet sizes for an unchanging picture (I then P): {:?}",
+        still_packets
+            .iter()
+            .map(|p| p.data.len())
+            .collect::<Vec<_>>()
+    );
+    let short = sequence(256, 256, 10);
+    for quality in (10..=100).step_by(10) {
+        let mut psnr = 0.0;
+        let mut bytes = 0;
+        for p in &short {
+            let coded = jpeg::encode(p, quality)?;
+            bytes += coded.len();
+            psnr += p.psnr(&jpeg::decode(&coded, 256, 256)?)?;
+        }
+        println!(
+            "sweep jpeg  q{quality:<3}  {:6} B/frame  PSNR {:5.2}",
+            bytes / short.len(),
+            psnr / short.len() as f64
+        );
+    }
+    for qscale in [1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 25, 31] {
+        let packets = encode_all(&short, &Mpeg4Options { qscale, gop: 30 })?;
+        let decoded = decode_all(&packets, 256, 256)?;
+        println!(
+            "sweep mpeg4 qs{qscale:<2}  {:6} B/frame  PSNR {:5.2}  (I-frame {} B, {:5.2} dB)",
+            packets.iter().map(|p| p.data.len()).sum::<usize>() / short.len(),
+            mean_psnr(&short, &decoded)?,
+            packets[0].data.len(),
+            short[0].psnr(&decoded[0])?
+        );
+    }
 
     // Three coordinate images: three streams vs one 768×256 picture tiled side by side.
     let coords: Vec<[Plane; 3]> = (0..FRAMES)
@@ -405,6 +456,17 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Bytes before the entropy-coded data: markers, tables, frame and scan headers.
+fn jpeg_header_len(jpeg: &[u8]) -> usize {
+    jpeg.windows(2)
+        .position(|w| w == [0xFF, 0xDA])
+        .and_then(|sos| {
+            let len = usize::from(*jpeg.get(sos + 2)?) << 8 | usize::from(*jpeg.get(sos + 3)?);
+            Some(sos + 2 + len)
+        })
+        .unwrap_or(0)
 }
 
 fn tile(planes: &[Plane; 3]) -> Plane {
