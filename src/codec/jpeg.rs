@@ -1,0 +1,89 @@
+//! Baseline grayscale JPEG for intra-coded residual planes.
+//!
+//! Encoding: `jpeg-encoder` (IJG quality law, optimised Huffman tables since every byte counts).
+//! Decoding: `zune-jpeg` — the decoder inside `image` — called directly rather than through `image` for
+//! two reasons: strict mode, so a truncated or damaged scan is an error instead of a silently grey
+//! block; and no platform intrinsics (`set_use_unsafe(false)`), so the scalar IDCT runs everywhere and
+//! the same bytes decode to the same samples on every machine. JPEG decoders legitimately differ by ±1
+//! (IDCT rounding); the encoder and decoder of mcgv must use this one function to agree exactly.
+
+use super::Plane;
+use crate::{Error, Result};
+use jpeg_encoder::{ColorType, Encoder};
+use zune_core::bytestream::ZCursor;
+use zune_core::colorspace::ColorSpace;
+use zune_core::options::DecoderOptions;
+use zune_jpeg::JpegDecoder;
+
+/// The largest width or height a baseline JPEG frame header can state.
+pub const MAX_SIDE: u32 = u16::MAX as u32;
+/// The EOI marker every complete JPEG ends with.
+const END_OF_IMAGE: [u8; 2] = [0xFF, 0xD9];
+
+/// Codes `plane` as a baseline grayscale JPEG at `quality` (1..=100, higher = better).
+pub fn encode(plane: &Plane, quality: u8) -> Result<Vec<u8>> {
+    plane.check()?;
+    if !(1..=100).contains(&quality) {
+        return Err(Error::Codec(format!(
+            "jpeg quality {quality} outside 1..=100"
+        )));
+    }
+    let (width, height) = side_u16(plane.width, plane.height)?;
+    let mut out = Vec::with_capacity(plane.data.len() / 4);
+    let mut encoder = Encoder::new(&mut out, quality);
+    encoder.set_optimized_huffman_tables(true);
+    encoder
+        .encode(&plane.data, width, height, ColorType::Luma)
+        .map_err(|e| Error::Codec(format!("jpeg encode {}×{}: {e}", plane.width, plane.height)))?;
+    Ok(out)
+}
+
+/// Decodes a JPEG made by [`encode`]; fails unless it is a valid grayscale image of `width × height`.
+pub fn decode(bytes: &[u8], width: u32, height: u32) -> Result<Plane> {
+    side_u16(width, height)?;
+    // A scan cut right after its last MCU still decodes; the missing end marker betrays it.
+    if !bytes.ends_with(&END_OF_IMAGE) {
+        return Err(Error::Codec(format!(
+            "jpeg of {} bytes does not end with the end-of-image marker (truncated?)",
+            bytes.len()
+        )));
+    }
+    let options = DecoderOptions::default()
+        .set_strict_mode(true)
+        .set_use_unsafe(false)
+        .set_max_width(width as usize)
+        .set_max_height(height as usize)
+        .jpeg_set_out_colorspace(ColorSpace::Luma);
+    let mut decoder = JpegDecoder::new_with_options(ZCursor::new(bytes), options);
+    decoder
+        .decode_headers()
+        .map_err(|e| Error::Codec(format!("jpeg headers: {e:?}")))?;
+    let info = decoder
+        .info()
+        .ok_or_else(|| Error::Codec("jpeg headers missing".into()))?;
+    if (u32::from(info.width), u32::from(info.height)) != (width, height) {
+        return Err(Error::Codec(format!(
+            "jpeg is {}×{}, expected {width}×{height}",
+            info.width, info.height
+        )));
+    }
+    if decoder.input_colorspace() != Some(ColorSpace::Luma) {
+        return Err(Error::Codec(format!(
+            "jpeg colour space {:?}, expected grayscale",
+            decoder.input_colorspace()
+        )));
+    }
+    let data = decoder
+        .decode()
+        .map_err(|e| Error::Codec(format!("jpeg decode {width}×{height}: {e:?}")))?;
+    Plane::new(width, height, data)
+}
+
+fn side_u16(width: u32, height: u32) -> Result<(u16, u16)> {
+    match (u16::try_from(width), u16::try_from(height)) {
+        (Ok(w), Ok(h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => Err(Error::Codec(format!(
+            "jpeg size {width}×{height} outside 1..={MAX_SIDE}"
+        ))),
+    }
+}
