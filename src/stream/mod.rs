@@ -1,1 +1,4 @@
 //! stream (see DESIGN.md).
+
+pub mod entropy;
+pub mod first_frame;
