@@ -18,19 +18,26 @@ fn read_obj(path: &Path) -> Result<(Vec<Point>, Vec<Triangle>)> {
         single_index: false,
         ..Default::default()
     };
-    let (models, _) = tobj::load_obj(path, &opts).map_err(|e| Error::Mesh(format!("{}: {e}", path.display())))?;
+    let (models, _) =
+        tobj::load_obj(path, &opts).map_err(|e| Error::Mesh(format!("{}: {e}", path.display())))?;
     let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     for m in models {
         let base = positions.len() as u32;
         positions.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-        triangles.extend(m.mesh.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
+        triangles.extend(
+            m.mesh
+                .indices
+                .chunks_exact(3)
+                .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
+        );
     }
     Ok((positions, triangles))
 }
 
 /// Bind-pose positions and triangles of every triangle primitive in a glTF file, concatenated.
 fn read_gltf(path: &Path) -> Result<(Vec<Point>, Vec<Triangle>)> {
-    let (doc, buffers, _) = gltf::import(path).map_err(|e| Error::Mesh(format!("{}: {e}", path.display())))?;
+    let (doc, buffers, _) =
+        gltf::import(path).map_err(|e| Error::Mesh(format!("{}: {e}", path.display())))?;
     let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     for mesh in doc.meshes() {
         for prim in mesh.primitives() {
@@ -38,7 +45,9 @@ fn read_gltf(path: &Path) -> Result<(Vec<Point>, Vec<Triangle>)> {
                 continue;
             }
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let Some(pos) = reader.read_positions() else { continue };
+            let Some(pos) = reader.read_positions() else {
+                continue;
+            };
             let base = positions.len() as u32;
             positions.extend(pos);
             let count = positions.len() as u32 - base;
@@ -46,7 +55,10 @@ fn read_gltf(path: &Path) -> Result<(Vec<Point>, Vec<Triangle>)> {
                 Some(i) => i.into_u32().collect(),
                 None => (0..count).collect(),
             };
-            triangles.extend(idx.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
+            triangles.extend(
+                idx.chunks_exact(3)
+                    .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
+            );
         }
     }
     Ok((positions, triangles))
@@ -71,14 +83,25 @@ fn main() -> Result<()> {
     let (mut bits, mut dump_dir, mut inputs) = (12u8, None::<PathBuf>, Vec::new());
     while let Some(a) = args.next() {
         match a.as_str() {
-            "--bits" => bits = args.next().and_then(|b| b.parse().ok()).ok_or(Error::Usage("--bits N".into()))?,
+            "--bits" => {
+                bits = args
+                    .next()
+                    .and_then(|b| b.parse().ok())
+                    .ok_or(Error::Usage("--bits N".into()))?
+            }
             "--dump" => dump_dir = args.next().map(PathBuf::from),
             _ => inputs.push(PathBuf::from(a)),
         }
     }
     for path in inputs {
-        let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-        let (positions, triangles) = if is_obj { read_obj(&path)? } else { read_gltf(&path)? };
+        let is_obj = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+        let (positions, triangles) = if is_obj {
+            read_obj(&path)?
+        } else {
+            read_gltf(&path)?
+        };
         let name = path
             .parent()
             .and_then(|p| p.file_name())
@@ -97,7 +120,11 @@ fn main() -> Result<()> {
             let (tris, _) = decode(&coded.bytes)?;
             let decode_ms = start.elapsed().as_secs_f64() * 1e3;
             if tris.len() != triangles.len() {
-                return Err(Error::Codec(format!("{name}: decoded {} of {} triangles", tris.len(), triangles.len())));
+                return Err(Error::Codec(format!(
+                    "{name}: decoded {} of {} triangles",
+                    tris.len(),
+                    triangles.len()
+                )));
             }
             let s = coded.sizes;
             let key = if reorder { "reorder" } else { "keep_order" };

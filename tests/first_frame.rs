@@ -27,9 +27,14 @@ fn round_trip(positions: &[Point], triangles: &[Triangle]) -> usize {
         let (tris, pos) = decode(&coded.bytes).unwrap();
         assert_eq!(pos.len(), positions.len());
         let bits_eq = |a: &[Point], b: &[Point]| {
-            a.iter().zip(b).all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()))
+            a.iter()
+                .zip(b)
+                .all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()))
         };
-        assert!(bits_eq(&pos, &coded.decoded_positions), "decoder differs from encoder's prediction");
+        assert!(
+            bits_eq(&pos, &coded.decoded_positions),
+            "decoder differs from encoder's prediction"
+        );
         let (tris, pos) = match &coded.permutation {
             None => (tris, pos),
             Some(perm) => {
@@ -38,17 +43,25 @@ fn round_trip(positions: &[Point], triangles: &[Triangle]) -> usize {
                 for (new, &old) in perm.iter().enumerate() {
                     back[old as usize] = pos[new];
                 }
-                let tris: Vec<Triangle> = tris.iter().map(|t| t.map(|v| perm[v as usize])).collect();
+                let tris: Vec<Triangle> =
+                    tris.iter().map(|t| t.map(|v| perm[v as usize])).collect();
                 (tris, back)
             }
         };
-        assert_eq!(canonical(&tris), canonical(triangles), "reorder = {reorder}");
+        assert_eq!(
+            canonical(&tris),
+            canonical(triangles),
+            "reorder = {reorder}"
+        );
         // Quantisation error is at most half a step per axis.
         let (lo, hi) = mcgv_video::mesh::bounding_box(positions);
         for (p, q) in positions.iter().zip(&pos) {
             for k in 0..3 {
                 let step = (hi[k] - lo[k]) / 4095.0;
-                assert!((p[k] - q[k]).abs() <= step * 0.5 + 1e-5 * (1.0 + p[k].abs()), "{p:?} vs {q:?}");
+                assert!(
+                    (p[k] - q[k]).abs() <= step * 0.5 + 1e-5 * (1.0 + p[k].abs()),
+                    "{p:?} vs {q:?}"
+                );
             }
         }
         size = coded.bytes.len();
@@ -79,7 +92,10 @@ fn torus(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
     let mut pos = Vec::new();
     for j in 0..m {
         for i in 0..n {
-            let (u, v) = (i as f32 / n as f32 * 6.283, j as f32 / m as f32 * 6.283);
+            let (u, v) = (
+                i as f32 / n as f32 * std::f32::consts::TAU,
+                j as f32 / m as f32 * std::f32::consts::TAU,
+            );
             let r = 3.0 + v.cos();
             pos.push([r * u.cos(), r * u.sin(), v.sin()]);
         }
@@ -99,10 +115,14 @@ fn torus(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
 fn sphere(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
     let mut pos = vec![[0.0, 0.0, 1.0]];
     for j in 1..m {
-        let theta = j as f32 / m as f32 * 3.1416;
+        let theta = j as f32 / m as f32 * std::f32::consts::PI;
         for i in 0..n {
-            let phi = i as f32 / n as f32 * 6.283;
-            pos.push([theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]);
+            let phi = i as f32 / n as f32 * std::f32::consts::TAU;
+            pos.push([
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ]);
         }
     }
     pos.push([0.0, 0.0, -1.0]);
@@ -131,7 +151,10 @@ fn grid_with_boundary() {
 #[test]
 fn closed_sphere_codes_compactly() {
     let (p, t) = sphere(24, 16);
-    let opts = FirstFrameOptions { bits: 12, reorder: true };
+    let opts = FirstFrameOptions {
+        bits: 12,
+        reorder: true,
+    };
     let coded = encode(&p, &t, &opts).unwrap();
     // Connectivity of a regular closed mesh should cost a few bits per vertex, not an index each.
     let bpv = coded.sizes.connectivity as f64 * 8.0 / p.len() as f64;
@@ -160,7 +183,9 @@ fn forty_one_components_and_isolated_vertices() {
 
 #[test]
 fn non_manifold_fin_bow_tie_and_flips() {
-    let p: Vec<Point> = (0..9).map(|k| [k as f32, (k * k % 5) as f32, (k % 3) as f32]).collect();
+    let p: Vec<Point> = (0..9)
+        .map(|k| [k as f32, (k * k % 5) as f32, (k % 3) as f32])
+        .collect();
     let t = vec![
         [0, 1, 2],
         [1, 0, 3], // shares edge 0-1
@@ -176,14 +201,23 @@ fn non_manifold_fin_bow_tie_and_flips() {
 
 #[test]
 fn degenerate_and_duplicate_vertices() {
-    let p: Vec<Point> = vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [2.0, 2.0, 2.0]];
+    let p: Vec<Point> = vec![
+        [0.0; 3],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 2.0, 2.0],
+    ];
     let t = vec![[0, 1, 2], [1, 1, 2], [3, 1, 2], [4, 4, 4], [2, 1, 0]];
     round_trip(&p, &t);
 }
 
 #[test]
 fn tiny_meshes() {
-    round_trip(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]]);
+    round_trip(
+        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[[0, 1, 2]],
+    );
     round_trip(&[], &[]);
     round_trip(&[[1.0, 2.0, 3.0]], &[]);
 }
@@ -191,10 +225,16 @@ fn tiny_meshes() {
 #[test]
 fn bad_input_is_refused() {
     let p = [[0.0f32; 3]; 3];
-    assert!(matches!(encode(&p, &[[0, 1, 3]], &FirstFrameOptions::default()), Err(Error::Mesh(_))));
+    assert!(matches!(
+        encode(&p, &[[0, 1, 3]], &FirstFrameOptions::default()),
+        Err(Error::Mesh(_))
+    ));
     let nan = [[f32::NAN, 0.0, 0.0], [0.0; 3], [1.0; 3]];
     assert!(encode(&nan, &[[0, 1, 2]], &FirstFrameOptions::default()).is_err());
-    let opts = FirstFrameOptions { bits: 0, reorder: false };
+    let opts = FirstFrameOptions {
+        bits: 0,
+        reorder: false,
+    };
     assert!(encode(&p, &[[0, 1, 2]], &opts).is_err());
 }
 
@@ -203,7 +243,10 @@ fn every_truncation_and_corruption_fails_cleanly() {
     let (p, t) = grid(4, 3);
     let bytes = encode(&p, &t, &FirstFrameOptions::default()).unwrap().bytes;
     for cut in 0..bytes.len() {
-        assert!(matches!(decode(&bytes[..cut]), Err(Error::Stream(_))), "cut at {cut}");
+        assert!(
+            matches!(decode(&bytes[..cut]), Err(Error::Stream(_))),
+            "cut at {cut}"
+        );
     }
     for k in 0..bytes.len() {
         let mut bad = bytes.clone();

@@ -90,7 +90,10 @@ impl EntropyModel<PRECISION> for FrozenBit {
 }
 
 impl EncoderModel<PRECISION> for FrozenBit {
-    fn left_cumulative_and_probability(&self, symbol: impl Borrow<bool>) -> Option<(u32, NonZeroU32)> {
+    fn left_cumulative_and_probability(
+        &self,
+        symbol: impl Borrow<bool>,
+    ) -> Option<(u32, NonZeroU32)> {
         let p_false = ONE - self.p_true;
         Some(if *symbol.borrow() {
             (p_false, nonzero(self.p_true))
@@ -123,7 +126,10 @@ impl EntropyModel<PRECISION> for RawChunk {
 }
 
 impl EncoderModel<PRECISION> for RawChunk {
-    fn left_cumulative_and_probability(&self, symbol: impl Borrow<u32>) -> Option<(u32, NonZeroU32)> {
+    fn left_cumulative_and_probability(
+        &self,
+        symbol: impl Borrow<u32>,
+    ) -> Option<(u32, NonZeroU32)> {
         let shift = PRECISION as u32 - self.bits;
         let value = *symbol.borrow();
         (value < (1 << self.bits)).then(|| (value << shift, nonzero(1 << shift)))
@@ -219,7 +225,8 @@ impl Encoder {
         M: EncoderModel<PRECISION, Probability = u32>,
     {
         if let Err(e) = self.inner.encode_symbol(symbol, model) {
-            self.failed.get_or_insert_with(|| format!("range coder: {e:?}"));
+            self.failed
+                .get_or_insert_with(|| format!("range coder: {e:?}"));
         }
     }
 
@@ -243,8 +250,9 @@ impl Encoder {
     /// Codes a symbol of a small alphabet; a symbol outside it is an encoding error.
     pub fn symbol(&mut self, symbol: usize, model: &mut SymbolModel) {
         if symbol >= model.size {
-            self.failed
-                .get_or_insert_with(|| format!("symbol {symbol} outside alphabet of {}", model.size));
+            self.failed.get_or_insert_with(|| {
+                format!("symbol {symbol} outside alphabet of {}", model.size)
+            });
             return;
         }
         let mut node = 1usize;
@@ -320,7 +328,8 @@ impl Decoder {
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
             .collect();
-        let inner = DefaultRangeDecoder::from_compressed(words).map_err(|e| corrupt(&format!("{e:?}")))?;
+        let inner =
+            DefaultRangeDecoder::from_compressed(words).map_err(|e| corrupt(&format!("{e:?}")))?;
         Ok(Self {
             inner,
             budget: max_symbols(bytes.len()),
@@ -412,7 +421,8 @@ impl Decoder {
     /// Decodes a signed integer.
     pub fn signed(&mut self, model: &mut IntModel) -> Result<i64> {
         let magnitude = self.unsigned(&mut model.magnitude)?;
-        let magnitude = i64::try_from(magnitude).map_err(|_| corrupt("signed integer overflows"))?;
+        let magnitude =
+            i64::try_from(magnitude).map_err(|_| corrupt("signed integer overflows"))?;
         if magnitude != 0 && self.bit(&mut model.sign)? {
             Ok(-magnitude)
         } else {
@@ -455,7 +465,11 @@ impl SymbolCoder for Encoder {
     }
     fn raw_bits(&mut self, value: u64, n: u32) -> Result<u64> {
         Encoder::raw_bits(self, value, n);
-        Ok(if n >= 64 { value } else { value & ((1u64 << n) - 1) })
+        Ok(if n >= 64 {
+            value
+        } else {
+            value & ((1u64 << n) - 1)
+        })
     }
 }
 

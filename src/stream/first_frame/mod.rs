@@ -98,7 +98,9 @@ fn code_order<C: SymbolCoder>(coder: &mut C, order: &mut [u32], vertex_count: us
             .filter(|&v| v < vertex_count)
             .ok_or_else(|| Error::Stream("first frame vertex order: index out of range".into()))?;
         if std::mem::replace(&mut seen[index], true) {
-            return Err(Error::Stream("first frame vertex order: repeated index".into()));
+            return Err(Error::Stream(
+                "first frame vertex order: repeated index".into(),
+            ));
         }
         *slot = index as u32;
         previous = value;
@@ -108,7 +110,11 @@ fn code_order<C: SymbolCoder>(coder: &mut C, order: &mut [u32], vertex_count: us
 }
 
 /// Codes the triangles with a repeated vertex index.
-fn code_degenerate<C: SymbolCoder>(coder: &mut C, triangles: &mut [Triangle], vertex_count: usize) -> Result<()> {
+fn code_degenerate<C: SymbolCoder>(
+    coder: &mut C,
+    triangles: &mut [Triangle],
+    vertex_count: usize,
+) -> Result<()> {
     let mut model = UIntModel::default();
     for tri in triangles.iter_mut() {
         for v in tri.iter_mut() {
@@ -116,7 +122,9 @@ fn code_degenerate<C: SymbolCoder>(coder: &mut C, triangles: &mut [Triangle], ve
             *v = u32::try_from(index)
                 .ok()
                 .filter(|&i| (i as usize) < vertex_count)
-                .ok_or_else(|| Error::Stream("first frame: degenerate triangle index out of range".into()))?;
+                .ok_or_else(|| {
+                    Error::Stream("first frame: degenerate triangle index out of range".into())
+                })?;
         }
     }
     Ok(())
@@ -147,17 +155,25 @@ fn code_leftover_positions<C: SymbolCoder>(
 }
 
 /// Encodes frame 0: `triangles` index `positions`.
-pub fn encode(positions: &[Point], triangles: &[Triangle], opts: &FirstFrameOptions) -> Result<EncodedFirstFrame> {
+pub fn encode(
+    positions: &[Point],
+    triangles: &[Triangle],
+    opts: &FirstFrameOptions,
+) -> Result<EncodedFirstFrame> {
     let vertex_count = positions.len();
     if vertex_count as u64 > MAX_ELEMENTS || triangles.len() as u64 > MAX_ELEMENTS {
-        return Err(Error::Usage(format!("first frame too large: {vertex_count} vertices")));
+        return Err(Error::Usage(format!(
+            "first frame too large: {vertex_count} vertices"
+        )));
     }
     if let Some((t, _)) = triangles
         .iter()
         .enumerate()
         .find(|(_, tri)| tri.iter().any(|&v| v as usize >= vertex_count))
     {
-        return Err(Error::Mesh(format!("triangle {t} indexes a vertex past {vertex_count}")));
+        return Err(Error::Mesh(format!(
+            "triangle {t} indexes a vertex past {vertex_count}"
+        )));
     }
     let grid = Grid::fit(positions, opts.bits)?;
     let cells: Vec<Cell> = positions.iter().map(|&p| grid.quantise(p)).collect();
@@ -182,7 +198,13 @@ pub fn encode(positions: &[Point], triangles: &[Triangle], opts: &FirstFrameOpti
         .filter(|&v| oracle.to_traversal.get(v as usize) == Some(&UNASSIGNED))
         .collect();
     let leftover_cells: Vec<Cell> = leftovers.iter().map(|&v| cells[v as usize]).collect();
-    code_leftover_positions(&mut geometry, &mut models.delta, &grid, &mut state.cells, &leftover_cells)?;
+    code_leftover_positions(
+        &mut geometry,
+        &mut models.delta,
+        &grid,
+        &mut state.cells,
+        &leftover_cells,
+    )?;
     for &v in &leftovers {
         oracle.assign(v);
     }
@@ -196,7 +218,11 @@ pub fn encode(positions: &[Point], triangles: &[Triangle], opts: &FirstFrameOpti
     let mut order_stream = Vec::new();
     if !opts.reorder {
         let mut order_coder = Encoder::new();
-        code_order(&mut order_coder, &mut oracle.from_traversal.clone(), vertex_count)?;
+        code_order(
+            &mut order_coder,
+            &mut oracle.from_traversal.clone(),
+            vertex_count,
+        )?;
         order_stream = order_coder.finish()?;
     }
     let traversal_positions: Vec<Point> = state.cells.iter().map(|&c| grid.dequantise(c)).collect();
@@ -219,7 +245,11 @@ pub fn encode(positions: &[Point], triangles: &[Triangle], opts: &FirstFrameOpti
         traversed: traversable.len() as u32,
         degenerate: degenerate.len() as u32,
         grid,
-        lengths: [connectivity.len() as u32, geometry.len() as u32, order_stream.len() as u32],
+        lengths: [
+            connectivity.len() as u32,
+            geometry.len() as u32,
+            order_stream.len() as u32,
+        ],
     };
     let mut bytes = header.to_bytes();
     bytes.extend_from_slice(&connectivity);
@@ -266,7 +296,13 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
     )?;
     let leftover_count = vertex_count.saturating_sub(state.cells.len());
     let placeholders = vec![[0; 3]; leftover_count];
-    code_leftover_positions(&mut geometry, &mut models.delta, &grid, &mut state.cells, &placeholders)?;
+    code_leftover_positions(
+        &mut geometry,
+        &mut models.delta,
+        &grid,
+        &mut state.cells,
+        &placeholders,
+    )?;
     let mut degenerate = vec![[0u32; 3]; header.degenerate as usize];
     code_degenerate(&mut connectivity, &mut degenerate, vertex_count)?;
     let mut triangles = state.triangles;
@@ -307,7 +343,12 @@ struct Header {
 impl Header {
     /// The header with a zero checksum, which `encode` fills in.
     fn to_bytes(&self) -> Vec<u8> {
-        let mut out = vec![VERSION, self.bits, if self.has_order { FLAG_ORDER } else { 0 }, 0];
+        let mut out = vec![
+            VERSION,
+            self.bits,
+            if self.has_order { FLAG_ORDER } else { 0 },
+            0,
+        ];
         for v in [self.vertex_count, self.traversed, self.degenerate] {
             out.extend_from_slice(&v.to_le_bytes());
         }
@@ -332,7 +373,10 @@ impl Header {
             return Err(Error::Stream("first frame: checksum mismatch".into()));
         }
         if head[0] != VERSION {
-            return Err(Error::Stream(format!("first frame: unknown version {}", head[0])));
+            return Err(Error::Stream(format!(
+                "first frame: unknown version {}",
+                head[0]
+            )));
         }
         let bits = head[1];
         if !(1..=Grid::MAX_BITS).contains(&bits) {
@@ -360,7 +404,10 @@ impl Header {
             ("degenerate triangles", header.degenerate),
         ] {
             if u64::from(n) > limit {
-                return Err(Error::Stream(format!("first frame: {n} {what} cannot fit in {} bytes", bytes.len())));
+                return Err(Error::Stream(format!(
+                    "first frame: {n} {what} cannot fit in {} bytes",
+                    bytes.len()
+                )));
             }
         }
         Ok(header)

@@ -33,7 +33,9 @@ impl Grid {
         let mut hi = [0.0f32; 3];
         for (k, p) in positions.iter().enumerate() {
             if p.iter().any(|c| !c.is_finite()) {
-                return Err(Error::Mesh(format!("vertex {k} has a non-finite coordinate")));
+                return Err(Error::Mesh(format!(
+                    "vertex {k} has a non-finite coordinate"
+                )));
             }
             for a in 0..3 {
                 if k == 0 || p[a] < lo[a] {

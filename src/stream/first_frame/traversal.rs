@@ -168,7 +168,8 @@ pub(super) struct Traversal {
 
 impl Traversal {
     fn is_open(&self, from: u32, to: u32) -> bool {
-        self.half_edges.contains(&directed(from, to)) && !self.half_edges.contains(&directed(to, from))
+        self.half_edges.contains(&directed(from, to))
+            && !self.half_edges.contains(&directed(to, from))
     }
 
     /// The first vertex u with an open border half-edge u→v (`backwards`) or v→u.
@@ -290,7 +291,15 @@ pub(super) fn run<C: SymbolCoder>(
     let mut t = Traversal::default();
     while t.triangles.len() < triangle_count {
         let Some(gate) = t.gates.pop() else {
-            seed(coder, geometry, oracle.as_deref_mut(), &mut t, vertex_limit, grid, models)?;
+            seed(
+                coder,
+                geometry,
+                oracle.as_deref_mut(),
+                &mut t,
+                vertex_limit,
+                grid,
+                models,
+            )?;
             continue;
         };
         let [a, b, _] = gate;
@@ -409,7 +418,11 @@ fn code_third_vertex<C: SymbolCoder>(
         Some(v) => {
             for left in [true, false] {
                 if walk_hit.is_none() {
-                    walk_hit = t.walk(a, b, left).iter().position(|&u| u == v).map(|k| (left, k));
+                    walk_hit = t
+                        .walk(a, b, left)
+                        .iter()
+                        .position(|&u| u == v)
+                        .map(|k| (left, k));
                 }
             }
             if walk_hit.is_some() {
@@ -425,7 +438,16 @@ fn code_third_vertex<C: SymbolCoder>(
     let x = match kind {
         REF_NEW => {
             let prediction = parallelogram(t, grid, gate);
-            new_vertex(geometry, oracle, input, t, vertex_limit, grid, &mut models.parallelogram, prediction)?
+            new_vertex(
+                geometry,
+                oracle,
+                input,
+                t,
+                vertex_limit,
+                grid,
+                &mut models.parallelogram,
+                prediction,
+            )?
         }
         REF_LEFT => left1.ok_or_else(|| corrupt("no left neighbour"))?,
         REF_RIGHT => right1.ok_or_else(|| corrupt("no right neighbour"))?,
@@ -468,7 +490,9 @@ fn seed<C: SymbolCoder>(
 ) -> Result<()> {
     let input = match oracle.as_deref_mut() {
         Some(o) => {
-            let s = o.next_seed().ok_or_else(|| corrupt("no triangle left to seed"))?;
+            let s = o
+                .next_seed()
+                .ok_or_else(|| corrupt("no triangle left to seed"))?;
             if let Some(c) = o.coded.get_mut(s) {
                 *c = true;
             }
@@ -485,7 +509,16 @@ fn seed<C: SymbolCoder>(
             .filter(|&v| v != UNASSIGNED);
         tri[k] = if coder.bit(known.is_none(), &mut models.seed_new)? {
             let prediction = previous_cell(&t.cells, grid);
-            new_vertex(geometry, oracle.as_deref_mut(), x, t, vertex_limit, grid, &mut models.delta, prediction)?
+            new_vertex(
+                geometry,
+                oracle.as_deref_mut(),
+                x,
+                t,
+                vertex_limit,
+                grid,
+                &mut models.delta,
+                prediction,
+            )?
         } else {
             let newest = t.cells.len() as u64;
             let distance = known.map_or(0, |v| newest - 1 - u64::from(v));
