@@ -47,7 +47,7 @@ impl Default for EncodeOptions {
             affine_bits: 17,
             first_frame_bits: 12,
             lattice: (256, 256),
-            padding: padding::Method::default(),
+            padding: padding::PaddingOptions::default().method,
             gop: 50,
             reorder: false,
         }
@@ -159,6 +159,10 @@ pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions, progress: &ProgressBar)
         affine_bits: opts.affine_bits,
         first_frame_bits: opts.first_frame_bits,
         padding: opts.padding.to_string(),
+        requested_clusters: opts.clusters as u32,
+        reorder: opts.reorder,
+        charts: analysis.atlas.stats().charts as u32,
+        chart_pixels: analysis.atlas.stats().chart_pixels as u32,
     };
     let mut container = ContainerWriter::new();
     container.add(Tag::HEADER, header.to_bytes(), Checksum::Whole);
@@ -251,8 +255,8 @@ pub fn analyse(mesh: &AnimatedMesh, reference: Vec<Point>, opts: &EncodeOptions)
     )
     .map_err(|e| Error::Usage(format!("atlas: {e}")))?;
     let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
-        .map(|f| motion::residuals(mesh.frame(f), &track.predict(f, &reference, &partition)))
-        .collect();
+        .map(|f| Ok(motion::residuals(mesh.frame(f), &track.predict(f, &reference, &partition)?)))
+        .collect::<Result<_>>()?;
     let mode = match opts.codec {
         CodecKind::Jpeg => RangeMode::PerFrame,
         CodecKind::Mpeg4 => RangeMode::PerGroup(opts.gop),
@@ -282,7 +286,10 @@ pub fn residual_images(
     for (a, img) in out.iter_mut().enumerate() {
         let range = analysis.ranges[f][a];
         let levels: Vec<f32> = analysis.residuals[f].iter().map(|r| range.quantise(r[a])).collect();
-        let mut image = analysis.atlas.splat(&levels);
+        let mut image = analysis
+            .atlas
+            .splat(&levels)
+            .map_err(|e| Error::Codec(format!("atlas: {e}")))?;
         padding::pad(
             &mut image,
             w,
