@@ -272,6 +272,17 @@ pub fn analyse(mesh: &AnimatedMesh, reference: Vec<Point>, opts: &EncodeOptions)
     })
 }
 
+/// Frame `f`'s residuals of coordinate `axis` as levels in `0..=255` on the lattice, before padding
+/// (free pixels are 0).
+pub fn level_image(analysis: &Analysis, f: usize, axis: usize) -> Result<Vec<f32>> {
+    let range = analysis.ranges[f][axis];
+    let levels: Vec<f32> = analysis.residuals[f].iter().map(|r| range.quantise(r[axis])).collect();
+    analysis
+        .atlas
+        .splat(&levels)
+        .map_err(|e| Error::Codec(format!("atlas: {e}")))
+}
+
 /// The three padded residual images of frame `f` (levels in `0..=255`, before rounding).
 /// `previous` holds the previous frame's padded images for P-frame coding.
 pub fn residual_images(
@@ -284,12 +295,7 @@ pub fn residual_images(
     let fixed = analysis.atlas.fixed_mask();
     let mut out: [Vec<f32>; 3] = Default::default();
     for (a, img) in out.iter_mut().enumerate() {
-        let range = analysis.ranges[f][a];
-        let levels: Vec<f32> = analysis.residuals[f].iter().map(|r| range.quantise(r[a])).collect();
-        let mut image = analysis
-            .atlas
-            .splat(&levels)
-            .map_err(|e| Error::Codec(format!("atlas: {e}")))?;
+        let mut image = level_image(analysis, f, a)?;
         padding::pad(
             &mut image,
             w,

@@ -13,6 +13,7 @@ pub mod geometry_image;
 pub mod mesh;
 pub mod metrics;
 pub mod motion;
+pub mod output;
 pub mod progress;
 pub mod stream;
 

@@ -5,7 +5,7 @@
 
 use super::{gltf_import, obj, pc2, AnimatedMesh};
 use crate::error::{Error, Result};
-use std::io::Write;
+use crate::output::write_atomic;
 use std::path::{Path, PathBuf};
 
 /// Options that apply to reading any input form.
@@ -61,14 +61,17 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
 /// Numbers have at least four digits, more when the frame count needs them, so the files sort by
 /// name too. Files of the same names are replaced; other files in `dir` are left alone.
 pub fn write_obj_sequence(mesh: &AnimatedMesh, dir: &Path) -> Result<()> {
+    write_obj_sequence_from(mesh, dir, 0)
+}
+
+/// Like [`write_obj_sequence`], numbering the files from `first` (e.g. `decode --frame 57` writes
+/// `frame_0057.obj`).
+pub fn write_obj_sequence_from(mesh: &AnimatedMesh, dir: &Path, first: usize) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let digits = (mesh.frame_count().saturating_sub(1))
-        .to_string()
-        .len()
-        .max(4);
+    let digits = (first + mesh.frame_count().saturating_sub(1)).to_string().len().max(4);
     for (f, frame) in mesh.frames().iter().enumerate() {
-        let path = dir.join(format!("frame_{f:0digits$}.obj"));
-        write_atomically(&path, obj::obj_text(mesh.triangles(), frame).as_bytes())?;
+        let path = dir.join(format!("frame_{:0digits$}.obj", first + f));
+        write_atomic(&path, obj::obj_text(mesh.triangles(), frame).as_bytes())?;
     }
     Ok(())
 }
@@ -77,25 +80,6 @@ pub fn write_obj_sequence(mesh: &AnimatedMesh, dir: &Path) -> Result<()> {
 pub fn write_pc2(mesh: &AnimatedMesh, path: &Path) -> Result<()> {
     let bytes =
         pc2::pc2_bytes(mesh).map_err(|e| Error::Usage(format!("{}: {e}", path.display())))?;
-    write_atomically(path, &bytes)
+    write_atomic(path, &bytes)
 }
 
-/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`, so readers see
-/// either the old file or the whole new one.
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| Error::Usage(format!("{}: not a file name", path.display())))?;
-    let mut temp_name = std::ffi::OsString::from(".");
-    temp_name.push(name);
-    temp_name.push(format!(".{}.tmp", std::process::id()));
-    let temp = path.with_file_name(temp_name);
-    // No fsync: the rename already keeps a failed or killed run from leaving half a file, and
-    // syncing every frame of a long sequence costs more than the rest of the write.
-    let written = std::fs::File::create(&temp).and_then(|mut file| file.write_all(bytes));
-    let result = written.and_then(|()| std::fs::rename(&temp, path));
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&temp);
-        Error::io(path, e)
-    })
-}
