@@ -14,7 +14,8 @@ use crate::mesh::{Point, Triangle};
 /// Triangles per leaf: a few exact distance tests are cheaper than another level of boxes.
 const LEAF_SIZE: usize = 4;
 
-/// Deepest possible tree: median splits halve the count, so 2³² triangles need at most 32 levels.
+/// Room for the traversal stack of any tree: median splits halve the count, so 2³² triangles need
+/// at most 32 levels.
 const MAX_DEPTH: usize = 64;
 
 #[derive(Debug, Clone, Copy)]
@@ -172,6 +173,12 @@ impl TriangleBvh {
     /// The triangle nearest to `p`. `hint`, a triangle likely to be near (out-of-range hints are
     /// ignored), only speeds the search up: the answer is exact either way.
     pub fn nearest(&self, p: Vec3, hint: Option<u32>) -> Nearest {
+        self.nearest_with(p, hint, &mut Vec::with_capacity(MAX_DEPTH))
+    }
+
+    /// [`Self::nearest`] with a caller-kept traversal stack, so that a run of queries allocates once.
+    pub fn nearest_with(&self, p: Vec3, hint: Option<u32>, stack: &mut Vec<(u32, f64)>) -> Nearest {
+        stack.clear();
         let mut best = Nearest {
             triangle: 0,
             distance_squared: f64::INFINITY,
@@ -185,8 +192,6 @@ impl TriangleBvh {
                 };
             }
         }
-        let mut stack = [(0u32, 0.0f64); MAX_DEPTH];
-        let mut top = 0usize;
         let mut node = 0u32;
         while let Some(n) = self.nodes.get(node as usize) {
             if n.count > 0 {
@@ -213,9 +218,8 @@ impl TriangleBvh {
                     (r, dr, l, dl)
                 };
                 if d_near < best.distance_squared {
-                    if d_far < best.distance_squared && top < MAX_DEPTH {
-                        stack[top] = (far, d_far);
-                        top += 1;
+                    if d_far < best.distance_squared {
+                        stack.push((far, d_far));
                     }
                     node = near;
                     continue;
@@ -223,9 +227,7 @@ impl TriangleBvh {
             }
             // Pop the next subtree that can still hold something nearer than the best so far.
             let mut next = None;
-            while top > 0 {
-                top -= 1;
-                let (candidate, d) = stack[top];
+            while let Some((candidate, d)) = stack.pop() {
                 if d < best.distance_squared {
                     next = Some(candidate);
                     break;

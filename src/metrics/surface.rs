@@ -64,9 +64,10 @@ pub fn one_sided(
     let samples = sample_surface(a.triangles, a.positions, spacing);
     let (mut area, mut sum, mut sum_sq, mut max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut last = None;
+    let mut stack = Vec::new();
     for s in &samples {
         let hint = if same_triangles { Some(s.face) } else { last };
-        let nearest = b.nearest(s.point, hint);
+        let nearest = b.nearest_with(s.point, hint, &mut stack);
         last = Some(nearest.triangle);
         let d = nearest.distance_squared.sqrt();
         area += s.weight;
