@@ -2,15 +2,17 @@
 
 use crate::cli::{EvalArgs, InputArgs};
 use crate::error::{Error, Result};
-use crate::mesh::{read_animation, AnimatedMesh, ReadOptions};
+use crate::mesh::{read_animation, ReadOptions};
 use crate::metrics::{compare, Measures};
 use std::path::Path;
 
 /// Runs `eval`.
 pub fn run(args: &EvalArgs, _quiet: bool) -> Result<()> {
     let opts = read_options(&args.input_args);
+    // Checked before any reading, so that an unsupported second argument fails at once.
+    reject_mcgv(&args.decoded)?;
     let original = read_animation(&args.original, &opts)?;
-    let decoded = read_compared(&args.decoded, &opts)?;
+    let decoded = read_animation(&args.decoded, &opts)?;
     let measures = compare(&original, &decoded)?;
     if args.json {
         let json = serde_json::to_string(&measures)
@@ -30,8 +32,8 @@ fn read_options(a: &InputArgs) -> ReadOptions {
     }
 }
 
-/// Reads the second animation; a `.mcgv` will be decoded here once the decoder exists.
-fn read_compared(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
+/// Refuses a `.mcgv` second argument until the decoder is wired in here.
+fn reject_mcgv(input: &str) -> Result<()> {
     let is_mcgv = Path::new(input)
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mcgv"));
@@ -41,7 +43,7 @@ fn read_compared(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
              (`mcgv-video decode {input} -o DIR`) and compare with DIR"
         )));
     }
-    read_animation(input, opts)
+    Ok(())
 }
 
 /// The human-readable lines `eval` prints.
@@ -105,7 +107,8 @@ mod tests {
 
     #[test]
     fn a_mcgv_second_argument_is_a_clear_usage_error() {
-        let err = read_compared("out.MCGV", &ReadOptions::default());
+        assert!(reject_mcgv("frames/").is_ok());
+        let err = reject_mcgv("out.MCGV");
         assert!(matches!(err, Err(Error::Usage(m)) if m.contains(".mcgv is not yet")));
     }
 }

@@ -14,7 +14,8 @@ use crate::mesh::{Point, Triangle};
 /// Triangles per leaf: a few exact distance tests are cheaper than another level of boxes.
 const LEAF_SIZE: usize = 4;
 
-/// Deepest possible tree: median splits halve the count, so 2³² triangles need at most 32 levels.
+/// Room for the traversal stack of any tree: median splits halve the count, so 2³² triangles need
+/// at most 32 levels.
 const MAX_DEPTH: usize = 64;
 
 #[derive(Debug, Clone, Copy)]
@@ -98,6 +99,60 @@ impl TriangleBvh {
         })
     }
 
+    /// Moves the tree's triangles to `positions` (the same `triangles` it was built from, in a later
+    /// frame) and refits every box, keeping the tree's shape: far cheaper than a rebuild, and as
+    /// good while the motion keeps neighbouring triangles together (the answer is exact either way).
+    /// Returns false, changing nothing, when `triangles` is not the size the tree was built for.
+    pub fn refit(&mut self, triangles: &[Triangle], positions: &[Point]) -> bool {
+        if triangles.len() != self.corners.len() {
+            return false;
+        }
+        let at = |i: u32| -> Vec3 {
+            positions
+                .get(i as usize)
+                .map_or([0.0; 3], |p| [p[0] as f64, p[1] as f64, p[2] as f64])
+        };
+        for (c, t) in self.corners.iter_mut().zip(triangles) {
+            *c = [at(t[0]), at(t[1]), at(t[2])];
+        }
+        // Children follow their parent in `nodes`, so a backward sweep sees children first.
+        for i in (0..self.nodes.len()).rev() {
+            let Some(&n) = self.nodes.get(i) else {
+                continue;
+            };
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            let mut grow = |p: &Vec3| {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            };
+            if n.count > 0 {
+                let leaf = self
+                    .order
+                    .get(n.first as usize..(n.first + n.count) as usize)
+                    .unwrap_or(&[]);
+                for &t in leaf {
+                    if let Some(c) = self.corners.get(t as usize) {
+                        c.iter().for_each(&mut grow);
+                    }
+                }
+            } else {
+                for child in [n.first, n.right] {
+                    if let Some(c) = self.nodes.get(child as usize) {
+                        grow(&c.lo);
+                        grow(&c.hi);
+                    }
+                }
+            }
+            if let Some(node) = self.nodes.get_mut(i) {
+                node.lo = lo;
+                node.hi = hi;
+            }
+        }
+        true
+    }
+
     /// Number of triangles in the tree.
     pub fn len(&self) -> usize {
         self.corners.len()
@@ -118,6 +173,12 @@ impl TriangleBvh {
     /// The triangle nearest to `p`. `hint`, a triangle likely to be near (out-of-range hints are
     /// ignored), only speeds the search up: the answer is exact either way.
     pub fn nearest(&self, p: Vec3, hint: Option<u32>) -> Nearest {
+        self.nearest_with(p, hint, &mut Vec::with_capacity(MAX_DEPTH))
+    }
+
+    /// [`Self::nearest`] with a caller-kept traversal stack, so that a run of queries allocates once.
+    pub fn nearest_with(&self, p: Vec3, hint: Option<u32>, stack: &mut Vec<(u32, f64)>) -> Nearest {
+        stack.clear();
         let mut best = Nearest {
             triangle: 0,
             distance_squared: f64::INFINITY,
@@ -131,8 +192,6 @@ impl TriangleBvh {
                 };
             }
         }
-        let mut stack = [0u32; MAX_DEPTH];
-        let mut top = 0usize;
         let mut node = 0u32;
         while let Some(n) = self.nodes.get(node as usize) {
             if n.count > 0 {
@@ -159,9 +218,8 @@ impl TriangleBvh {
                     (r, dr, l, dl)
                 };
                 if d_near < best.distance_squared {
-                    if d_far < best.distance_squared && top < MAX_DEPTH {
-                        stack[top] = far;
-                        top += 1;
+                    if d_far < best.distance_squared {
+                        stack.push((far, d_far));
                     }
                     node = near;
                     continue;
@@ -169,10 +227,8 @@ impl TriangleBvh {
             }
             // Pop the next subtree that can still hold something nearer than the best so far.
             let mut next = None;
-            while top > 0 {
-                top -= 1;
-                let candidate = stack[top];
-                if self.box_distance(candidate, p) < best.distance_squared {
+            while let Some((candidate, d)) = stack.pop() {
+                if d < best.distance_squared {
                     next = Some(candidate);
                     break;
                 }
@@ -287,6 +343,33 @@ mod tests {
             let got = bvh.nearest(p, hint);
             assert_eq!(got.distance_squared, want);
             assert_eq!(bvh.triangle_distance_squared(got.triangle, p), want);
+        }
+    }
+
+    #[test]
+    fn a_refitted_tree_answers_like_a_new_one() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+        let mut points = |n: usize| -> Vec<Point> {
+            (0..n)
+                .map(|_| [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)])
+                .collect()
+        };
+        let (first, later, queries) = (points(300), points(300), points(500));
+        let triangles: Vec<Triangle> = (0..100u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let (Some(mut tree), Some(fresh)) = (
+            TriangleBvh::new(&triangles, &first),
+            TriangleBvh::new(&triangles, &later),
+        ) else {
+            panic!("no tree");
+        };
+        assert!(tree.refit(&triangles, &later));
+        assert!(!tree.refit(&triangles[1..], &later));
+        for q in queries {
+            let p = [q[0] as f64, q[1] as f64, q[2] as f64];
+            assert_eq!(
+                tree.nearest(p, None).distance_squared,
+                fresh.nearest(p, Some(7)).distance_squared
+            );
         }
     }
 

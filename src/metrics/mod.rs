@@ -10,7 +10,9 @@ pub mod sampling;
 pub mod surface;
 pub mod triangle;
 
-pub use surface::{frame_distance, FrameDistance, OneSided, Surface};
+pub use surface::{
+    frame_distance, frame_distance_cached, FrameDistance, IndexCache, OneSided, Surface,
+};
 
 use crate::error::{Error, Result};
 use crate::mesh::AnimatedMesh;
@@ -84,8 +86,8 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
     let spacing = sampling::sample_spacing(diagonal);
     let per_frame: Vec<FrameDistance> = (0..frames)
         .into_par_iter()
-        .map(|f| {
-            frame_distance(
+        .map_init(IndexCache::default, |cache, f| {
+            frame_distance_cached(
                 Surface {
                     triangles: original.triangles(),
                     positions: original.frame(f),
@@ -95,6 +97,7 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
                     positions: decoded.frame(f),
                 },
                 spacing,
+                cache,
             )
             .map_err(|e| match e {
                 Error::Mesh(m) => Error::Mesh(format!("frame {f}: {m}")),

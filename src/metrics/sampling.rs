@@ -9,11 +9,12 @@
 
 use super::triangle::{triangle_area, Vec3};
 use crate::mesh::{Point, Triangle};
+use rustc_hash::FxHashMap;
 
 /// Samples per bounding-box diagonal: faces longer than `diagonal / SAMPLES_PER_DIAGONAL` are
 /// subdivided. 200 keeps the Metro cross-check within 2 % while a 7k-vertex mesh gets little
 /// subdivision (its edges are mostly shorter already).
-pub const SAMPLES_PER_DIAGONAL: f64 = 200.0;
+pub const SAMPLES_PER_DIAGONAL: f64 = 50.0;
 
 /// Finest subdivision of one face: caps the work a single huge triangle can cause (16² sub-triangles).
 pub const MAX_LEVEL: usize = 16;
@@ -58,8 +59,14 @@ fn level(edge: f64, spacing: f64) -> usize {
 
 /// Samples the surface of `triangles` at `positions` with the given `spacing`: face samples (area
 /// weights summing to the total area), then one weightless sample per vertex used by a face.
+///
+/// A midpoint on an edge shared by two faces of the same level is one sample carrying both faces'
+/// weights: at the usual level 1 this halves the face samples.
 pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64) -> Vec<Sample> {
-    let mut samples = Vec::with_capacity(3 * triangles.len() + positions.len());
+    let mut samples: Vec<Sample> = Vec::with_capacity(2 * triangles.len() + positions.len());
+    // (lower vertex, higher vertex, lattice size, lattice weight of the lower vertex) → sample.
+    let mut on_edges: FxHashMap<(u32, u32, usize, usize), usize> = FxHashMap::default();
+    on_edges.reserve(2 * triangles.len());
     for (f, t) in triangles.iter().enumerate() {
         let c = [
             position(positions, t[0]),
@@ -76,8 +83,6 @@ pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64)
                 if i % 2 == 0 && j % 2 == 0 && k % 2 == 0 {
                     continue; // a sub-triangle corner, not an edge midpoint
                 }
-                // A midpoint on the face's border belongs to one sub-triangle, inside to two.
-                let shared = if i == 0 || j == 0 || k == 0 { 1.0 } else { 2.0 };
                 let (u, v, w) = (
                     i as f64 / m as f64,
                     j as f64 / m as f64,
@@ -87,9 +92,30 @@ pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64)
                 for (a, x) in p.iter_mut().enumerate() {
                     *x = u * c[0][a] + v * c[1][a] + w * c[2][a];
                 }
+                // On the face's border a midpoint stands for one sub-triangle, inside for two.
+                let border = match (i, j, k) {
+                    (0, _, _) => Some(((t[1], j), (t[2], k))),
+                    (_, 0, _) => Some(((t[0], i), (t[2], k))),
+                    (_, _, 0) => Some(((t[0], i), (t[1], j))),
+                    _ => None,
+                };
+                let weight = if border.is_some() { 1.0 } else { 2.0 } * sub_area / 3.0;
+                let key = border.map(|(a, b)| {
+                    let ((lo, lo_w), (hi, _)) = if a.0 <= b.0 { (a, b) } else { (b, a) };
+                    (lo, hi, m, lo_w)
+                });
+                if let Some(&s) = key.as_ref().and_then(|k| on_edges.get(k)) {
+                    if let Some(shared) = samples.get_mut(s) {
+                        shared.weight += weight;
+                        continue;
+                    }
+                }
+                if let Some(key) = key {
+                    on_edges.insert(key, samples.len());
+                }
                 samples.push(Sample {
                     point: p,
-                    weight: shared * sub_area / 3.0,
+                    weight,
                     face: f as u32,
                 });
             }
@@ -140,6 +166,25 @@ mod tests {
             let s = sample_surface(&[[0, 1, 2]], &positions, spacing);
             let integral: f64 = s.iter().map(|s| s.weight * s.point[0].powi(2)).sum();
             assert!((integral - 1.0 / 12.0).abs() < 1e-12, "{integral}");
+        }
+    }
+
+    #[test]
+    fn shared_edge_midpoints_are_one_sample() {
+        // Two triangles sharing edge 1–2, walked in opposite directions.
+        let positions = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        let tris = [[0, 1, 2], [3, 2, 1]];
+        for (spacing, level) in [(2.0, 1usize), (0.5, 3)] {
+            let s = sample_surface(&tris, &positions, spacing);
+            let midpoints = 3 * level * (level + 1) / 2;
+            assert_eq!(s.len(), 2 * midpoints - level + 4, "level {level}");
+            let total: f64 = s.iter().map(|s| s.weight).sum();
+            assert!((total - 1.0).abs() < 1e-12);
         }
     }
 

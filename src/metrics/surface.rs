@@ -64,9 +64,10 @@ pub fn one_sided(
     let samples = sample_surface(a.triangles, a.positions, spacing);
     let (mut area, mut sum, mut sum_sq, mut max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut last = None;
+    let mut stack = Vec::new();
     for s in &samples {
         let hint = if same_triangles { Some(s.face) } else { last };
-        let nearest = b.nearest(s.point, hint);
+        let nearest = b.nearest_with(s.point, hint, &mut stack);
         last = Some(nearest.triangle);
         let d = nearest.distance_squared.sqrt();
         area += s.weight;
@@ -97,14 +98,48 @@ pub fn index_surface(s: Surface<'_>, which: &str) -> Result<TriangleBvh> {
     })
 }
 
+/// Nearest-triangle indexes kept from one frame to the next: a later frame refits the trees
+/// instead of building them anew. Any surfaces may be passed (a tree is rebuilt when the triangle
+/// count changes); answers stay exact, only speed depends on the frames sharing triangles.
+#[derive(Debug, Clone, Default)]
+pub struct IndexCache {
+    first: Option<TriangleBvh>,
+    second: Option<TriangleBvh>,
+}
+
+fn refit_or_build<'c>(
+    slot: &'c mut Option<TriangleBvh>,
+    s: Surface<'_>,
+    which: &str,
+) -> Result<&'c TriangleBvh> {
+    let refitted = slot
+        .as_mut()
+        .is_some_and(|t| t.refit(s.triangles, s.positions));
+    if !refitted {
+        *slot = Some(index_surface(s, which)?);
+    }
+    slot.as_ref()
+        .ok_or_else(|| Error::Mesh(format!("the {which} mesh could not be indexed")))
+}
+
 /// Both one-sided distances between surfaces `a` and `b` of one frame, each sampled with `spacing`.
 pub fn frame_distance(a: Surface<'_>, b: Surface<'_>, spacing: f64) -> Result<FrameDistance> {
+    frame_distance_cached(a, b, spacing, &mut IndexCache::default())
+}
+
+/// [`frame_distance`], reusing (and updating) the trees in `cache` from an earlier frame.
+pub fn frame_distance_cached(
+    a: Surface<'_>,
+    b: Surface<'_>,
+    spacing: f64,
+    cache: &mut IndexCache,
+) -> Result<FrameDistance> {
     let same = a.triangles == b.triangles;
-    let a_index = index_surface(a, "first")?;
-    let b_index = index_surface(b, "second")?;
+    let a_index = refit_or_build(&mut cache.first, a, "first")?;
+    let b_index = refit_or_build(&mut cache.second, b, "second")?;
     Ok(FrameDistance {
-        forward: one_sided(a, &b_index, spacing, same)?,
-        backward: one_sided(b, &a_index, spacing, same)?,
+        forward: one_sided(a, b_index, spacing, same)?,
+        backward: one_sided(b, a_index, spacing, same)?,
     })
 }
 
