@@ -151,7 +151,10 @@ fn bad_numbers_empty_files_and_missing_inputs_are_errors() {
     let none = dir.path().join("nothing");
     std::fs::create_dir(&none).unwrap();
     assert!(error_of(none.to_str().unwrap()).contains("no .obj files"));
-    assert!(error_of(&format!("{}/*.obj", none.display())).contains("no files match"));
+    assert!(error_of(&format!("{}/*.obj", none.display())).contains("no .obj files match"));
+    let ply = dir.path().join("mesh.ply");
+    write(&ply, "ply\n");
+    assert!(error_of(ply.to_str().unwrap()).contains("not a form this tool reads"));
     assert!(error_of(dir.path().join("missing.obj").to_str().unwrap()).contains("no such"));
 }
 
@@ -352,6 +355,11 @@ fn frame_rate_and_clip_are_chosen_by_the_options() {
         assert!((0..3).all(|k| (a[k] - b[k]).abs() < 1e-5), "{a:?} vs {b:?}");
     }
     assert!(at(Some(0.0), None).unwrap_err().to_string().contains("fps"));
+    let err = at(Some(1e6), None).unwrap_err().to_string();
+    assert!(
+        err.contains("CesiumMan.glb") && err.contains("lower --fps"),
+        "{err}"
+    );
 
     let fox = |clip: &str| {
         let opts = ReadOptions {

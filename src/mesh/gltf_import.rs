@@ -19,8 +19,8 @@ use std::path::Path;
 const FALLBACK_FPS: f64 = 30.0;
 /// Estimated keyframe rates outside this range are not trusted (sparse or dense keys).
 const PLAUSIBLE_FPS: std::ops::RangeInclusive<f64> = 10.0..=240.0;
-/// More frames than this is surely a mistaken `--fps`.
-const MAX_FRAMES: usize = 100_000;
+/// More positions (frames × vertices) than this would not fit in memory: surely a mistaken `--fps`.
+const MAX_POSITIONS: f64 = 4e8;
 /// Joint influence sets (`JOINTS_n`/`WEIGHTS_n`) read per vertex.
 const MAX_INFLUENCE_SETS: u32 = 4;
 
@@ -54,10 +54,11 @@ pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Re
         });
     let rate = fps.unwrap_or_else(|| keyframe_rate(&channels).unwrap_or(FALLBACK_FPS));
     let frame_count = ((end - start).max(0.0) * rate + 1e-6).floor() + 1.0;
-    if !(frame_count.is_finite() && frame_count <= MAX_FRAMES as f64) {
+    if !(frame_count.is_finite() && frame_count * geometry.vertex_count as f64 <= MAX_POSITIONS) {
         return Err(fail(format!(
-            "{:.3} s at {rate} frames/s is more than {MAX_FRAMES} frames",
-            end - start
+            "{:.3} s at {rate} frames/s is {frame_count} frames of {} vertices: too many, lower --fps",
+            end - start,
+            geometry.vertex_count
         )));
     }
     let pose = Pose::new(&document);
@@ -162,7 +163,15 @@ fn read_channels<'a>(
                 1
             };
         let width = values.len() / per_key;
-        if width == 0 || width * per_key != values.len() {
+        let expected_width = match channel.target().property() {
+            Property::Translation | Property::Scale => Some(3),
+            Property::Rotation => Some(4),
+            Property::MorphTargetWeights => None,
+        };
+        if width == 0
+            || width * per_key != values.len()
+            || expected_width.is_some_and(|e| e != width)
+        {
             return Err(format!(
                 "{name}: {} values do not fit {} keys",
                 values.len(),

@@ -224,8 +224,8 @@ fn check_same_mesh(
     Ok(())
 }
 
-/// The frame files named by `input`: a folder's `.obj` files, a glob pattern, or one `.obj` file;
-/// several files are ordered by the last number in their names.
+/// The frame files named by `input`: a folder's `.obj` files, the `.obj` files a glob pattern
+/// matches, or one `.obj` file; several files are ordered by the last number in their names.
 pub(crate) fn frame_files(input: &str) -> Result<Vec<PathBuf>> {
     let path = Path::new(input);
     let files: Vec<PathBuf> = if path.is_dir() {
@@ -243,6 +243,11 @@ pub(crate) fn frame_files(input: &str) -> Result<Vec<PathBuf>> {
         }
         files
     } else if path.is_file() {
+        if !has_obj_extension(path) {
+            return Err(Error::Usage(format!(
+                "{input}: not a form this tool reads (a folder or glob of .obj files, .obj, .pc2, .gltf, .glb)"
+            )));
+        }
         vec![path.to_path_buf()]
     } else if input.contains(['*', '?', '[']) {
         let pattern =
@@ -250,12 +255,12 @@ pub(crate) fn frame_files(input: &str) -> Result<Vec<PathBuf>> {
         let mut files = Vec::new();
         for p in pattern {
             let p = p.map_err(|e| Error::io(e.path().to_path_buf(), e.into()))?;
-            if p.is_file() {
+            if p.is_file() && has_obj_extension(&p) {
                 files.push(p);
             }
         }
         if files.is_empty() {
-            return Err(Error::Usage(format!("{input}: no files match")));
+            return Err(Error::Usage(format!("{input}: no .obj files match")));
         }
         files
     } else {
