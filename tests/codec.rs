@@ -483,3 +483,22 @@ fn tile(planes: &[Plane; 3]) -> Plane {
         data,
     }
 }
+
+/// Our decoder forces zune-jpeg's scalar path so every platform decodes alike; where the machine has
+/// a SIMD path, it must agree with it exactly, or the choice would matter.
+#[test]
+fn jpeg_scalar_decode_equals_simd_decode() -> Result<()> {
+    use zune_core::{bytestream::ZCursor, colorspace::ColorSpace, options::DecoderOptions};
+    for quality in [10, 75, 100] {
+        let bytes = jpeg::encode(&smooth_frame(128, 64, 2, 0.7), quality)?;
+        let ours = jpeg::decode(&bytes, 128, 64)?;
+        let options = DecoderOptions::default()
+            .set_use_unsafe(true)
+            .jpeg_set_out_colorspace(ColorSpace::Luma);
+        let simd = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(&bytes), options)
+            .decode()
+            .map_err(|e| mcgv_video::Error::Codec(format!("{e:?}")))?;
+        assert_eq!(ours.data, simd, "quality {quality}");
+    }
+    Ok(())
+}
