@@ -4,6 +4,12 @@
 //! [`jpeg`] codes every plane on its own (any frame decodes alone), [`mpeg4`] codes a sequence as
 //! MPEG-4 Part 2 I- and P-frames through FFmpeg. [`quality_to_qscale`] maps the one user-facing rate
 //! knob (`--quality 1..100`) onto the MPEG-4 quantiser so both codecs follow the same scale.
+//!
+//! Three coordinate images per frame, measured on smooth synthetic 256×256 planes (see
+//! `measure_rate_distortion_and_speed` in `tests/codec.rs`): tiling them into one 768×256 picture
+//! saves JPEG ≈ 460 bytes a frame (two fewer headers of ≈ 250 bytes, 2–4 %), while MPEG-4 codes three
+//! separate streams 2–4 % smaller than the tiled picture. Chroma is flat and costs nothing measurable
+//! (the GRAY flag changes no byte).
 
 pub mod abbreviated;
 pub mod jpeg;

@@ -128,6 +128,9 @@ impl Encoder {
         });
         let mut dict = Dictionary::new();
         dict.set("sc_threshold", NO_SCENE_CUT);
+        // Trellis quantisation: measured +0.7..1.1 dB at qscale 2..8 for 1..2 % more bytes, at a third
+        // of the encoding speed (still > 1000 frames/s at 256×256).
+        dict.set("trellis", "1");
         let inner = video
             .open_as_with(codec, dict)
             .map_err(|e| ff_error(&format!("open encoder {width}×{height}"), e))?;
