@@ -51,6 +51,8 @@ pub struct AtlasStats {
     pub block_efficiency: f64,
     /// Vertices moved off their rounded position to keep the map injective.
     pub moved_vertices: usize,
+    /// Vertices handed from a chart with too few vertices to a neighbouring one.
+    pub absorbed_vertices: usize,
     /// Vertices no face charts (isolated or only in dropped degenerate faces).
     pub faceless_vertices: usize,
     /// Area-weighted normalised L2 stretch over all charts (1 = no stretch).

@@ -156,6 +156,74 @@ fn assign_owners(
         .collect()
 }
 
+/// Hands the vertices of charts owning fewer than `min` vertices to the
+/// neighbouring chart that owns most of their mesh neighbours, placed at the
+/// mean of those neighbours' 2D positions: a chart of a few vertices would
+/// otherwise hold a whole block alone. Returns how many vertices moved chart.
+fn absorb_small_charts(
+    triangles: &[[u32; 3]],
+    owner: &mut [Option<(u32, [f64; 2])>],
+    charts: u32,
+    min: usize,
+) -> usize {
+    let mut count = vec![0usize; charts as usize];
+    for (c, _) in owner.iter().flatten() {
+        count[*c as usize] += 1;
+    }
+    let small: Vec<bool> = count.iter().map(|&n| n > 0 && n < min).collect();
+    if !small.iter().any(|&s| s) {
+        return 0;
+    }
+    let mut neighbours = vec![Vec::new(); owner.len()];
+    for tri in triangles {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if a != b {
+                neighbours[a as usize].push(b);
+                neighbours[b as usize].push(a);
+            }
+        }
+    }
+    let mut absorbed = 0;
+    loop {
+        let mut changed = false;
+        for v in 0..owner.len() {
+            let Some((c, _)) = owner[v] else { continue };
+            if !small[c as usize] {
+                continue;
+            }
+            let mut tally: Vec<(u32, usize, [f64; 2])> = Vec::new();
+            for &w in &neighbours[v] {
+                let Some((d, uv)) = owner[w as usize] else {
+                    continue;
+                };
+                if small[d as usize] {
+                    continue;
+                }
+                match tally.iter_mut().find(|t| t.0 == d) {
+                    Some(t) => {
+                        t.1 += 1;
+                        t.2 = [t.2[0] + uv[0], t.2[1] + uv[1]];
+                    }
+                    None => tally.push((d, 1, uv)),
+                }
+            }
+            let best = tally
+                .into_iter()
+                .max_by_key(|t| (t.1, std::cmp::Reverse(t.0)));
+            if let Some((d, n, sum)) = best {
+                owner[v] = Some((d, [sum[0] / n as f64, sum[1] / n as f64]));
+                absorbed += 1;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    absorbed
+}
+
 fn layouts(flat: &Flattening, owner: &[Option<(u32, [f64; 2])>]) -> Vec<ChartLayout> {
     let mut charts: Vec<ChartLayout> = (0..flat.charts as usize)
         .map(|c| ChartLayout {
@@ -388,13 +456,14 @@ pub fn build(
             opts.max_split_rounds,
         )?
     };
-    let owner = assign_owners(
+    let mut owner = assign_owners(
         triangles,
         partition,
         &seeds.face_cluster,
         &flat,
         positions.len(),
     );
+    let absorbed = absorb_small_charts(triangles, &mut owner, flat.charts, opts.min_chart_vertices);
     let charts = layouts(&flat, &owner);
     let (scale, placements) = best_scale(&charts, opts)?;
 
@@ -493,6 +562,7 @@ pub fn build(
         packing_efficiency: chart_pixels as f64 / pixels as f64,
         block_efficiency: owned_blocks as f64 / block_chart.len().max(1) as f64,
         moved_vertices: moved,
+        absorbed_vertices: absorbed,
         faceless_vertices: charts
             .iter()
             .filter(|c| c.faceless)
