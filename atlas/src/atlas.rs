@@ -19,11 +19,14 @@ pub enum Occupancy {
 /// One chart as packed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Chart {
-    /// Top-left pixel of its block rectangle.
+    /// Top-left pixel of its frame (a rectangle of whole blocks).
     pub origin: [u32; 2],
-    /// Rectangle size in pixels (whole blocks), as placed.
+    /// Frame size in pixels, as placed; the chart owns only the blocks of
+    /// the frame that its triangles or vertices touch.
     pub size: [u32; 2],
-    /// Whether the chart's u axis runs down the image.
+    /// Blocks it owns.
+    pub blocks: usize,
+    /// Whether the chart's u axis runs down the image (it may also be turned by half a turn).
     pub transposed: bool,
     /// Vertices it owns.
     pub vertices: usize,

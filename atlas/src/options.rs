@@ -41,10 +41,7 @@ impl Default for AtlasOptions {
             max_stretch: 1.25,
             interior: Interior::Rasterised,
             max_split_rounds: 3,
-            min_chart_vertices: std::env::var("ATLAS_MIN")
-                .ok()
-                .and_then(|v| v.parse().ok())
-                .unwrap_or(8),
+            min_chart_vertices: 8,
         }
     }
 }
