@@ -19,11 +19,14 @@ pub enum Occupancy {
 /// One chart as packed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Chart {
-    /// Top-left pixel of its block rectangle.
+    /// Top-left pixel of its frame (a rectangle of whole blocks).
     pub origin: [u32; 2],
-    /// Rectangle size in pixels (whole blocks), as placed.
+    /// Frame size in pixels, as placed; the chart owns only the blocks of
+    /// the frame that its triangles or vertices touch.
     pub size: [u32; 2],
-    /// Whether the chart's u axis runs down the image.
+    /// Blocks it owns.
+    pub blocks: usize,
+    /// Whether the chart's u axis runs down the image (it may also be turned by half a turn).
     pub transposed: bool,
     /// Vertices it owns.
     pub vertices: usize,
@@ -51,6 +54,8 @@ pub struct AtlasStats {
     pub block_efficiency: f64,
     /// Vertices moved off their rounded position to keep the map injective.
     pub moved_vertices: usize,
+    /// Vertices handed from a chart with too few vertices to a neighbouring one.
+    pub absorbed_vertices: usize,
     /// Vertices no face charts (isolated or only in dropped degenerate faces).
     pub faceless_vertices: usize,
     /// Area-weighted normalised L2 stretch over all charts (1 = no stretch).

@@ -1,7 +1,7 @@
 //! From mesh and partition to a packed, injective lattice atlas.
 
 use crate::atlas::{Atlas, AtlasStats, Chart, InteriorSample, Occupancy};
-use crate::pack::{pack, Placement};
+use crate::pack::{pack, Footprint, Orientation, Placement};
 use crate::seed::seeds;
 use crate::stretch::StretchSum;
 use crate::unwrap::{flatten, Flattening};
@@ -19,46 +19,94 @@ struct ChartLayout {
     extent: [f64; 2],
     /// Owned vertices and their 2D position.
     owned: Vec<(u32, [f64; 2])>,
-    /// Faces to rasterise.
-    faces: Vec<usize>,
+    /// Faces to rasterise and their 2D corners.
+    faces: Vec<(usize, [[f64; 2]; 3])>,
     /// Stretch sums (empty for the face-less chart).
     stretch: StretchSum,
     /// Whether this chart holds the face-less vertices in a plain grid.
     faceless: bool,
 }
 
+/// A chart at one scale: its local frame and the blocks it needs.
+struct Shape {
+    footprint: Footprint,
+    /// Local pixel offset of the 2D minimum (centres the chart in its frame).
+    offset: [f64; 2],
+}
+
 impl ChartLayout {
-    /// Rectangle in blocks at scale `s`, before any transposition; large
-    /// enough to give every owned vertex its own pixel.
-    fn blocks(&self, s: f64, block: u32) -> (u32, u32, [u32; 2]) {
+    /// Local pixel position of a 2D point at scale `s`.
+    fn local(&self, uv: [f64; 2], s: f64, offset: [f64; 2]) -> [f64; 2] {
+        [0, 1].map(|a| (uv[a] - self.min[a]) * s + offset[a])
+    }
+
+    /// The blocks the chart's triangles and vertices touch at scale `s`,
+    /// or its whole frame when those hold fewer pixels than it has vertices.
+    fn shape(&self, s: f64, block: u32) -> Shape {
         let n = self.owned.len() as u64;
         let per_block = u64::from(block) * u64::from(block);
+        let full = |bw: u32, bh: u32| Footprint {
+            width: bw,
+            height: bh,
+            cells: (0..bh).flat_map(|y| (0..bw).map(move |x| (x, y))).collect(),
+        };
         if self.faceless {
             let nb = n.div_ceil(per_block).max(1);
-            let bw = (nb as f64).sqrt().ceil().max(1.0) as u64;
-            let bh = nb.div_ceil(bw);
-            let px = [
-                (bw * u64::from(block)) as u32,
-                (bh * u64::from(block)) as u32,
-            ];
-            return (bw as u32, bh as u32, px);
+            let bw = (nb as f64).sqrt().ceil().max(1.0) as u32;
+            let bh = nb.div_ceil(u64::from(bw)) as u32;
+            return Shape {
+                footprint: full(bw, bh),
+                offset: [0.0; 2],
+            };
         }
-        let px = self.extent.map(|e| (e * s).round().min(1e9) as u32 + 1);
-        let mut bw = u64::from(px[0].div_ceil(block));
-        let mut bh = u64::from(px[1].div_ceil(block));
-        while bw * bh * per_block < n {
-            if bw <= bh {
-                bw += 1;
+        let px = self.extent.map(|e| (e * s).round().min(1e6) as u32 + 1);
+        let (bw, bh) = (px[0].div_ceil(block), px[1].div_ceil(block));
+        let offset = [0, 1].map(|a| f64::from(([bw, bh][a] * block - px[a]) / 2));
+        let rect = [0, 0, bw * block, bh * block];
+        let mut touched = vec![false; (bw * bh) as usize];
+        let mut mark = |p: [u32; 2]| touched[((p[1] / block) * bw + p[0] / block) as usize] = true;
+        for (_, uv) in &self.owned {
+            mark(clamp_pixel(self.local(*uv, s, offset), rect));
+        }
+        for (_, corners) in &self.faces {
+            let c = corners.map(|uv| self.local(uv, s, offset));
+            rasterise(c, rect, |p, _| mark(p));
+        }
+        let cells: Vec<(u32, u32)> = (0..bh)
+            .flat_map(|y| (0..bw).map(move |x| (x, y)))
+            .filter(|&(x, y)| touched[(y * bw + x) as usize])
+            .collect();
+        if cells.len() as u64 * per_block >= n {
+            return Shape {
+                footprint: Footprint {
+                    width: bw,
+                    height: bh,
+                    cells,
+                },
+                offset,
+            };
+        }
+        let (mut gw, mut gh) = (u64::from(bw), u64::from(bh));
+        while gw * gh * per_block < n {
+            if gw <= gh {
+                gw += 1;
             } else {
-                bh += 1;
+                gh += 1;
             }
         }
-        (
-            bw.min(u64::from(u32::MAX)) as u32,
-            bh.min(u64::from(u32::MAX)) as u32,
-            px,
-        )
+        Shape {
+            footprint: full(gw as u32, gh as u32),
+            offset,
+        }
     }
+}
+
+/// Nearest pixel of `rect` (x0, y0, width, height) to a point.
+fn clamp_pixel(p: [f64; 2], rect: [u32; 4]) -> [u32; 2] {
+    let [x0, y0, w, h] = rect;
+    let cx = p[0].round().clamp(f64::from(x0), f64::from(x0 + w - 1)) as u32;
+    let cy = p[1].round().clamp(f64::from(y0), f64::from(y0 + h - 1)) as u32;
+    [cx, cy]
 }
 
 fn check_input(
@@ -156,6 +204,74 @@ fn assign_owners(
         .collect()
 }
 
+/// Hands the vertices of charts owning fewer than `min` vertices to the
+/// neighbouring chart that owns most of their mesh neighbours, placed at the
+/// mean of those neighbours' 2D positions: a chart of a few vertices would
+/// otherwise hold a whole block alone. Returns how many vertices moved chart.
+fn absorb_small_charts(
+    triangles: &[[u32; 3]],
+    owner: &mut [Option<(u32, [f64; 2])>],
+    charts: u32,
+    min: usize,
+) -> usize {
+    let mut count = vec![0usize; charts as usize];
+    for (c, _) in owner.iter().flatten() {
+        count[*c as usize] += 1;
+    }
+    let small: Vec<bool> = count.iter().map(|&n| n > 0 && n < min).collect();
+    if !small.iter().any(|&s| s) {
+        return 0;
+    }
+    let mut neighbours = vec![Vec::new(); owner.len()];
+    for tri in triangles {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if a != b {
+                neighbours[a as usize].push(b);
+                neighbours[b as usize].push(a);
+            }
+        }
+    }
+    let mut absorbed = 0;
+    loop {
+        let mut changed = false;
+        for v in 0..owner.len() {
+            let Some((c, _)) = owner[v] else { continue };
+            if !small[c as usize] {
+                continue;
+            }
+            let mut tally: Vec<(u32, usize, [f64; 2])> = Vec::new();
+            for &w in &neighbours[v] {
+                let Some((d, uv)) = owner[w as usize] else {
+                    continue;
+                };
+                if small[d as usize] {
+                    continue;
+                }
+                match tally.iter_mut().find(|t| t.0 == d) {
+                    Some(t) => {
+                        t.1 += 1;
+                        t.2 = [t.2[0] + uv[0], t.2[1] + uv[1]];
+                    }
+                    None => tally.push((d, 1, uv)),
+                }
+            }
+            let best = tally
+                .into_iter()
+                .max_by_key(|t| (t.1, std::cmp::Reverse(t.0)));
+            if let Some((d, n, sum)) = best {
+                owner[v] = Some((d, [sum[0] / n as f64, sum[1] / n as f64]));
+                absorbed += 1;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    absorbed
+}
+
 fn layouts(flat: &Flattening, owner: &[Option<(u32, [f64; 2])>]) -> Vec<ChartLayout> {
     let mut charts: Vec<ChartLayout> = (0..flat.charts as usize)
         .map(|c| ChartLayout {
@@ -171,7 +287,7 @@ fn layouts(flat: &Flattening, owner: &[Option<(u32, [f64; 2])>]) -> Vec<ChartLay
     for (f, chart) in flat.face_chart.iter().enumerate() {
         let Some(c) = chart else { continue };
         let layout = &mut charts[*c as usize];
-        layout.faces.push(f);
+        layout.faces.push((f, flat.corner_uv[f]));
         for uv in flat.corner_uv[f] {
             for a in 0..2 {
                 layout.min[a] = layout.min[a].min(uv[a]);
@@ -205,29 +321,32 @@ fn layouts(flat: &Flattening, owner: &[Option<(u32, [f64; 2])>]) -> Vec<ChartLay
     charts
 }
 
-fn try_pack(charts: &[ChartLayout], s: f64, opts: &AtlasOptions) -> Option<Vec<Placement>> {
-    let sizes: Vec<(u32, u32)> = charts
-        .iter()
-        .map(|c| {
-            let (w, h, _) = c.blocks(s, opts.block);
-            (w, h)
-        })
-        .collect();
-    pack(&sizes, opts.width / opts.block, opts.height / opts.block)
+fn try_pack(
+    charts: &[ChartLayout],
+    s: f64,
+    opts: &AtlasOptions,
+) -> Option<(Vec<Shape>, Vec<Placement>)> {
+    let shapes: Vec<Shape> = charts.iter().map(|c| c.shape(s, opts.block)).collect();
+    let footprints: Vec<Footprint> = shapes.iter().map(|s| s.footprint.clone()).collect();
+    let placed = pack(
+        &footprints,
+        opts.width / opts.block,
+        opts.height / opts.block,
+    )?;
+    Some((shapes, placed))
 }
 
-/// Largest common scale at which every chart's block rectangle fits.
-fn best_scale(
-    charts: &[ChartLayout],
-    opts: &AtlasOptions,
-) -> Result<(f64, Vec<Placement>), AtlasError> {
+/// A scale, the chart shapes at that scale and where they go.
+type Packing = (f64, Vec<Shape>, Vec<Placement>);
+
+/// Largest common scale at which every chart's blocks fit (bisection; the
+/// greedy packer is not exactly monotonic in the scale, so this is the
+/// largest scale found, not a proven optimum).
+fn best_scale(charts: &[ChartLayout], opts: &AtlasOptions) -> Result<Packing, AtlasError> {
     let Some(at_zero) = try_pack(charts, 0.0, opts) else {
         let blocks = charts
             .iter()
-            .map(|c| {
-                let (w, h, _) = c.blocks(0.0, opts.block);
-                w as usize * h as usize
-            })
+            .map(|c| c.shape(0.0, opts.block).footprint.cells.len())
             .sum();
         return Err(AtlasError::ChartsDoNotFit {
             charts: charts.len(),
@@ -246,10 +365,11 @@ fn best_scale(
     } else {
         0.0
     };
-    let (mut lo, mut best) = (0.0, at_zero);
+    let mut lo = 0.0;
+    let mut best = at_zero;
     if hi > 0.0 {
-        if let Some(p) = try_pack(charts, hi, opts) {
-            return Ok((hi, p));
+        if let Some((shapes, placed)) = try_pack(charts, hi, opts) {
+            return Ok((hi, shapes, placed));
         }
     }
     for _ in 0..40 {
@@ -261,56 +381,48 @@ fn best_scale(
             }
             None => hi = mid,
         }
-        if hi - lo <= 1e-4 * hi {
+        if hi - lo <= 1e-3 * hi {
             break;
         }
     }
-    Ok((lo, best))
+    Ok((lo, best.0, best.1))
 }
 
-/// Where one chart sits: maps its 2D coordinates to global lattice coordinates.
+/// Where one chart sits: maps its local pixels to lattice pixels.
 struct Frame {
     origin: [f64; 2],
-    min: [f64; 2],
-    offset: [f64; 2],
-    scale: f64,
-    transposed: bool,
-    /// Rectangle in the lattice: x0, y0, width, height (pixels).
-    rect: [u32; 4],
+    /// Local frame size in pixels.
+    size: [f64; 2],
+    orientation: Orientation,
 }
 
 impl Frame {
-    fn to_lattice(&self, uv: [f64; 2]) -> [f64; 2] {
-        let local = [0, 1].map(|a| (uv[a] - self.min[a]) * self.scale + self.offset[a]);
-        let (x, y) = if self.transposed {
-            (local[1], local[0])
-        } else {
-            (local[0], local[1])
-        };
-        [self.origin[0] + x, self.origin[1] + y]
-    }
-
-    fn clamp_pixel(&self, p: [f64; 2]) -> [u32; 2] {
-        let [x0, y0, w, h] = self.rect;
-        let cx = p[0].round().clamp(f64::from(x0), f64::from(x0 + w - 1)) as u32;
-        let cy = p[1].round().clamp(f64::from(y0), f64::from(y0 + h - 1)) as u32;
-        [cx, cy]
+    fn to_lattice(&self, local: [f64; 2]) -> [f64; 2] {
+        let p = self.orientation.apply(local, self.size[0], self.size[1]);
+        [self.origin[0] + p[0], self.origin[1] + p[1]]
     }
 }
 
-/// Nearest free pixel of a rectangle to `target`.
-fn nearest_free(grid: &[u32], width: u32, rect: [u32; 4], target: [u32; 2]) -> Option<[u32; 2]> {
-    let [x0, y0, w, h] = rect;
+/// Nearest pixel to `target` without a vertex, among the given blocks.
+fn nearest_free(
+    grid: &[u32],
+    width: u32,
+    block: u32,
+    blocks: &[(u32, u32)],
+    target: [u32; 2],
+) -> Option<[u32; 2]> {
     let mut best: Option<(i64, [u32; 2])> = None;
-    for y in y0..y0 + h {
-        for x in x0..x0 + w {
-            if grid[(y * width + x) as usize] != NO_VERTEX {
-                continue;
-            }
-            let d = (i64::from(x) - i64::from(target[0])).pow(2)
-                + (i64::from(y) - i64::from(target[1])).pow(2);
-            if best.is_none_or(|(bd, _)| d < bd) {
-                best = Some((d, [x, y]));
+    for &(bx, by) in blocks {
+        for y in by * block..(by + 1) * block {
+            for x in bx * block..(bx + 1) * block {
+                if grid[(y * width + x) as usize] != NO_VERTEX {
+                    continue;
+                }
+                let d = (i64::from(x) - i64::from(target[0])).pow(2)
+                    + (i64::from(y) - i64::from(target[1])).pow(2);
+                if best.is_none_or(|(bd, _)| d < bd) {
+                    best = Some((d, [x, y]));
+                }
             }
         }
     }
@@ -388,15 +500,16 @@ pub fn build(
             opts.max_split_rounds,
         )?
     };
-    let owner = assign_owners(
+    let mut owner = assign_owners(
         triangles,
         partition,
         &seeds.face_cluster,
         &flat,
         positions.len(),
     );
+    let absorbed = absorb_small_charts(triangles, &mut owner, flat.charts, opts.min_chart_vertices);
     let charts = layouts(&flat, &owner);
-    let (scale, placements) = best_scale(&charts, opts)?;
+    let (scale, shapes, placements) = best_scale(&charts, opts)?;
 
     let (width, height, block) = (opts.width, opts.height, opts.block);
     let pixels = (width * height) as usize;
@@ -413,34 +526,35 @@ pub fn build(
     let mut total_stretch = StretchSum::default();
     let mut max_chart_stretch: f64 = 0.0;
 
-    for (ci, (layout, place)) in charts.iter().zip(&placements).enumerate() {
-        let (bw, bh, px) = layout.blocks(scale, block);
-        let (rbw, rbh) = if place.transposed { (bh, bw) } else { (bw, bh) };
-        let rect = [place.bx * block, place.by * block, rbw * block, rbh * block];
-        for by in place.by..place.by + rbh {
-            for bx in place.bx..place.bx + rbw {
-                block_chart[(by * blocks_across + bx) as usize] = Some(ci as u32);
-            }
+    for (ci, ((layout, shape), place)) in charts.iter().zip(&shapes).zip(&placements).enumerate() {
+        let fp = &shape.footprint;
+        let blocks: Vec<(u32, u32)> = place.cells(fp).collect();
+        for &(bx, by) in &blocks {
+            block_chart[(by * blocks_across + bx) as usize] = Some(ci as u32);
         }
+        let local_rect = [0, 0, fp.width * block, fp.height * block];
         let frame = Frame {
-            origin: [f64::from(rect[0]), f64::from(rect[1])],
-            min: layout.min,
-            offset: [0, 1].map(|a| f64::from(([bw, bh][a] * block).saturating_sub(px[a]) / 2)),
-            scale,
-            transposed: place.transposed,
-            rect,
+            origin: [f64::from(place.bx * block), f64::from(place.by * block)],
+            size: [f64::from(local_rect[2]), f64::from(local_rect[3])],
+            orientation: place.orientation,
+        };
+        let lattice_pixel = |local: [f64; 2]| {
+            let p = frame.to_lattice(local);
+            [p[0].round() as u32, p[1].round() as u32]
         };
         for (k, &(v, uv)) in layout.owned.iter().enumerate() {
             let target = if layout.faceless {
                 let k = k as u32;
-                [rect[0] + k % rect[2], rect[1] + k / rect[2]]
+                lattice_pixel([f64::from(k % local_rect[2]), f64::from(k / local_rect[2])])
             } else {
-                frame.clamp_pixel(frame.to_lattice(uv))
+                lattice_pixel(
+                    clamp_pixel(layout.local(uv, scale, shape.offset), local_rect).map(f64::from),
+                )
             };
             let mut at = target;
             if grid[(at[1] * width + at[0]) as usize] != NO_VERTEX {
-                // The rectangle has a pixel per owned vertex, so this finds one.
-                at = nearest_free(&grid, width, rect, target).unwrap_or(target);
+                // The chart's blocks hold a pixel per owned vertex, so this finds one.
+                at = nearest_free(&grid, width, block, &blocks, target).unwrap_or(target);
                 moved += 1;
             }
             grid[(at[1] * width + at[0]) as usize] = v;
@@ -449,12 +563,16 @@ pub fn build(
             vertex_pixels[v as usize] = [at[0] as u16, at[1] as u16];
             vertex_chart[v as usize] = ci as u32;
         }
-        for &f in &layout.faces {
-            let corners = [0, 1, 2].map(|k| frame.to_lattice(flat.corner_uv[f][k]));
-            let tri = triangles[f];
-            rasterise(corners, rect, |[x, y], w| {
+        for (f, corners) in &layout.faces {
+            let local = corners.map(|uv| layout.local(uv, scale, shape.offset));
+            let tri = triangles[*f];
+            rasterise(local, local_rect, |p, w| {
+                let [x, y] = lattice_pixel(p.map(f64::from));
                 let i = (y * width + x) as usize;
-                if covered[i] {
+                if covered[i]
+                    || block_chart[((y / block) * blocks_across + x / block) as usize]
+                        != Some(ci as u32)
+                {
                     return;
                 }
                 covered[i] = true;
@@ -473,10 +591,16 @@ pub fn build(
             total_stretch.merge(&layout.stretch);
             max_chart_stretch = max_chart_stretch.max(s);
         }
+        let (ow, oh) = if place.orientation.transposed {
+            (local_rect[3], local_rect[2])
+        } else {
+            (local_rect[2], local_rect[3])
+        };
         packed.push(Chart {
-            origin: [rect[0], rect[1]],
-            size: [rect[2], rect[3]],
-            transposed: place.transposed,
+            origin: [place.bx * block, place.by * block],
+            size: [ow, oh],
+            blocks: blocks.len(),
+            transposed: place.orientation.transposed,
             vertices: layout.owned.len(),
             stretch,
         });
@@ -493,6 +617,7 @@ pub fn build(
         packing_efficiency: chart_pixels as f64 / pixels as f64,
         block_efficiency: owned_blocks as f64 / block_chart.len().max(1) as f64,
         moved_vertices: moved,
+        absorbed_vertices: absorbed,
         faceless_vertices: charts
             .iter()
             .filter(|c| c.faceless)

@@ -25,6 +25,9 @@ pub struct AtlasOptions {
     pub max_stretch: f64,
     /// Interior pixel mode.
     pub interior: Interior,
+    /// Charts owning fewer vertices than this give them to neighbouring
+    /// charts (0 or 1: never).
+    pub min_chart_vertices: usize,
     /// Rounds of stretch-driven splitting at most.
     pub max_split_rounds: u32,
 }
@@ -38,6 +41,7 @@ impl Default for AtlasOptions {
             max_stretch: 1.25,
             interior: Interior::Rasterised,
             max_split_rounds: 3,
+            min_chart_vertices: 8,
         }
     }
 }

@@ -1,110 +1,162 @@
-//! Block-aligned rectangle packing: every chart gets a rectangle of whole
-//! blocks, no block is shared, one common scale for all charts.
+//! Block-aligned packing of chart footprints: every chart owns a set of
+//! whole blocks (the blocks its triangles and vertices touch), no block is
+//! shared, one common scale for all charts.
 //!
-//! Written here because the rectangles live on a tiny grid (32×32 blocks for
-//! a 256 lattice) and must be re-packed at each step of the scale search;
-//! the packing crates work on pixels and pad, which this does not need.
+//! Written here because the footprints live on a tiny grid (32×32 blocks for
+//! a 256 lattice) and are re-packed at each step of the scale search; the
+//! packing crates work on pixel rectangles with padding, which this does not
+//! need, and cannot nest a chart into another's empty blocks.
 
-/// A chart's rectangle in blocks, and where it went.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Placement {
-    /// Left column, in blocks.
-    pub bx: u32,
-    /// Top row, in blocks.
-    pub by: u32,
-    /// Whether the chart is transposed (its u runs down, v runs across).
+/// One of the four orientations tried for a chart: a half turn and/or a
+/// transposition (mirroring is harmless: only the vertex → pixel map matters).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub(crate) struct Orientation {
+    /// Coordinates reversed on both axes first.
+    pub half_turn: bool,
+    /// Then x and y swapped.
     pub transposed: bool,
 }
 
-/// Free-cell runs of a block grid, for quick "is this rectangle free" tests.
-struct Grid {
-    w: u32,
-    h: u32,
-    /// For each cell, free cells to its right including itself.
-    run: Vec<u32>,
-}
-
-impl Grid {
-    fn new(w: u32, h: u32) -> Self {
-        let mut g = Grid {
-            w,
-            h,
-            run: vec![0; (w * h) as usize],
-        };
-        for y in 0..h {
-            for x in 0..w {
-                g.run[(y * w + x) as usize] = w - x;
-            }
-        }
-        g
-    }
-
-    fn fits(&self, x: u32, y: u32, rw: u32, rh: u32) -> bool {
-        x + rw <= self.w
-            && y + rh <= self.h
-            && (y..y + rh).all(|row| self.run[(row * self.w + x) as usize] >= rw)
-    }
-
-    /// First fit scanning rows top to bottom, columns left to right.
-    fn find(&self, rw: u32, rh: u32) -> Option<(u32, u32)> {
-        if rw > self.w || rh > self.h {
-            return None;
-        }
-        (0..=self.h - rh)
-            .flat_map(|y| (0..=self.w - rw).map(move |x| (x, y)))
-            .find(|&(x, y)| self.fits(x, y, rw, rh))
-    }
-
-    fn occupy(&mut self, x: u32, y: u32, rw: u32, rh: u32) {
-        for row in y..y + rh {
-            let base = (row * self.w) as usize;
-            for cx in x..x + rw {
-                self.run[base + cx as usize] = 0;
-            }
-            let mut next = 0;
-            for cx in (0..self.w).rev() {
-                let i = base + cx as usize;
-                next = if self.run[i] == 0 { 0 } else { next + 1 };
-                self.run[i] = next;
-            }
-        }
-    }
-}
-
-/// Packs rectangles of `(width, height)` blocks into a `grid_w × grid_h`
-/// block grid, trying both orientations, biggest first, each at the
-/// top-most then left-most free spot (bottom-left fill, so small charts drop
-/// into holes left by big ones). `None` if one does not fit.
-pub(crate) fn pack(sizes: &[(u32, u32)], grid_w: u32, grid_h: u32) -> Option<Vec<Placement>> {
-    let mut order: Vec<usize> = (0..sizes.len()).collect();
-    order.sort_by_key(|&i| {
-        let (w, h) = sizes[i];
-        (std::cmp::Reverse(w.max(h)), std::cmp::Reverse(w * h), i)
-    });
-    let mut grid = Grid::new(grid_w, grid_h);
-    let mut placed = vec![
-        Placement {
-            bx: 0,
-            by: 0,
-            transposed: false
-        };
-        sizes.len()
+impl Orientation {
+    const ALL: [Orientation; 4] = [
+        Orientation {
+            half_turn: false,
+            transposed: false,
+        },
+        Orientation {
+            half_turn: false,
+            transposed: true,
+        },
+        Orientation {
+            half_turn: true,
+            transposed: false,
+        },
+        Orientation {
+            half_turn: true,
+            transposed: true,
+        },
     ];
-    for i in order {
-        let (w, h) = sizes[i];
-        let upright = grid.find(w, h).map(|(x, y)| (y, x, false));
-        let turned = if w != h {
-            grid.find(h, w).map(|(x, y)| (y, x, true))
+
+    /// Maps a point of a `w × h` local frame (cells or pixels, where the
+    /// last one is `w - 1`) into the oriented frame.
+    pub(crate) fn apply(&self, p: [f64; 2], w: f64, h: f64) -> [f64; 2] {
+        let p = if self.half_turn {
+            [w - 1.0 - p[0], h - 1.0 - p[1]]
         } else {
-            None
+            p
         };
-        let (by, bx, transposed) = match (upright, turned) {
-            (Some(a), Some(b)) => a.min(b),
-            (a, b) => a.or(b)?,
+        if self.transposed {
+            [p[1], p[0]]
+        } else {
+            p
+        }
+    }
+
+    fn cell(&self, c: (u32, u32), w: u32, h: u32) -> (u32, u32) {
+        let c = if self.half_turn {
+            (w - 1 - c.0, h - 1 - c.1)
+        } else {
+            c
         };
-        let (rw, rh) = if transposed { (h, w) } else { (w, h) };
-        grid.occupy(bx, by, rw, rh);
-        placed[i] = Placement { bx, by, transposed };
+        if self.transposed {
+            (c.1, c.0)
+        } else {
+            c
+        }
+    }
+}
+
+/// A chart's blocks in its own `width × height` block frame.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Footprint {
+    pub width: u32,
+    pub height: u32,
+    /// Occupied cells `(x, y)`, each once.
+    pub cells: Vec<(u32, u32)>,
+}
+
+/// Where a chart went: top-left of its oriented frame, in blocks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub(crate) struct Placement {
+    pub bx: u32,
+    pub by: u32,
+    pub orientation: Orientation,
+}
+
+impl Placement {
+    /// Lattice blocks a footprint covers when placed here.
+    pub(crate) fn cells<'a>(&'a self, f: &'a Footprint) -> impl Iterator<Item = (u32, u32)> + 'a {
+        f.cells.iter().map(move |&c| {
+            let (x, y) = self.orientation.cell(c, f.width, f.height);
+            (self.bx + x, self.by + y)
+        })
+    }
+}
+
+/// Packs footprints into a `grid_w × grid_h` block grid, biggest first, each
+/// at the top-most then left-most spot where one of its orientations fits
+/// (bottom-left fill, so small charts drop into the gaps of big ones).
+/// `None` if one does not fit.
+pub(crate) fn pack(footprints: &[Footprint], grid_w: u32, grid_h: u32) -> Option<Vec<Placement>> {
+    let mut order: Vec<usize> = (0..footprints.len()).collect();
+    order.sort_by_key(|&i| {
+        let f = &footprints[i];
+        (
+            std::cmp::Reverse(f.cells.len()),
+            std::cmp::Reverse(f.width.max(f.height)),
+            i,
+        )
+    });
+    let mut used = vec![false; (grid_w * grid_h) as usize];
+    let mut placed = vec![Placement::default(); footprints.len()];
+    for i in order {
+        let f = &footprints[i];
+        let mut best: Option<(u32, u32, Orientation)> = None;
+        for o in Orientation::ALL {
+            let full = f.cells.len() == (f.width * f.height) as usize;
+            // A full rectangle looks the same turned; a full square also transposed.
+            if full && (o.half_turn || (o.transposed && f.width == f.height)) {
+                continue;
+            }
+            let (ow, oh) = if o.transposed {
+                (f.height, f.width)
+            } else {
+                (f.width, f.height)
+            };
+            if ow > grid_w || oh > grid_h {
+                continue;
+            }
+            let cells: Vec<(u32, u32)> = f
+                .cells
+                .iter()
+                .map(|&c| o.cell(c, f.width, f.height))
+                .collect();
+            let limit = best.map_or(grid_h - oh, |(y, _, _)| y.min(grid_h - oh));
+            'search: for y in 0..=limit {
+                for x in 0..=grid_w - ow {
+                    if best.is_some_and(|(by, bx, _)| (y, x) >= (by, bx)) {
+                        break 'search;
+                    }
+                    if cells
+                        .iter()
+                        .all(|&(cx, cy)| !used[((y + cy) * grid_w + x + cx) as usize])
+                    {
+                        best = Some((y, x, o));
+                        break 'search;
+                    }
+                }
+            }
+        }
+        let (by, bx, orientation) = best?;
+        let p = Placement {
+            bx,
+            by,
+            orientation,
+        };
+        for (x, y) in p.cells(f) {
+            used[(y * grid_w + x) as usize] = true;
+        }
+        placed[i] = p;
     }
     Some(placed)
 }
@@ -113,23 +165,49 @@ pub(crate) fn pack(sizes: &[(u32, u32)], grid_w: u32, grid_h: u32) -> Option<Vec
 mod tests {
     use super::*;
 
+    fn rect(w: u32, h: u32) -> Footprint {
+        Footprint {
+            width: w,
+            height: h,
+            cells: (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).collect(),
+        }
+    }
+
     #[test]
     fn packs_without_overlap_and_refuses_overflow() {
-        let sizes = [(3, 2), (2, 2), (4, 1), (1, 1), (1, 3)];
-        let placed = pack(&sizes, 4, 5);
-        let Some(placed) = placed else {
-            panic!("16 blocks fit a 4×5 grid");
+        let l_shape = Footprint {
+            width: 3,
+            height: 3,
+            cells: vec![(0, 0), (0, 1), (0, 2), (1, 2), (2, 2)],
         };
-        let mut used = [[false; 4]; 5];
-        for (p, &(w, h)) in placed.iter().zip(&sizes) {
-            let (w, h) = if p.transposed { (h, w) } else { (w, h) };
-            for y in p.by..p.by + h {
-                for x in p.bx..p.bx + w {
-                    assert!(!used[y as usize][x as usize], "overlap at {x},{y}");
-                    used[y as usize][x as usize] = true;
-                }
+        let shapes = [
+            rect(3, 2),
+            rect(2, 2),
+            rect(4, 1),
+            rect(1, 1),
+            rect(1, 3),
+            l_shape,
+        ];
+        let Some(placed) = pack(&shapes, 5, 5) else {
+            panic!("21 blocks fit a 5×5 grid");
+        };
+        let mut used = [[false; 5]; 5];
+        for (p, f) in placed.iter().zip(&shapes) {
+            for (x, y) in p.cells(f) {
+                assert!(!used[y as usize][x as usize], "overlap at {x},{y}");
+                used[y as usize][x as usize] = true;
             }
         }
-        assert!(pack(&[(3, 3), (3, 3)], 4, 5).is_none());
+        assert!(pack(&[rect(3, 3), rect(3, 3)], 4, 5).is_none());
+    }
+
+    #[test]
+    fn a_small_chart_nests_in_an_l_shape() {
+        let l_shape = Footprint {
+            width: 2,
+            height: 2,
+            cells: vec![(0, 0), (0, 1), (1, 1)],
+        };
+        assert!(pack(&[l_shape, rect(1, 1)], 2, 2).is_some());
     }
 }

@@ -56,19 +56,33 @@ fn check_invariants(atlas: &Atlas, vertices: usize) {
                 && y < c.origin[1] + c.size[1]
         );
     }
-    // Chart rectangles are whole blocks and never share a block.
+    // Frames are whole blocks; each block has at most one chart, and it lies in that chart's frame.
     let b = atlas.block();
-    let mut owner = vec![None; (atlas.width() / b * atlas.height() / b) as usize];
-    for (ci, c) in atlas.charts().iter().enumerate() {
-        assert!(c.origin.iter().chain(&c.size).all(|v| v % b == 0));
-        for by in c.origin[1] / b..(c.origin[1] + c.size[1]) / b {
-            for bx in c.origin[0] / b..(c.origin[0] + c.size[0]) / b {
-                let slot = &mut owner[(by * atlas.width() / b + bx) as usize];
-                assert_eq!(*slot, None, "block ({bx}, {by}) holds two charts");
-                *slot = Some(ci as u32);
-                assert_eq!(atlas.chart_at(bx * b, by * b), Some(ci as u32));
+    let mut owned = vec![0usize; atlas.charts().len()];
+    for by in 0..atlas.height() / b {
+        for bx in 0..atlas.width() / b {
+            let owner = atlas.chart_at(bx * b, by * b);
+            for y in by * b..(by + 1) * b {
+                for x in bx * b..(bx + 1) * b {
+                    assert_eq!(
+                        atlas.chart_at(x, y),
+                        owner,
+                        "block ({bx}, {by}) is not uniform"
+                    );
+                }
+            }
+            if let Some(ci) = owner {
+                owned[ci as usize] += 1;
+                let c = &atlas.charts()[ci as usize];
+                assert!(bx * b >= c.origin[0] && (bx + 1) * b <= c.origin[0] + c.size[0]);
+                assert!(by * b >= c.origin[1] && (by + 1) * b <= c.origin[1] + c.size[1]);
             }
         }
+    }
+    for (c, n) in atlas.charts().iter().zip(&owned) {
+        assert!(c.origin.iter().chain(&c.size).all(|v| v % b == 0));
+        assert_eq!(c.blocks, *n);
+        assert!(c.blocks * (b * b) as usize >= c.vertices);
     }
     for (i, fixed) in atlas.fixed_mask().iter().enumerate() {
         let (x, y) = (i as u32 % atlas.width(), i as u32 / atlas.width());
