@@ -330,7 +330,7 @@ fn smooth_methods_reproduce_a_linear_ramp() {
 }
 
 /// w(u, v) of the DCT coefficient in row u, column v.
-type CoefficientWeight = dyn Fn(usize, usize) -> f64;
+type CoefficientWeight<'a> = dyn Fn(usize, usize) -> f64 + 'a;
 
 /// Σ_{k≠0} w_k c_k² of an 8×8 block, with a textbook (slow) orthonormal DCT.
 fn weighted_ac_energy(block: &[f64], weight: impl Fn(usize, usize) -> f64) -> f64 {
@@ -372,7 +372,7 @@ fn dct_methods_reach_their_energy_minimum() {
     let lambda = |k: usize| 2.0 - 2.0 * (std::f64::consts::PI * k as f64 / 8.0).cos();
     let values: Vec<f32> = (0..64).map(|i| ((i * 53) % 97) as f32).collect();
     let fixed: Vec<bool> = (0..64).map(|i| (i * 5 + 2) % 7 < 3).collect();
-    let cases: [(Method, &CoefficientWeight); 2] = [
+    let cases: [(Method, &CoefficientWeight<'_>); 2] = [
         (Method::DctEnergy, &|u, v| ANNEX_K[u * 8 + v].powi(-2)),
         (Method::Biharmonic, &|u, v| (lambda(u) + lambda(v)).powi(2)),
     ];
