@@ -143,8 +143,10 @@ impl AffineTrack {
         let solvers: Vec<AffineSolver> = members
             .iter()
             .map(|m| {
-                let source: Vec<[f64; 3]> =
-                    m.iter().map(|&u| unit.to_unit(&reference[u as usize])).collect();
+                let source: Vec<[f64; 3]> = m
+                    .iter()
+                    .map(|&u| unit.to_unit(&reference[u as usize]))
+                    .collect();
                 AffineSolver::new(&source, CLUSTER_LAMBDA)
             })
             .collect();
