@@ -118,7 +118,7 @@ fn options(clusters: usize) -> SegmentOptions {
 fn max_residual(mesh: &AnimatedMesh, track: &AffineTrack, partition: &Partition) -> f64 {
     (0..mesh.frame_count())
         .flat_map(|f| {
-            let predicted = track.predict(f, mesh.frame(0), partition).unwrap();
+            let predicted = track.try_predict(f, mesh.frame(0), partition).unwrap();
             residuals(mesh.frame(f), &predicted)
         })
         .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
@@ -157,13 +157,13 @@ fn connected_parts_are_recovered_up_to_their_seams() {
 
     // With the true parts, the predictor leaves only quantisation noise; the motion is far larger.
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
-    let exact = Partition::new(labels, 4).unwrap();
+    let exact = Partition::from_labels(labels, 4).unwrap();
     let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, 17).unwrap();
     let diag = mesh.bbox_diagonal();
     assert!(max_residual(&mesh, &track, &exact) < 2e-5 * diag);
     let last = mesh.frame(FRAMES - 1);
     let motion: Vec<[f32; 3]> = residuals(last, mesh.frame(0));
-    let predicted = track.predict(FRAMES - 1, mesh.frame(0), &exact).unwrap();
+    let predicted = track.predict(FRAMES - 1, mesh.frame(0), &exact);
     assert!(energy(&residuals(last, &predicted)) < 1e-9 * energy(&motion));
 }
 
@@ -190,13 +190,13 @@ fn segmentation_is_deterministic() {
 fn quantised_form_round_trips_and_rejects_corruption() {
     let (mesh, truth) = separate_parts();
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
-    let partition = Partition::new(labels, 4).unwrap();
+    let partition = Partition::from_labels(labels, 4).unwrap();
     let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
     let again = AffineTrack::from_quantised(track.quantised().clone()).unwrap();
     for f in [0, 5, FRAMES - 1] {
         assert_eq!(
-            track.predict(f, mesh.frame(0), &partition).unwrap(),
-            again.predict(f, mesh.frame(0), &partition).unwrap()
+            track.predict(f, mesh.frame(0), &partition),
+            again.predict(f, mesh.frame(0), &partition)
         );
     }
     let mut too_big = track.quantised().clone();
@@ -208,7 +208,14 @@ fn quantised_form_round_trips_and_rejects_corruption() {
     let mut nan = track.quantised().clone();
     nan.ranges[0].1 = f32::NAN;
     assert!(AffineTrack::from_quantised(nan).is_err());
-    assert!(track.predict(FRAMES, mesh.frame(0), &partition).is_err());
+    assert!(track
+        .try_predict(FRAMES, mesh.frame(0), &partition)
+        .is_err());
+    // Unchecked prediction past the end leaves the reference as it is instead of panicking.
+    assert_eq!(
+        track.predict(FRAMES, mesh.frame(0), &partition),
+        mesh.frame(0)
+    );
 }
 
 fn assert_finite_everywhere(mesh: &AnimatedMesh, clusters: usize) {
@@ -217,7 +224,7 @@ fn assert_finite_everywhere(mesh: &AnimatedMesh, clusters: usize) {
     assert!(partition.clusters() >= 1 && partition.clusters() <= clusters);
     let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
     for f in 0..mesh.frame_count() {
-        let predicted = track.predict(f, mesh.frame(0), &partition).unwrap();
+        let predicted = track.predict(f, mesh.frame(0), &partition);
         assert!(predicted.iter().flatten().all(|c| c.is_finite()));
     }
 }
@@ -279,7 +286,7 @@ fn bad_requests_are_errors() {
     let (mesh, truth) = separate_parts();
     assert!(segment(&mesh, &options(0)).is_err());
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
-    let partition = Partition::new(labels, 4).unwrap();
+    let partition = Partition::from_labels(labels, 4).unwrap();
     assert!(AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 0).is_err());
     assert!(AffineTrack::fit(mesh.frames(), &mesh.frame(0)[1..], &partition, 17).is_err());
 }

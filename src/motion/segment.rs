@@ -62,7 +62,7 @@ pub struct Partition {
 impl Partition {
     /// Checks and wraps labels (e.g. read from a stream): at least one vertex, every label below
     /// `clusters`, and every cluster used.
-    pub fn new(labels: Vec<u32>, clusters: usize) -> Result<Self> {
+    pub fn from_labels(labels: Vec<u32>, clusters: usize) -> Result<Self> {
         if labels.is_empty() {
             return Err(Error::Stream("partition has no vertices".into()));
         }
@@ -134,7 +134,7 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     let v_count = mesh.vertex_count();
     let k = opts.clusters.min(v_count);
     if k == 1 {
-        return Partition::new(vec![0; v_count], 1);
+        return Partition::from_labels(vec![0; v_count], 1);
     }
     let sampled = SampledMotion::new(mesh, opts.feature_frames);
     let (features, misfit) = motion_features(mesh, &sampled, opts.ring);
@@ -147,7 +147,7 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     let spread = feature_spread(&training);
     if spread == 0.0 {
         // Every vertex moves alike: k-means would only split ties.
-        return Partition::new(vec![0; v_count], 1);
+        return Partition::from_labels(vec![0; v_count], 1);
     }
     let training = DatasetBase::from(training);
     let model = KMeans::params_with_rng(k, Xoshiro256Plus::seed_from_u64(opts.seed))
@@ -485,7 +485,7 @@ fn compact(labels: Vec<usize>) -> Result<Partition> {
             *map.entry(l).or_insert(next)
         })
         .collect();
-    Partition::new(compact, map.len())
+    Partition::from_labels(compact, map.len())
 }
 
 #[cfg(test)]
@@ -504,10 +504,10 @@ mod tests {
 
     #[test]
     fn partition_rejects_bad_labels() {
-        assert!(Partition::new(vec![0, 2], 2).is_err());
-        assert!(Partition::new(vec![0, 0], 2).is_err());
-        assert!(Partition::new(vec![], 1).is_err());
-        let p = Partition::new(vec![1, 0, 1], 2).unwrap();
+        assert!(Partition::from_labels(vec![0, 2], 2).is_err());
+        assert!(Partition::from_labels(vec![0, 0], 2).is_err());
+        assert!(Partition::from_labels(vec![], 1).is_err());
+        let p = Partition::from_labels(vec![1, 0, 1], 2).unwrap();
         assert_eq!(p.members(), vec![vec![1], vec![0, 2]]);
     }
 }
