@@ -2,7 +2,8 @@
 //! motion energy, largest residual, and the time of each stage.
 //!
 //! `cargo bench --bench motion [-- DIR_OR_FILE ...]`; with no arguments, every sequence found under
-//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped).
+//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). `REFINE=N` sets
+//! `SegmentOptions::refine_passes`.
 
 use mcgv_video::mesh::Point;
 use mcgv_video::motion::{
@@ -13,7 +14,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
     let inputs: Vec<PathBuf> = if args.is_empty() {
         default_inputs()
     } else {
@@ -24,9 +28,10 @@ fn main() {
         "sequence", "V", "F", "K", "resid/motion", "max % diag", "segment s", "predict s"
     );
     for input in inputs {
-        let name = input
-            .file_name()
-            .map_or_else(|| input.display().to_string(), |n| n.to_string_lossy().into());
+        let name = input.file_name().map_or_else(
+            || input.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
         match load(&input) {
             Ok(mesh) => measure(&name, &mesh),
             Err(e) => println!("{name:<22} skipped: {e}"),
@@ -36,17 +41,30 @@ fn main() {
 
 fn default_inputs() -> Vec<PathBuf> {
     let unpacked = Path::new("/work/media-unpacked");
-    let mut inputs: Vec<PathBuf> = ["chickenCrossing", "pcow", "pdance", "horse-gallop", "horse-collapse"]
-        .iter()
-        .map(|n| unpacked.join(n))
-        .collect();
+    let mut inputs: Vec<PathBuf> = [
+        "chickenCrossing",
+        "pcow",
+        "pdance",
+        "horse-gallop",
+        "horse-collapse",
+    ]
+    .iter()
+    .map(|n| unpacked.join(n))
+    .collect();
     inputs.push(PathBuf::from("/work/shared/media/walking_cat/OBJ"));
     inputs.into_iter().filter(|p| p.exists()).collect()
 }
 
 fn measure(name: &str, mesh: &AnimatedMesh) {
     let start = Instant::now();
-    let partition = match segment(mesh, &SegmentOptions::default()) {
+    let opts = SegmentOptions {
+        refine_passes: std::env::var("REFINE")
+            .ok()
+            .and_then(|r| r.parse().ok())
+            .unwrap_or(SegmentOptions::default().refine_passes),
+        ..SegmentOptions::default()
+    };
+    let partition = match segment(mesh, &opts) {
         Ok(p) => p,
         Err(e) => return println!("{name:<22} segmentation failed: {e}"),
     };
@@ -63,9 +81,7 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
     let mut motion_energy = 0.0;
     let mut largest = 0f64;
     for f in 0..mesh.frame_count() {
-        let Ok(predicted) = track.predict(f, reference, &partition) else {
-            return println!("{name:<22} prediction of frame {f} failed");
-        };
+        let predicted = track.predict(f, reference, &partition);
         let e = residuals(mesh.frame(f), &predicted);
         residual_energy += energy(&e);
         motion_energy += energy(&residuals(mesh.frame(f), reference));
@@ -97,7 +113,12 @@ fn load(dir: &Path) -> Result<AnimatedMesh, String> {
         .map(|p| {
             let digits: String = p
                 .file_stem()
-                .map(|s| s.to_string_lossy().chars().filter(char::is_ascii_digit).collect())
+                .map(|s| {
+                    s.to_string_lossy()
+                        .chars()
+                        .filter(char::is_ascii_digit)
+                        .collect()
+                })
                 .unwrap_or_default();
             (digits.parse().unwrap_or(0), p)
         })
@@ -119,7 +140,12 @@ fn load(dir: &Path) -> Result<AnimatedMesh, String> {
         for m in &models {
             let base = points.len() as u32;
             points.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-            tris.extend(m.mesh.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
+            tris.extend(
+                m.mesh
+                    .indices
+                    .chunks_exact(3)
+                    .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
+            );
         }
         if frames.is_empty() {
             triangles = tris;

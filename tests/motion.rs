@@ -36,7 +36,11 @@ fn tube(points: &mut Vec<Point>, tris: &mut Vec<Triangle>, x0: f32, x1: f32, rin
 fn part_map(k: usize, t: f32) -> impl Fn(Point) -> Point {
     let angle = t * (0.6 + 0.5 * k as f32) * if k % 2 == 0 { 1.0 } else { -1.0 };
     let stretch = 1.0 + 0.3 * t * (k as f32 - 1.5);
-    let shift = [0.5 * t * k as f32, 1.5 * t * (k as f32 * 0.7).sin(), -t * k as f32];
+    let shift = [
+        0.5 * t * k as f32,
+        1.5 * t * (k as f32 * 0.7).sin(),
+        -t * k as f32,
+    ];
     let axis = k % 3;
     move |p: Point| {
         let (c, s) = (angle.cos(), angle.sin());
@@ -68,7 +72,10 @@ fn piecewise_affine(points: Vec<Point>, tris: Vec<Triangle>, part: &[usize]) -> 
 fn connected_parts() -> (AnimatedMesh, Vec<usize>) {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
     tube(&mut points, &mut tris, 0.0, 8.0, 81);
-    let part: Vec<usize> = points.iter().map(|p| ((p[0] / 2.0) as usize).min(3)).collect();
+    let part: Vec<usize> = points
+        .iter()
+        .map(|p| ((p[0] / 2.0) as usize).min(3))
+        .collect();
     (piecewise_affine(points, tris, &part), part)
 }
 
@@ -77,7 +84,13 @@ fn separate_parts() -> (AnimatedMesh, Vec<usize>) {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
     let mut part = Vec::new();
     for k in 0..4 {
-        tube(&mut points, &mut tris, 2.5 * k as f32, 2.5 * k as f32 + 2.0, 9);
+        tube(
+            &mut points,
+            &mut tris,
+            2.5 * k as f32,
+            2.5 * k as f32 + 2.0,
+            9,
+        );
         part.resize(points.len(), k);
     }
     (piecewise_affine(points, tris, &part), part)
@@ -105,7 +118,7 @@ fn options(clusters: usize) -> SegmentOptions {
 fn max_residual(mesh: &AnimatedMesh, track: &AffineTrack, partition: &Partition) -> f64 {
     (0..mesh.frame_count())
         .flat_map(|f| {
-            let predicted = track.predict(f, mesh.frame(0), partition).unwrap();
+            let predicted = track.try_predict(f, mesh.frame(0), partition).unwrap();
             residuals(mesh.frame(f), &predicted)
         })
         .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
@@ -122,11 +135,17 @@ fn separate_parts_are_recovered_and_predicted_to_quantisation_level() {
     let diag = mesh.bbox_diagonal();
     let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
     let worst = max_residual(&mesh, &track, &partition);
-    assert!(worst < 2e-5 * diag, "largest residual {worst} vs diagonal {diag}");
+    assert!(
+        worst < 2e-5 * diag,
+        "largest residual {worst} vs diagonal {diag}"
+    );
     // Fewer bits: coarser, but still following the motion (the ranges are what make bits count).
     let coarse = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 8).unwrap();
     let coarse_worst = max_residual(&mesh, &coarse, &partition);
-    assert!(coarse_worst > worst && coarse_worst < 1e-2 * diag, "{coarse_worst}");
+    assert!(
+        coarse_worst > worst && coarse_worst < 1e-2 * diag,
+        "{coarse_worst}"
+    );
 }
 
 #[test]
@@ -138,14 +157,25 @@ fn connected_parts_are_recovered_up_to_their_seams() {
 
     // With the true parts, the predictor leaves only quantisation noise; the motion is far larger.
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
-    let exact = Partition::new(labels, 4).unwrap();
+    let exact = Partition::from_labels(labels, 4).unwrap();
     let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, 17).unwrap();
     let diag = mesh.bbox_diagonal();
     assert!(max_residual(&mesh, &track, &exact) < 2e-5 * diag);
     let last = mesh.frame(FRAMES - 1);
     let motion: Vec<[f32; 3]> = residuals(last, mesh.frame(0));
-    let predicted = track.predict(FRAMES - 1, mesh.frame(0), &exact).unwrap();
+    let predicted = track.predict(FRAMES - 1, mesh.frame(0), &exact);
     assert!(energy(&residuals(last, &predicted)) < 1e-9 * energy(&motion));
+}
+
+#[test]
+fn plain_k_means_recovers_separate_parts_too() {
+    let (mesh, truth) = separate_parts();
+    let opts = SegmentOptions {
+        refine_passes: 0,
+        ..options(4)
+    };
+    let partition = segment(&mesh, &opts).unwrap();
+    assert_eq!(rand_index(partition.labels(), &truth), 1.0);
 }
 
 #[test]
@@ -160,13 +190,13 @@ fn segmentation_is_deterministic() {
 fn quantised_form_round_trips_and_rejects_corruption() {
     let (mesh, truth) = separate_parts();
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
-    let partition = Partition::new(labels, 4).unwrap();
+    let partition = Partition::from_labels(labels, 4).unwrap();
     let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
     let again = AffineTrack::from_quantised(track.quantised().clone()).unwrap();
     for f in [0, 5, FRAMES - 1] {
         assert_eq!(
-            track.predict(f, mesh.frame(0), &partition).unwrap(),
-            again.predict(f, mesh.frame(0), &partition).unwrap()
+            track.predict(f, mesh.frame(0), &partition),
+            again.predict(f, mesh.frame(0), &partition)
         );
     }
     let mut too_big = track.quantised().clone();
@@ -178,7 +208,14 @@ fn quantised_form_round_trips_and_rejects_corruption() {
     let mut nan = track.quantised().clone();
     nan.ranges[0].1 = f32::NAN;
     assert!(AffineTrack::from_quantised(nan).is_err());
-    assert!(track.predict(FRAMES, mesh.frame(0), &partition).is_err());
+    assert!(track
+        .try_predict(FRAMES, mesh.frame(0), &partition)
+        .is_err());
+    // Unchecked prediction past the end leaves the reference as it is instead of panicking.
+    assert_eq!(
+        track.predict(FRAMES, mesh.frame(0), &partition),
+        mesh.frame(0)
+    );
 }
 
 fn assert_finite_everywhere(mesh: &AnimatedMesh, clusters: usize) {
@@ -187,7 +224,7 @@ fn assert_finite_everywhere(mesh: &AnimatedMesh, clusters: usize) {
     assert!(partition.clusters() >= 1 && partition.clusters() <= clusters);
     let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
     for f in 0..mesh.frame_count() {
-        let predicted = track.predict(f, mesh.frame(0), &partition).unwrap();
+        let predicted = track.predict(f, mesh.frame(0), &partition);
         assert!(predicted.iter().flatten().all(|c| c.is_finite()));
     }
 }
@@ -196,7 +233,9 @@ fn assert_finite_everywhere(mesh: &AnimatedMesh, clusters: usize) {
 fn degenerate_inputs_give_finite_answers() {
     // A flat grid that slides and shears in its plane, and a moving line of vertices.
     let n = 6u32;
-    let grid: Vec<Point> = (0..n * n).map(|i| [(i % n) as f32, (i / n) as f32, 0.0]).collect();
+    let grid: Vec<Point> = (0..n * n)
+        .map(|i| [(i % n) as f32, (i / n) as f32, 0.0])
+        .collect();
     let mut tris = Vec::new();
     for y in 0..n - 1 {
         for x in 0..n - 1 {
@@ -211,16 +250,24 @@ fn degenerate_inputs_give_finite_answers() {
 
     let line: Vec<Point> = (0..8).map(|i| [i as f32, 0.0, 0.0]).collect();
     let line_tris: Vec<Triangle> = (0..7).map(|i| [i, i + 1, i + 1]).collect();
-    let frames = (0..3).map(|f| line.iter().map(|p| [p[0] * (1.0 + f as f32), f as f32, 0.0]).collect());
+    let frames = (0..3).map(|f| {
+        line.iter()
+            .map(|p| [p[0] * (1.0 + f as f32), f as f32, 0.0])
+            .collect()
+    });
     assert_finite_everywhere(&AnimatedMesh::new(line_tris, frames.collect()).unwrap(), 3);
 
     // Isolated vertices, more clusters than vertices, a single frame, no motion at all.
     let loose: Vec<Point> = vec![[0.0, 0.0, 0.0], [1.0, 2.0, 3.0], [4.0, 1.0, 0.0]];
     let moved: Vec<Point> = loose.iter().map(|p| [p[0] + 1.0, p[1], -p[2]]).collect();
-    assert_finite_everywhere(&AnimatedMesh::new(vec![], vec![loose.clone(), moved]).unwrap(), 20);
+    assert_finite_everywhere(
+        &AnimatedMesh::new(vec![], vec![loose.clone(), moved]).unwrap(),
+        20,
+    );
     assert_finite_everywhere(&AnimatedMesh::new(vec![], vec![loose.clone()]).unwrap(), 2);
     let (mesh, _) = separate_parts();
-    let still = AnimatedMesh::new(mesh.triangles().to_vec(), vec![mesh.frame(0).to_vec(); 3]).unwrap();
+    let still =
+        AnimatedMesh::new(mesh.triangles().to_vec(), vec![mesh.frame(0).to_vec(); 3]).unwrap();
     let partition = segment(&still, &options(4)).unwrap();
     assert_eq!(partition.clusters(), 1);
 }
@@ -239,7 +286,7 @@ fn bad_requests_are_errors() {
     let (mesh, truth) = separate_parts();
     assert!(segment(&mesh, &options(0)).is_err());
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
-    let partition = Partition::new(labels, 4).unwrap();
+    let partition = Partition::from_labels(labels, 4).unwrap();
     assert!(AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 0).is_err());
     assert!(AffineTrack::fit(mesh.frames(), &mesh.frame(0)[1..], &partition, 17).is_err());
 }
@@ -258,5 +305,7 @@ fn partition_picture_shows_every_cluster() {
     colours.dedup();
     // Background plus four hues, each in a few shades.
     assert!(colours.len() >= 5, "{} colours", colours.len());
-    assert!(render_partition_png(mesh.frame(0), mesh.triangles(), &labels[1..], 96, &path).is_err());
+    assert!(
+        render_partition_png(mesh.frame(0), mesh.triangles(), &labels[1..], 96, &path).is_err()
+    );
 }

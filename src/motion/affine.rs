@@ -143,8 +143,10 @@ impl AffineTrack {
         let solvers: Vec<AffineSolver> = members
             .iter()
             .map(|m| {
-                let source: Vec<[f64; 3]> =
-                    m.iter().map(|&u| unit.to_unit(&reference[u as usize])).collect();
+                let source: Vec<[f64; 3]> = m
+                    .iter()
+                    .map(|&u| unit.to_unit(&reference[u as usize]))
+                    .collect();
                 AffineSolver::new(&source, CLUSTER_LAMBDA)
             })
             .collect();
@@ -212,8 +214,9 @@ impl AffineTrack {
         self.maps.get(frame * self.quantised.clusters + cluster)
     }
 
-    /// Predicts frame `frame` (eq. 3): each vertex of `reference` moved by its cluster's dequantised map.
-    pub fn predict(
+    /// Predicts frame `frame` (eq. 3): each vertex of `reference` moved by its cluster's dequantised
+    /// map. Checks that frame, reference and partition fit this track.
+    pub fn try_predict(
         &self,
         frame: usize,
         reference: &[Point],
@@ -237,13 +240,21 @@ impl AffineTrack {
                 self.quantised.clusters
             )));
         }
+        Ok(self.predict(frame, reference, partition))
+    }
+
+    /// Predicts frame `frame` (eq. 3) like [`AffineTrack::try_predict`], for callers that have
+    /// already checked the sizes: a vertex without a map (frame or cluster out of range) stays at
+    /// its reference position, and vertices beyond the partition are left out; it never panics.
+    pub fn predict(&self, frame: usize, reference: &[Point], partition: &Partition) -> Vec<Point> {
         let unit = UnitFrame::of(reference);
-        let start = frame * self.quantised.clusters;
-        let maps = &self.maps[start..start + self.quantised.clusters];
-        Ok(reference
+        reference
             .iter()
             .zip(partition.labels())
-            .map(|(p, &k)| unit.to_world(apply(&maps[k as usize], unit.to_unit(p))))
-            .collect())
+            .map(|(p, &k)| match self.map(frame, k as usize) {
+                Some(h) => unit.to_world(apply(h, unit.to_unit(p))),
+                None => *p,
+            })
+            .collect()
     }
 }

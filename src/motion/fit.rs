@@ -49,12 +49,12 @@ impl UnitFrame {
     }
 
     /// A world position in unit coordinates.
-    pub fn to_unit(&self, p: &Point) -> [f64; 3] {
+    pub fn to_unit(self, p: &Point) -> [f64; 3] {
         [0, 1, 2].map(|a| (p[a] as f64 - self.centre[a]) / self.scale)
     }
 
     /// A unit-coordinate position back in the world.
-    pub fn to_world(&self, q: [f64; 3]) -> Point {
+    pub fn to_world(self, q: [f64; 3]) -> Point {
         [0, 1, 2].map(|a| (q[a] * self.scale + self.centre[a]) as f32)
     }
 }
@@ -134,8 +134,16 @@ mod tests {
 
     #[test]
     fn recovers_an_exact_affine_map() {
-        let src = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.2, 0.9]];
-        let h = [0.9, 0.1, -0.2, 0.5, -0.1, 1.1, 0.3, -0.2, 0.2, 0.0, 0.8, 0.1];
+        let src = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.3, 0.2, 0.9],
+        ];
+        let h = [
+            0.9, 0.1, -0.2, 0.5, -0.1, 1.1, 0.3, -0.2, 0.2, 0.0, 0.8, 0.1,
+        ];
         let solver = AffineSolver::new(&src, 0.0);
         let got = solver.solve(src.iter().map(|&p| apply(&h, p)));
         for (g, w) in got.iter().zip(&h) {
@@ -145,7 +153,12 @@ mod tests {
 
     #[test]
     fn degenerate_sources_are_finite() {
-        let plane = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+        let plane = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
         let shift = |p: [f64; 3]| [p[0] + 1.0, p[1], p[2] + 2.0];
         for src in [&plane[..], &plane[..2], &plane[..1]] {
             let h = AffineSolver::new(src, 1e-3).solve(src.iter().map(|&p| shift(p)));
@@ -153,7 +166,10 @@ mod tests {
             for &p in src {
                 let q = apply(&h, p);
                 let want = shift(p);
-                assert!((0..3).all(|a| (q[a] - want[a]).abs() < 1e-2), "{q:?} vs {want:?}");
+                assert!(
+                    (0..3).all(|a| (q[a] - want[a]).abs() < 1e-2),
+                    "{q:?} vs {want:?}"
+                );
             }
         }
         assert_eq!(AffineSolver::new(&[], 0.0).solve([]), IDENTITY);

@@ -122,16 +122,38 @@ fn shade(colour: [f32; 3], facing: f32) -> Rgb<u8> {
 /// Fills the pixels whose centres fall inside the screen-space triangle and are nearer (larger z)
 /// than what is drawn.
 fn fill_triangle(image: &mut RgbImage, depth: &mut [f32], s: [[f32; 3]; 3], colour: Rgb<u8>) {
-    let edge = |a: [f32; 3], b: [f32; 3], x: f32, y: f32| (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+    let edge = |a: [f32; 3], b: [f32; 3], x: f32, y: f32| {
+        (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])
+    };
     let area = edge(s[0], s[1], s[2][0], s[2][1]);
     if area == 0.0 || !area.is_finite() {
         return;
     }
     let (w, h) = (image.width(), image.height());
-    let min_x = s.iter().map(|p| p[0]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
-    let max_x = s.iter().map(|p| p[0]).fold(f32::NEG_INFINITY, f32::max).ceil().min(w as f32 - 1.0);
-    let min_y = s.iter().map(|p| p[1]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
-    let max_y = s.iter().map(|p| p[1]).fold(f32::NEG_INFINITY, f32::max).ceil().min(h as f32 - 1.0);
+    let min_x = s
+        .iter()
+        .map(|p| p[0])
+        .fold(f32::INFINITY, f32::min)
+        .floor()
+        .max(0.0) as u32;
+    let max_x = s
+        .iter()
+        .map(|p| p[0])
+        .fold(f32::NEG_INFINITY, f32::max)
+        .ceil()
+        .min(w as f32 - 1.0);
+    let min_y = s
+        .iter()
+        .map(|p| p[1])
+        .fold(f32::INFINITY, f32::min)
+        .floor()
+        .max(0.0) as u32;
+    let max_y = s
+        .iter()
+        .map(|p| p[1])
+        .fold(f32::NEG_INFINITY, f32::max)
+        .ceil()
+        .min(h as f32 - 1.0);
     if max_x < 0.0 || max_y < 0.0 {
         return;
     }

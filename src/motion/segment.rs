@@ -31,8 +31,12 @@ pub struct SegmentOptions {
     /// At most this many frames, evenly spaced, describe each vertex's motion (default 64): k-means
     /// cost grows with the feature length, and smooth motion is well sampled by far fewer frames.
     pub feature_frames: usize,
-    /// Cap on Lloyd iterations of k-means (default 100).
+    /// Cap on Lloyd iterations of k-means (default 40).
     pub max_iterations: u64,
+    /// Passes of border refinement after k-means (default 4; 0 = the paper's plain k-means): each pass
+    /// refits every cluster's affine maps and moves each vertex to the neighbouring cluster (or each
+    /// whole single-cluster component to any cluster) that predicts its sampled trajectory best.
+    pub refine_passes: usize,
 }
 
 impl Default for SegmentOptions {
@@ -42,7 +46,8 @@ impl Default for SegmentOptions {
             ring: 3,
             seed: 0,
             feature_frames: 64,
-            max_iterations: 100,
+            max_iterations: 40,
+            refine_passes: 4,
         }
     }
 }
@@ -57,7 +62,7 @@ pub struct Partition {
 impl Partition {
     /// Checks and wraps labels (e.g. read from a stream): at least one vertex, every label below
     /// `clusters`, and every cluster used.
-    pub fn new(labels: Vec<u32>, clusters: usize) -> Result<Self> {
+    pub fn from_labels(labels: Vec<u32>, clusters: usize) -> Result<Self> {
         if labels.is_empty() {
             return Err(Error::Stream("partition has no vertices".into()));
         }
@@ -117,7 +122,9 @@ impl Partition {
 /// vertices are dissolved, smallest first, into the nearest remaining centroid; empty ones vanish.
 pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> {
     if opts.clusters == 0 {
-        return Err(Error::Usage("the number of clusters must be at least 1".into()));
+        return Err(Error::Usage(
+            "the number of clusters must be at least 1".into(),
+        ));
     }
     if opts.feature_frames == 0 || opts.max_iterations == 0 {
         return Err(Error::Usage(
@@ -127,7 +134,7 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     let v_count = mesh.vertex_count();
     let k = opts.clusters.min(v_count);
     if k == 1 {
-        return Partition::new(vec![0; v_count], 1);
+        return Partition::from_labels(vec![0; v_count], 1);
     }
     let sampled = SampledMotion::new(mesh, opts.feature_frames);
     let (features, misfit) = motion_features(mesh, &sampled, opts.ring);
@@ -140,19 +147,23 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     let spread = feature_spread(&training);
     if spread == 0.0 {
         // Every vertex moves alike: k-means would only split ties.
-        return Partition::new(vec![0; v_count], 1);
+        return Partition::from_labels(vec![0; v_count], 1);
     }
     let training = DatasetBase::from(training);
     let model = KMeans::params_with_rng(k, Xoshiro256Plus::seed_from_u64(opts.seed))
         .init_method(KMeansInit::KMeansPlusPlus)
         .n_runs(1)
         .max_n_iterations(opts.max_iterations)
-        .tolerance((1e-5 * spread).max(f32::MIN_POSITIVE))
+        .tolerance((1e-4 * spread).max(f32::MIN_POSITIVE))
         .fit(&training)
         .map_err(|e| Error::Usage(format!("k-means failed: {e}")))?;
     let mut labels: Vec<usize> = model.predict(&features).to_vec();
     if inliers.len() >= k && inliers.len() < v_count {
         assign_by_trajectory(&mut labels, &inliers, &sampled, k);
+    }
+    if opts.refine_passes > 0 {
+        let adjacency = VertexAdjacency::new(v_count, mesh.triangles());
+        refine_borders(&mut labels, &adjacency, &sampled, k, opts.refine_passes);
     }
     let labels = dissolve_small_clusters(labels, &features, model.centroids(), k);
     compact(labels)
@@ -187,20 +198,18 @@ fn affine_rings(misfit: &[f32]) -> Vec<usize> {
     let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
     // The floor is float noise in unit coordinates: exact motion must not make every vertex an outlier.
     let threshold = 4.0 * median + 1e-6;
-    (0..misfit.len()).filter(|&v| misfit[v] <= threshold).collect()
+    (0..misfit.len())
+        .filter(|&v| misfit[v] <= threshold)
+        .collect()
 }
 
-/// Gives each vertex outside `inliers` the cluster whose affine maps (fitted on that cluster's
-/// inliers, eq. 2) predict its sampled trajectory best: the criterion the predictor will be judged by.
-fn assign_by_trajectory(labels: &mut [usize], inliers: &[usize], motion: &SampledMotion, k: usize) {
-    let mut members = vec![Vec::new(); k];
-    for &v in inliers {
-        if let Some(m) = members.get_mut(labels[v]) {
-            m.push(v);
-        }
-    }
-    let maps: Vec<Option<Vec<AffineCoefficients>>> = members
-        .iter()
+/// Per cluster, the affine maps (eq. 2) of its `members` over the sampled frames; `None` when empty.
+fn cluster_tracks(
+    members: &[Vec<usize>],
+    motion: &SampledMotion,
+) -> Vec<Option<Vec<AffineCoefficients>>> {
+    members
+        .par_iter()
         .map(|m| {
             if m.is_empty() {
                 return None;
@@ -215,7 +224,42 @@ fn assign_by_trajectory(labels: &mut [usize], inliers: &[usize], motion: &Sample
                     .collect(),
             )
         })
-        .collect();
+        .collect()
+}
+
+/// Squared error of predicting vertex `v`'s sampled trajectory with `track`; infinite for no track.
+fn trajectory_cost(
+    track: Option<&Vec<AffineCoefficients>>,
+    motion: &SampledMotion,
+    v: usize,
+) -> f64 {
+    let Some(track) = track else {
+        return f64::INFINITY;
+    };
+    track
+        .iter()
+        .zip(&motion.frames)
+        .map(|(h, f)| {
+            let q = apply(h, motion.rest[v]);
+            (0..3).map(|a| (q[a] - f[v][a]).powi(2)).sum::<f64>()
+        })
+        .sum()
+}
+
+fn group(labels: &[usize], vertices: impl Iterator<Item = usize>, k: usize) -> Vec<Vec<usize>> {
+    let mut members = vec![Vec::new(); k];
+    for v in vertices {
+        if let Some(m) = members.get_mut(labels[v]) {
+            m.push(v);
+        }
+    }
+    members
+}
+
+/// Gives each vertex outside `inliers` the cluster whose affine maps (fitted on that cluster's
+/// inliers, eq. 2) predict its sampled trajectory best: the criterion the predictor will be judged by.
+fn assign_by_trajectory(labels: &mut [usize], inliers: &[usize], motion: &SampledMotion, k: usize) {
+    let tracks = cluster_tracks(&group(labels, inliers.iter().copied(), k), motion);
     let mut is_inlier = vec![false; labels.len()];
     inliers.iter().for_each(|&v| is_inlier[v] = true);
     labels
@@ -223,25 +267,82 @@ fn assign_by_trajectory(labels: &mut [usize], inliers: &[usize], motion: &Sample
         .enumerate()
         .filter(|(v, _)| !is_inlier[*v])
         .for_each(|(v, label)| {
-            let cost = |track: &Vec<AffineCoefficients>| -> f64 {
-                track
-                    .iter()
-                    .zip(&motion.frames)
-                    .map(|(h, f)| {
-                        let q = apply(h, motion.rest[v]);
-                        (0..3).map(|a| (q[a] - f[v][a]).powi(2)).sum::<f64>()
-                    })
-                    .sum()
-            };
-            if let Some((best, _)) = maps
-                .iter()
-                .enumerate()
-                .filter_map(|(c, m)| m.as_ref().map(|m| (c, cost(m))))
+            if let Some((best, _)) = (0..k)
+                .map(|c| (c, trajectory_cost(tracks[c].as_ref(), motion, v)))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
             {
                 *label = best;
             }
         });
+}
+
+/// Moves cluster borders to lower the prediction error, keeping clusters spatially coherent: a
+/// vertex may only join a cluster one of its neighbours is in, and a connected component lying
+/// wholly in one cluster may move as a whole to any cluster.
+fn refine_borders(
+    labels: &mut Vec<usize>,
+    adjacency: &VertexAdjacency,
+    motion: &SampledMotion,
+    k: usize,
+    passes: usize,
+) {
+    let (component, component_count) = adjacency.components();
+    for _ in 0..passes {
+        let tracks = cluster_tracks(&group(labels, 0..labels.len(), k), motion);
+        let current: &[usize] = labels;
+        let mut next: Vec<usize> = (0..current.len())
+            .into_par_iter()
+            .map(|v| {
+                let own = current[v];
+                let mut best = (own, trajectory_cost(tracks[own].as_ref(), motion, v));
+                for &u in adjacency.neighbours(v) {
+                    let c = current[u as usize];
+                    if c != best.0 {
+                        let cost = trajectory_cost(tracks[c].as_ref(), motion, v);
+                        if cost < best.1 {
+                            best = (c, cost);
+                        }
+                    }
+                }
+                best.0
+            })
+            .collect();
+        let mut single = vec![Some(usize::MAX); component_count];
+        for (v, &c) in component.iter().enumerate() {
+            let s = &mut single[c as usize];
+            *s = match *s {
+                Some(usize::MAX) => Some(next[v]),
+                Some(l) if l == next[v] => Some(l),
+                _ => None,
+            };
+        }
+        let members = group(
+            &component.iter().map(|&c| c as usize).collect::<Vec<_>>(),
+            0..labels.len(),
+            component_count,
+        );
+        for (c, vertices) in members.iter().enumerate() {
+            if single[c].is_none() || vertices.is_empty() {
+                continue;
+            }
+            let best = (0..k)
+                .map(|l| {
+                    let cost: f64 = vertices
+                        .iter()
+                        .map(|&v| trajectory_cost(tracks[l].as_ref(), motion, v))
+                        .sum();
+                    (l, cost)
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((l, _)) = best {
+                vertices.iter().for_each(|&v| next[v] = l);
+            }
+        }
+        if next == *labels {
+            break;
+        }
+        *labels = next;
+    }
 }
 
 /// The per-vertex motion descriptors α^v (one row per vertex, 12 per sampled frame) and how far each
@@ -384,7 +485,7 @@ fn compact(labels: Vec<usize>) -> Result<Partition> {
             *map.entry(l).or_insert(next)
         })
         .collect();
-    Partition::new(compact, map.len())
+    Partition::from_labels(compact, map.len())
 }
 
 #[cfg(test)]
@@ -403,10 +504,10 @@ mod tests {
 
     #[test]
     fn partition_rejects_bad_labels() {
-        assert!(Partition::new(vec![0, 2], 2).is_err());
-        assert!(Partition::new(vec![0, 0], 2).is_err());
-        assert!(Partition::new(vec![], 1).is_err());
-        let p = Partition::new(vec![1, 0, 1], 2).unwrap();
+        assert!(Partition::from_labels(vec![0, 2], 2).is_err());
+        assert!(Partition::from_labels(vec![0, 0], 2).is_err());
+        assert!(Partition::from_labels(vec![], 1).is_err());
+        let p = Partition::from_labels(vec![1, 0, 1], 2).unwrap();
         assert_eq!(p.members(), vec![vec![1], vec![0, 2]]);
     }
 }
