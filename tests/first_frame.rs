@@ -55,9 +55,10 @@ fn round_trip(positions: &[Point], triangles: &[Triangle]) -> usize {
         );
         // Quantisation error is at most half a step per axis.
         let (lo, hi) = mcgv_video::mesh::bounding_box(positions);
+        let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0f32, f32::max);
+        let step = extent / 4095.0;
         for (p, q) in positions.iter().zip(&pos) {
             for k in 0..3 {
-                let step = (hi[k] - lo[k]) / 4095.0;
                 assert!(
                     (p[k] - q[k]).abs() <= step * 0.5 + 1e-5 * (1.0 + p[k].abs()),
                     "{p:?} vs {q:?}"
