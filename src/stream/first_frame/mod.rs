@@ -15,14 +15,16 @@
 //! log2(F!) bits) with the input's vertex indices and orientation, possibly rotated.
 
 mod geometry;
+mod order;
 mod quantise;
 mod traversal;
 
 pub use quantise::{Cell, Grid};
 
 use crate::error::{Error, Result};
+use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::{Point, Triangle};
-use crate::stream::entropy::{max_symbols, Decoder, Encoder, IntModel, SymbolCoder, UIntModel};
+use crate::stream::entropy::{max_symbols, Decoder, Encoder, SymbolCoder, UIntModel};
 use traversal::{Models, Oracle, UNASSIGNED};
 
 const VERSION: u8 = 1;
@@ -73,41 +75,6 @@ pub struct StreamSizes {
     pub geometry: usize,
     /// Vertex order stream.
     pub order: usize,
-}
-
-/// Adaptive contexts of the vertex-order stream.
-#[derive(Default)]
-struct OrderModels {
-    choice: crate::stream::entropy::BitModel,
-    delta: IntModel,
-}
-
-/// Codes the input index of each traversal vertex in turn, predicted by the one after the
-/// largest so far (input orders often follow face order) or after the previous one.
-fn code_order<C: SymbolCoder>(coder: &mut C, order: &mut [u32], vertex_count: usize) -> Result<()> {
-    let mut models = OrderModels::default();
-    let mut seen = vec![false; vertex_count];
-    let (mut previous, mut largest) = (-1i64, -1i64);
-    for slot in order.iter_mut() {
-        let actual = i64::from(*slot);
-        let use_previous = (actual - previous - 1).abs() < (actual - largest - 1).abs();
-        let use_previous = coder.bit(use_previous, &mut models.choice)?;
-        let base = if use_previous { previous } else { largest } + 1;
-        let value = base + coder.signed(actual - base, &mut models.delta)?;
-        let index = usize::try_from(value)
-            .ok()
-            .filter(|&v| v < vertex_count)
-            .ok_or_else(|| Error::Stream("first frame vertex order: index out of range".into()))?;
-        if std::mem::replace(&mut seen[index], true) {
-            return Err(Error::Stream(
-                "first frame vertex order: repeated index".into(),
-            ));
-        }
-        *slot = index as u32;
-        previous = value;
-        largest = largest.max(value);
-    }
-    Ok(())
 }
 
 /// Codes the triangles with a repeated vertex index.
@@ -197,10 +164,12 @@ pub fn encode(
     let mut order_stream = Vec::new();
     if !opts.reorder {
         let mut order_coder = Encoder::new();
-        code_order(
+        let all: Vec<Triangle> = state.triangles.iter().chain(&degenerate).copied().collect();
+        let adjacency = VertexAdjacency::new(vertex_count, &all);
+        order::code_order(
             &mut order_coder,
             &mut oracle.from_traversal.clone(),
-            vertex_count,
+            &adjacency,
         )?;
         order_stream = order_coder.finish()?;
     }
@@ -281,7 +250,8 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
     let mut positions: Vec<Point> = cells.iter().map(|&c| grid.dequantise(c)).collect();
     if header.has_order {
         let mut order_indices = vec![0u32; vertex_count];
-        code_order(&mut Decoder::new(order)?, &mut order_indices, vertex_count)?;
+        let adjacency = VertexAdjacency::new(vertex_count, &triangles);
+        order::code_order(&mut Decoder::new(order)?, &mut order_indices, &adjacency)?;
         let mut reordered = vec![[0.0; 3]; vertex_count];
         for (t, &input) in order_indices.iter().enumerate() {
             reordered[input as usize] = positions[t];
