@@ -33,13 +33,33 @@ const REF_RIGHT: usize = 2;
 const REF_WALK: usize = 3;
 const REF_EXPLICIT: usize = 4;
 const REF_KINDS: usize = 5;
+const REFERENCE_CONTEXTS: usize = REF_KINDS * 2 * 3 * 3;
+
+/// Context of a reference: the previous kind, whether both border neighbours are one vertex
+/// (a closing triangle is likely) and how many coded triangles already surround each gate end
+/// (a nearly full fan is likely to close, as in valence-driven coders).
+fn reference_context(
+    t: &Traversal,
+    previous: usize,
+    [a, b, _]: [u32; 3],
+    left: Option<u32>,
+    right: Option<u32>,
+) -> usize {
+    let fan = |v: u32| match t.outgoing.get(v as usize).map_or(0, Vec::len) {
+        0..=3 => 0,
+        4 => 1,
+        _ => 2,
+    };
+    let closing = usize::from(left.is_some() && left == right);
+    ((previous.min(REF_KINDS - 1) * 2 + closing) * 3 + fan(a)) * 3 + fan(b)
+}
 
 /// Adaptive contexts of the traversal.
 pub(super) struct Models {
     /// "another triangle on this edge?", by how many coded triangles the edge has (0, 1, 2+).
     more: [BitModel; 3],
     flipped: BitModel,
-    /// The kind of vertex reference, by the previous kind.
+    /// The kind of vertex reference, by [`reference_context`].
     reference: Vec<SymbolModel>,
     walk_side: BitModel,
     walk_step: UIntModel,
@@ -53,7 +73,7 @@ impl Default for Models {
         Self {
             more: Default::default(),
             flipped: BitModel::default(),
-            reference: vec![SymbolModel::new(REF_KINDS); REF_KINDS],
+            reference: vec![SymbolModel::new(REF_KINDS); REFERENCE_CONTEXTS],
             walk_side: BitModel::default(),
             walk_step: UIntModel::default(),
             explicit: UIntModel::default(),
@@ -359,7 +379,7 @@ fn code_third_vertex<C: SymbolCoder>(
             }
         }
     };
-    let context = models.previous_kind;
+    let context = reference_context(t, models.previous_kind, gate, left1, right1);
     let kind = coder.symbol(kind, &mut models.reference[context])?;
     models.previous_kind = kind;
     let x = match kind {
