@@ -102,10 +102,13 @@ fn main() -> Result<()> {
         } else {
             read_gltf(&path)?
         };
+        // Sequences live in folders named after them (walking_cat one level deeper, in OBJ/).
         let name = path
-            .parent()
-            .and_then(|p| p.file_name())
+            .ancestors()
+            .skip(1)
+            .filter_map(|p| p.file_name())
             .map(|n| n.to_string_lossy().into_owned())
+            .find(|n| n != "OBJ")
             .unwrap_or_default();
         if let Some(dir) = &dump_dir {
             dump(dir, &name, &positions, &triangles)?;

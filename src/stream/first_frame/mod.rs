@@ -6,23 +6,26 @@
 //! geometry length u32, order length u32, crc32 u32` then the three range-coded streams:
 //! - connectivity: the [`traversal`] symbols, then the degenerate triangles (a repeated index),
 //!   which no traversal can reach, as plain adaptive-coded indices;
-//! - geometry: the quantised positions, parallelogram-predicted for vertices the traversal
-//!   reaches through an edge, delta-coded for seeds and for vertices in no triangle (appended
-//!   after the traversal in input order);
+//! - geometry: the quantised positions in traversal order (vertices in no triangle appended in
+//!   input order), coded after the connectivity by [`geometry`]: multi-parallelogram prediction,
+//!   else the mean of coded neighbours, else the previous vertex;
 //! - order: the traversal → input vertex permutation, absent with `reorder`.
 //!
 //! Triangles come back in traversal order (face order is not kept: coding it would cost
 //! log2(F!) bits) with the input's vertex indices and orientation, possibly rotated.
 
+mod geometry;
+mod order;
 mod quantise;
 mod traversal;
 
 pub use quantise::{Cell, Grid};
 
 use crate::error::{Error, Result};
+use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::{Point, Triangle};
-use crate::stream::entropy::{max_symbols, Decoder, Encoder, IntModel, SymbolCoder, UIntModel};
-use traversal::{previous_cell, Models, Oracle, UNASSIGNED};
+use crate::stream::entropy::{max_symbols, Decoder, Encoder, SymbolCoder, UIntModel};
+use traversal::{Models, Oracle, UNASSIGNED};
 
 const VERSION: u8 = 1;
 const HEADER_LEN: usize = 56;
@@ -74,41 +77,6 @@ pub struct StreamSizes {
     pub order: usize,
 }
 
-/// Adaptive contexts of the vertex-order stream.
-#[derive(Default)]
-struct OrderModels {
-    choice: crate::stream::entropy::BitModel,
-    delta: IntModel,
-}
-
-/// Codes the input index of each traversal vertex in turn, predicted by the one after the
-/// largest so far (input orders often follow face order) or after the previous one.
-fn code_order<C: SymbolCoder>(coder: &mut C, order: &mut [u32], vertex_count: usize) -> Result<()> {
-    let mut models = OrderModels::default();
-    let mut seen = vec![false; vertex_count];
-    let (mut previous, mut largest) = (-1i64, -1i64);
-    for slot in order.iter_mut() {
-        let actual = i64::from(*slot);
-        let use_previous = (actual - previous - 1).abs() < (actual - largest - 1).abs();
-        let use_previous = coder.bit(use_previous, &mut models.choice)?;
-        let base = if use_previous { previous } else { largest } + 1;
-        let value = base + coder.signed(actual - base, &mut models.delta)?;
-        let index = usize::try_from(value)
-            .ok()
-            .filter(|&v| v < vertex_count)
-            .ok_or_else(|| Error::Stream("first frame vertex order: index out of range".into()))?;
-        if std::mem::replace(&mut seen[index], true) {
-            return Err(Error::Stream(
-                "first frame vertex order: repeated index".into(),
-            ));
-        }
-        *slot = index as u32;
-        previous = value;
-        largest = largest.max(value);
-    }
-    Ok(())
-}
-
 /// Codes the triangles with a repeated vertex index.
 fn code_degenerate<C: SymbolCoder>(
     coder: &mut C,
@@ -126,30 +94,6 @@ fn code_degenerate<C: SymbolCoder>(
                     Error::Stream("first frame: degenerate triangle index out of range".into())
                 })?;
         }
-    }
-    Ok(())
-}
-
-/// Codes the positions of the vertices in no traversed triangle, each from the previous one.
-fn code_leftover_positions<C: SymbolCoder>(
-    coder: &mut C,
-    models: &mut [IntModel; 3],
-    grid: &Grid,
-    cells: &mut Vec<Cell>,
-    actual: &[Cell],
-) -> Result<()> {
-    for &target in actual {
-        let prediction = previous_cell(cells, grid);
-        let mut cell = [0; 3];
-        for a in 0..3 {
-            let r = coder.signed(i64::from(target[a] - prediction[a]), &mut models[a])?;
-            cell[a] = i32::try_from(i64::from(prediction[a]) + r)
-                .map_err(|_| Error::Stream("first frame: position off the grid".into()))?;
-        }
-        if !grid.contains(cell) {
-            return Err(Error::Stream("first frame: position off the grid".into()));
-        }
-        cells.push(cell);
     }
     Ok(())
 }
@@ -184,30 +128,32 @@ pub fn encode(
     let mut connectivity = Encoder::new();
     let mut geometry = Encoder::new();
     let mut models = Models::default();
-    let mut oracle = Oracle::new(&traversable, &cells);
-    let mut state = traversal::run(
+    let mut oracle = Oracle::new(&traversable, vertex_count);
+    let state = traversal::run(
         &mut connectivity,
-        &mut geometry,
         Some(&mut oracle),
         traversable.len(),
         vertex_count,
-        &grid,
         &mut models,
     )?;
-    let leftovers: Vec<u32> = (0..vertex_count as u32)
-        .filter(|&v| oracle.to_traversal.get(v as usize) == Some(&UNASSIGNED))
-        .collect();
-    let leftover_cells: Vec<Cell> = leftovers.iter().map(|&v| cells[v as usize]).collect();
-    code_leftover_positions(
-        &mut geometry,
-        &mut models.delta,
-        &grid,
-        &mut state.cells,
-        &leftover_cells,
-    )?;
-    for &v in &leftovers {
-        oracle.assign(v);
+    // Vertices in no traversed triangle follow, in input order.
+    for v in 0..vertex_count as u32 {
+        if oracle.to_traversal.get(v as usize) == Some(&UNASSIGNED) {
+            oracle.assign(v);
+        }
     }
+    let traversal_cells: Vec<Cell> = oracle
+        .from_traversal
+        .iter()
+        .map(|&v| cells[v as usize])
+        .collect();
+    let decoded_cells = geometry::code_positions(
+        &mut geometry,
+        &grid,
+        &state.triangles,
+        vertex_count,
+        &traversal_cells,
+    )?;
     for tri in degenerate.iter_mut() {
         for v in tri.iter_mut() {
             *v = oracle.to_traversal.get(*v as usize).copied().unwrap_or(0);
@@ -218,14 +164,17 @@ pub fn encode(
     let mut order_stream = Vec::new();
     if !opts.reorder {
         let mut order_coder = Encoder::new();
-        code_order(
+        let all: Vec<Triangle> = state.triangles.iter().chain(&degenerate).copied().collect();
+        let adjacency = VertexAdjacency::new(vertex_count, &all);
+        order::code_order(
             &mut order_coder,
             &mut oracle.from_traversal.clone(),
-            vertex_count,
+            &adjacency,
         )?;
         order_stream = order_coder.finish()?;
     }
-    let traversal_positions: Vec<Point> = state.cells.iter().map(|&c| grid.dequantise(c)).collect();
+    let traversal_positions: Vec<Point> =
+        decoded_cells.iter().map(|&c| grid.dequantise(c)).collect();
     let (decoded_positions, permutation) = if opts.reorder {
         (traversal_positions, Some(oracle.from_traversal.clone()))
     } else {
@@ -285,32 +234,24 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
     let mut geometry = Decoder::new(geometry)?;
     let mut models = Models::default();
     let grid = header.grid;
-    let mut state = traversal::run(
+    let state = traversal::run(
         &mut connectivity,
-        &mut geometry,
         None,
         header.traversed as usize,
         vertex_count,
-        &grid,
         &mut models,
     )?;
-    let leftover_count = vertex_count.saturating_sub(state.cells.len());
-    let placeholders = vec![[0; 3]; leftover_count];
-    code_leftover_positions(
-        &mut geometry,
-        &mut models.delta,
-        &grid,
-        &mut state.cells,
-        &placeholders,
-    )?;
+    let cells =
+        geometry::code_positions(&mut geometry, &grid, &state.triangles, vertex_count, &[])?;
     let mut degenerate = vec![[0u32; 3]; header.degenerate as usize];
     code_degenerate(&mut connectivity, &mut degenerate, vertex_count)?;
     let mut triangles = state.triangles;
     triangles.extend(degenerate);
-    let mut positions: Vec<Point> = state.cells.iter().map(|&c| grid.dequantise(c)).collect();
+    let mut positions: Vec<Point> = cells.iter().map(|&c| grid.dequantise(c)).collect();
     if header.has_order {
         let mut order_indices = vec![0u32; vertex_count];
-        code_order(&mut Decoder::new(order)?, &mut order_indices, vertex_count)?;
+        let adjacency = VertexAdjacency::new(vertex_count, &triangles);
+        order::code_order(&mut Decoder::new(order)?, &mut order_indices, &adjacency)?;
         let mut reordered = vec![[0.0; 3]; vertex_count];
         for (t, &input) in order_indices.iter().enumerate() {
             reordered[input as usize] = positions[t];

@@ -1,4 +1,4 @@
-//! Uniform quantisation of positions over their per-axis bounding box.
+//! Uniform quantisation of positions over their bounding cube.
 
 use crate::error::{Error, Result};
 use crate::mesh::Point;
@@ -6,7 +6,7 @@ use crate::mesh::Point;
 /// Quantised coordinates: each axis in `0..=max_level()`.
 pub type Cell = [i32; 3];
 
-/// The grid positions are snapped to: `bits` levels per axis between `lo` and `hi`.
+/// The grid positions are snapped to: 2^`bits` levels over the largest extent of `lo`..`hi`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
     /// Bits per coordinate (1..=24, so every level is exact in f32 arithmetic).
@@ -54,15 +54,20 @@ impl Grid {
         (1i32 << self.bits) - 1
     }
 
-    fn step(&self, axis: usize) -> f32 {
-        (self.hi[axis] - self.lo[axis]) / self.max_level() as f32
+    /// One step for every axis (the largest extent over the levels), as Draco does: the error
+    /// is isotropic, and short axes do not pay for precision nobody asked for.
+    fn step(&self) -> f32 {
+        let extent = (0..3)
+            .map(|a| self.hi[a] - self.lo[a])
+            .fold(0.0f32, f32::max);
+        extent / self.max_level() as f32
     }
 
     /// The cell nearest to `p`.
     pub fn quantise(&self, p: Point) -> Cell {
         let mut cell = [0; 3];
         for (a, c) in cell.iter_mut().enumerate() {
-            let step = self.step(a);
+            let step = self.step();
             if step > 0.0 {
                 let level = ((p[a] - self.lo[a]) / step).round();
                 *c = (level as i32).clamp(0, self.max_level());
@@ -75,7 +80,7 @@ impl Grid {
     pub fn dequantise(&self, cell: Cell) -> Point {
         let mut p = [0.0; 3];
         for (a, c) in p.iter_mut().enumerate() {
-            *c = self.lo[a] + cell[a] as f32 * self.step(a);
+            *c = self.lo[a] + cell[a] as f32 * self.step();
         }
         p
     }

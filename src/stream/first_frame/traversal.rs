@@ -5,7 +5,7 @@
 //! (depth first). Processing a gate codes, one by one, every not-yet-coded triangle on that edge
 //! (so non-manifold edges just carry more than one) followed by a stop flag. A triangle is its
 //! orientation bit (consistent with its neighbour or not) and a reference to its third vertex:
-//! - `New`: first appearance; its position is coded with parallelogram prediction over the gate;
+//! - `New`: first appearance (its position is coded afterwards, see `geometry`);
 //! - `Left` / `Right`: the neighbour of the gate's ends along the open border (Edgebreaker's
 //!   L, R and E cases);
 //! - `Walk`: further along the open border (up to [`WALK_LIMIT`] steps), which covers most of
@@ -18,10 +18,9 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::quantise::{Cell, Grid};
 use crate::error::{Error, Result};
 use crate::mesh::Triangle;
-use crate::stream::entropy::{BitModel, IntModel, SymbolCoder, SymbolModel, UIntModel};
+use crate::stream::entropy::{BitModel, SymbolCoder, SymbolModel, UIntModel};
 
 /// How far along the open border a `Walk` reference looks on each side.
 const WALK_LIMIT: usize = 16;
@@ -34,22 +33,38 @@ const REF_RIGHT: usize = 2;
 const REF_WALK: usize = 3;
 const REF_EXPLICIT: usize = 4;
 const REF_KINDS: usize = 5;
+const REFERENCE_CONTEXTS: usize = REF_KINDS * 2 * 3 * 3;
+
+/// Context of a reference: the previous kind, whether both border neighbours are one vertex
+/// (a closing triangle is likely) and how many coded triangles already surround each gate end
+/// (a nearly full fan is likely to close, as in valence-driven coders).
+fn reference_context(
+    t: &Traversal,
+    previous: usize,
+    [a, b, _]: [u32; 3],
+    left: Option<u32>,
+    right: Option<u32>,
+) -> usize {
+    let fan = |v: u32| match t.outgoing.get(v as usize).map_or(0, Vec::len) {
+        0..=3 => 0,
+        4 => 1,
+        _ => 2,
+    };
+    let closing = usize::from(left.is_some() && left == right);
+    ((previous.min(REF_KINDS - 1) * 2 + closing) * 3 + fan(a)) * 3 + fan(b)
+}
 
 /// Adaptive contexts of the traversal.
 pub(super) struct Models {
     /// "another triangle on this edge?", by how many coded triangles the edge has (0, 1, 2+).
     more: [BitModel; 3],
     flipped: BitModel,
-    /// The kind of vertex reference, by the previous kind.
+    /// The kind of vertex reference, by [`reference_context`].
     reference: Vec<SymbolModel>,
     walk_side: BitModel,
     walk_step: UIntModel,
     explicit: UIntModel,
     seed_new: BitModel,
-    /// Position residuals: parallelogram-predicted, per axis.
-    parallelogram: [IntModel; 3],
-    /// Position residuals: predicted by the previous vertex, per axis.
-    pub(super) delta: [IntModel; 3],
     previous_kind: usize,
 }
 
@@ -58,13 +73,11 @@ impl Default for Models {
         Self {
             more: Default::default(),
             flipped: BitModel::default(),
-            reference: vec![SymbolModel::new(REF_KINDS); REF_KINDS],
+            reference: vec![SymbolModel::new(REF_KINDS); REFERENCE_CONTEXTS],
             walk_side: BitModel::default(),
             walk_step: UIntModel::default(),
             explicit: UIntModel::default(),
             seed_new: BitModel::default(),
-            parallelogram: Default::default(),
-            delta: Default::default(),
             previous_kind: REF_NEW,
         }
     }
@@ -73,7 +86,6 @@ impl Default for Models {
 /// What only the encoder knows: the input mesh and how far it has been coded.
 pub(super) struct Oracle<'a> {
     triangles: &'a [Triangle],
-    cells: &'a [Cell],
     by_edge: HashMap<u64, Vec<u32>>,
     coded: Vec<bool>,
     next_seed: usize,
@@ -84,8 +96,8 @@ pub(super) struct Oracle<'a> {
 }
 
 impl<'a> Oracle<'a> {
-    /// `triangles` must have three distinct in-range indices each; `cells` is indexed like the input.
-    pub(super) fn new(triangles: &'a [Triangle], cells: &'a [Cell]) -> Self {
+    /// `triangles` must have three distinct indices below `vertex_count` each.
+    pub(super) fn new(triangles: &'a [Triangle], vertex_count: usize) -> Self {
         let mut by_edge: HashMap<u64, Vec<u32>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
             for k in 0..3 {
@@ -97,11 +109,10 @@ impl<'a> Oracle<'a> {
         }
         Self {
             triangles,
-            cells,
             by_edge,
             coded: vec![false; triangles.len()],
             next_seed: 0,
-            to_traversal: vec![UNASSIGNED; cells.len()],
+            to_traversal: vec![UNASSIGNED; vertex_count],
             from_traversal: Vec::new(),
         }
     }
@@ -155,8 +166,8 @@ fn corrupt(what: &str) -> Error {
 pub(super) struct Traversal {
     /// Triangles in coding order.
     pub(super) triangles: Vec<Triangle>,
-    /// Quantised positions.
-    pub(super) cells: Vec<Cell>,
+    /// Number of vertices so far.
+    pub(super) vertices: usize,
     half_edges: HashSet<u64>,
     edge_use: HashMap<u64, u8>,
     done: HashSet<u64>,
@@ -204,11 +215,11 @@ impl Traversal {
         out
     }
 
-    fn add_vertex(&mut self, cell: Cell) -> u32 {
-        self.cells.push(cell);
+    fn add_vertex(&mut self) -> u32 {
+        self.vertices += 1;
         self.incoming.push(Vec::new());
         self.outgoing.push(Vec::new());
-        (self.cells.len() - 1) as u32
+        (self.vertices - 1) as u32
     }
 
     /// Records a coded triangle and opens gates on its edges other than `entry`.
@@ -239,67 +250,18 @@ impl Traversal {
     }
 }
 
-/// Codes a new vertex's position given its prediction; returns its cell.
-fn code_position<C: SymbolCoder>(
-    coder: &mut C,
-    models: &mut [IntModel; 3],
-    grid: &Grid,
-    prediction: Cell,
-    actual: Cell,
-) -> Result<Cell> {
-    let mut cell = [0; 3];
-    for a in 0..3 {
-        let r = coder.signed(i64::from(actual[a] - prediction[a]), &mut models[a])?;
-        let c = i64::from(prediction[a]) + r;
-        cell[a] = i32::try_from(c).map_err(|_| corrupt("position off the grid"))?;
-    }
-    if !grid.contains(cell) {
-        return Err(corrupt("position off the grid"));
-    }
-    Ok(cell)
-}
-
-/// Parallelogram a + b - c, clamped to the grid.
-fn parallelogram(t: &Traversal, grid: &Grid, [a, b, c]: [u32; 3]) -> Cell {
-    let get = |v: u32| t.cells.get(v as usize).copied().unwrap_or([0; 3]);
-    let (pa, pb, pc) = (get(a), get(b), get(c));
-    let mut out = [0; 3];
-    for k in 0..3 {
-        out[k] = (pa[k] + pb[k] - pc[k]).clamp(0, grid.max_level());
-    }
-    out
-}
-
-/// The previous vertex's cell, or the grid's centre for the first one.
-pub(super) fn previous_cell(cells: &[Cell], grid: &Grid) -> Cell {
-    cells
-        .last()
-        .copied()
-        .unwrap_or([(grid.max_level() + 1) / 2; 3])
-}
-
 /// Runs the traversal over `triangle_count` triangles and at most `vertex_limit` vertices.
 pub(super) fn run<C: SymbolCoder>(
     coder: &mut C,
-    geometry: &mut C,
     mut oracle: Option<&mut Oracle>,
     triangle_count: usize,
     vertex_limit: usize,
-    grid: &Grid,
     models: &mut Models,
 ) -> Result<Traversal> {
     let mut t = Traversal::default();
     while t.triangles.len() < triangle_count {
         let Some(gate) = t.gates.pop() else {
-            seed(
-                coder,
-                geometry,
-                oracle.as_deref_mut(),
-                &mut t,
-                vertex_limit,
-                grid,
-                models,
-            )?;
+            seed(coder, oracle.as_deref_mut(), &mut t, vertex_limit, models)?;
             continue;
         };
         let [a, b, _] = gate;
@@ -322,13 +284,11 @@ pub(super) fn run<C: SymbolCoder>(
             let flipped = coder.bit(next.is_some_and(|n| n.2), &mut models.flipped)?;
             let x = code_third_vertex(
                 coder,
-                geometry,
                 oracle.as_deref_mut(),
                 next,
                 &mut t,
                 gate,
                 vertex_limit,
-                grid,
                 models,
             )?;
             if let (Some(o), Some((index, _, _))) = (oracle.as_deref_mut(), next) {
@@ -359,46 +319,33 @@ impl Oracle<'_> {
         }
         self.from_traversal.push(x);
     }
-
-    fn cell(&self, x: u32) -> Cell {
-        self.cells.get(x as usize).copied().unwrap_or([0; 3])
-    }
 }
 
-/// Appends a new vertex predicted by `prediction`, coding its position.
-#[allow(clippy::too_many_arguments)]
-fn new_vertex<C: SymbolCoder>(
-    coder: &mut C,
+/// Appends a new vertex (the encoder gives input vertex `input` the next traversal index).
+fn new_vertex(
     oracle: Option<&mut Oracle>,
     input: u32,
     t: &mut Traversal,
     vertex_limit: usize,
-    grid: &Grid,
-    models: &mut [IntModel; 3],
-    prediction: Cell,
 ) -> Result<u32> {
-    if t.cells.len() >= vertex_limit {
+    if t.vertices >= vertex_limit {
         return Err(corrupt("more vertices than announced"));
     }
-    let actual = oracle.as_deref().map_or([0; 3], |o| o.cell(input));
-    let cell = code_position(coder, models, grid, prediction, actual)?;
     if let Some(o) = oracle {
         o.assign(input);
     }
-    Ok(t.add_vertex(cell))
+    Ok(t.add_vertex())
 }
 
 /// Codes the third vertex of a triangle entering through `gate`; returns its traversal index.
 #[allow(clippy::too_many_arguments)]
 fn code_third_vertex<C: SymbolCoder>(
     coder: &mut C,
-    geometry: &mut C,
     oracle: Option<&mut Oracle>,
     next: Option<(usize, u32, bool)>,
     t: &mut Traversal,
     gate: [u32; 3],
     vertex_limit: usize,
-    grid: &Grid,
     models: &mut Models,
 ) -> Result<u32> {
     let [a, b, _] = gate;
@@ -432,23 +379,11 @@ fn code_third_vertex<C: SymbolCoder>(
             }
         }
     };
-    let context = models.previous_kind;
+    let context = reference_context(t, models.previous_kind, gate, left1, right1);
     let kind = coder.symbol(kind, &mut models.reference[context])?;
     models.previous_kind = kind;
     let x = match kind {
-        REF_NEW => {
-            let prediction = parallelogram(t, grid, gate);
-            new_vertex(
-                geometry,
-                oracle,
-                input,
-                t,
-                vertex_limit,
-                grid,
-                &mut models.parallelogram,
-                prediction,
-            )?
-        }
+        REF_NEW => new_vertex(oracle, input, t, vertex_limit)?,
         REF_LEFT => left1.ok_or_else(|| corrupt("no left neighbour"))?,
         REF_RIGHT => right1.ok_or_else(|| corrupt("no right neighbour"))?,
         REF_WALK => {
@@ -462,7 +397,7 @@ fn code_third_vertex<C: SymbolCoder>(
                 .ok_or_else(|| corrupt("border walk too short"))?
         }
         _ => {
-            let newest = t.cells.len() as u64;
+            let newest = t.vertices as u64;
             let distance = known.map_or(0, |v| newest - 1 - u64::from(v));
             let distance = coder.unsigned(distance, &mut models.explicit)?;
             newest
@@ -481,11 +416,9 @@ fn code_third_vertex<C: SymbolCoder>(
 /// Starts a new component with the next uncoded triangle.
 fn seed<C: SymbolCoder>(
     coder: &mut C,
-    geometry: &mut C,
     mut oracle: Option<&mut Oracle>,
     t: &mut Traversal,
     vertex_limit: usize,
-    grid: &Grid,
     models: &mut Models,
 ) -> Result<()> {
     let input = match oracle.as_deref_mut() {
@@ -508,19 +441,9 @@ fn seed<C: SymbolCoder>(
             .and_then(|o| o.to_traversal.get(x as usize).copied())
             .filter(|&v| v != UNASSIGNED);
         tri[k] = if coder.bit(known.is_none(), &mut models.seed_new)? {
-            let prediction = previous_cell(&t.cells, grid);
-            new_vertex(
-                geometry,
-                oracle.as_deref_mut(),
-                x,
-                t,
-                vertex_limit,
-                grid,
-                &mut models.delta,
-                prediction,
-            )?
+            new_vertex(oracle.as_deref_mut(), x, t, vertex_limit)?
         } else {
-            let newest = t.cells.len() as u64;
+            let newest = t.vertices as u64;
             let distance = known.map_or(0, |v| newest - 1 - u64::from(v));
             let distance = coder.unsigned(distance, &mut models.explicit)?;
             newest
