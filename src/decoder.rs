@@ -51,7 +51,7 @@ impl<R: Read + Seek> Decoder<R> {
             )));
         }
         let labels = side_info::decode_partition(&reader.part(Tag::PARTITION)?, v, header.clusters as usize, &triangles)?;
-        let partition = Partition::new(labels, header.clusters as usize)?;
+        let partition = Partition::from_labels(labels, header.clusters as usize)?;
         let lattice = (header.lattice_width, header.lattice_height);
         let pixels = side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, &triangles)?;
         let track = side_info::decode_affine(&reader.part(Tag::AFFINE)?, f, partition.clusters(), header.affine_bits)?;
@@ -202,7 +202,7 @@ impl<R: Read + Seek> Decoder<R> {
             )));
         }
         let lw = self.header.lattice_width as usize;
-        let mut out = self.track.predict(f, &self.reference, &self.partition)?;
+        let mut out = self.track.try_predict(f, &self.reference, &self.partition)?;
         for a in 0..3 {
             let levels = tile::sample(plane, a, lw, &self.pixels);
             let range = self.ranges[f][a];

@@ -255,7 +255,7 @@ pub fn analyse(mesh: &AnimatedMesh, reference: Vec<Point>, opts: &EncodeOptions)
     )
     .map_err(|e| Error::Usage(format!("atlas: {e}")))?;
     let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
-        .map(|f| Ok(motion::residuals(mesh.frame(f), &track.predict(f, &reference, &partition)?)))
+        .map(|f| Ok(motion::residuals(mesh.frame(f), &track.try_predict(f, &reference, &partition)?)))
         .collect::<Result<_>>()?;
     let mode = match opts.codec {
         CodecKind::Jpeg => RangeMode::PerFrame,

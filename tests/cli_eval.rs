@@ -103,11 +103,11 @@ fn a_lifted_copy_is_off_by_the_lift_in_both_outputs() {
 }
 
 #[test]
-fn a_mcgv_to_compare_is_refused_clearly_for_now() {
-    let out = eval(&[&media("Fox.glb"), "decoded.mcgv"]);
+fn a_missing_mcgv_fails_naming_it() {
+    let out = eval(&[&media("Fox.glb"), "no/such/decoded.mcgv"]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains(".mcgv is not yet"), "{err}");
+    assert!(err.contains("no/such/decoded.mcgv"), "{err}");
 }
 
 #[test]

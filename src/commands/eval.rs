@@ -1,19 +1,27 @@
 //! `mcgv-video eval`: the error measures of one animation against another.
 
-use crate::cli::{EvalArgs, InputArgs};
+use crate::cli::EvalArgs;
+use crate::decoder::Decoder;
+use crate::progress;
 use crate::error::{Error, Result};
 use crate::mesh::{read_animation, ReadOptions};
 use crate::metrics::{compare, Measures};
 use std::path::Path;
 
 /// Runs `eval`.
-pub fn run(args: &EvalArgs, _quiet: bool) -> Result<()> {
-    let opts = read_options(&args.input_args);
-    // Checked before any reading, so that an unsupported second argument fails at once.
-    reject_mcgv(&args.decoded)?;
+pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
+    let opts: ReadOptions = (&args.input_args).into();
     let original = read_animation(&args.original, &opts)?;
-    let decoded = read_animation(&args.decoded, &opts)?;
-    let measures = compare(&original, &decoded)?;
+    let measures = if is_mcgv(&args.decoded) {
+        let mut decoder = Decoder::open(Path::new(&args.decoded))?;
+        let bits = decoder.container().file_len() * 8;
+        let pb = progress::bar(decoder.header().frames as u64, "decode", quiet);
+        let decoded = decoder.decode_all(&pb)?;
+        pb.finish_and_clear();
+        compare(&original, &decoded)?.with_bits(bits)
+    } else {
+        compare(&original, &read_animation(&args.decoded, &opts)?)?
+    };
     if args.json {
         let json = serde_json::to_string(&measures)
             .map_err(|e| Error::Usage(format!("cannot write the measures as JSON: {e}")))?;
@@ -24,26 +32,11 @@ pub fn run(args: &EvalArgs, _quiet: bool) -> Result<()> {
     Ok(())
 }
 
-fn read_options(a: &InputArgs) -> ReadOptions {
-    ReadOptions {
-        fps: a.fps,
-        clip: a.clip.clone(),
-        base: a.base.clone(),
-    }
-}
-
-/// Refuses a `.mcgv` second argument until the decoder is wired in here.
-fn reject_mcgv(input: &str) -> Result<()> {
-    let is_mcgv = Path::new(input)
+/// Whether a path names a `.mcgv` stream (compared after decoding, with its bpvf).
+fn is_mcgv(input: &str) -> bool {
+    Path::new(input)
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mcgv"));
-    if is_mcgv {
-        return Err(Error::Usage(format!(
-            "{input}: comparing with a .mcgv is not yet supported; decode it first \
-             (`mcgv-video decode {input} -o DIR`) and compare with DIR"
-        )));
-    }
-    Ok(())
+        .is_some_and(|e| e.eq_ignore_ascii_case("mcgv"))
 }
 
 /// The human-readable lines `eval` prints.
