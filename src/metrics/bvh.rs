@@ -6,7 +6,7 @@
 //! almost always the triangle the previous sample hit (or the same-numbered triangle, when the
 //! connectivity is shared), so the query takes a *hint* triangle whose distance bounds the search from
 //! the start; that bound is what makes a 200-frame sequence take seconds. The tree itself is a plain
-//! median split: built per frame in O(n log n), a few milliseconds for 14k triangles.
+//! median split, built once in O(n log n) and refitted to each later frame in O(n).
 
 use super::triangle::{point_triangle_distance_squared, Vec3};
 use crate::mesh::{Point, Triangle};
@@ -153,6 +153,11 @@ impl TriangleBvh {
         true
     }
 
+    /// The corner positions of triangle `t` as the tree holds them.
+    pub fn corners(&self, t: u32) -> Option<&[Vec3; 3]> {
+        self.corners.get(t as usize)
+    }
+
     /// Number of triangles in the tree.
     pub fn len(&self) -> usize {
         self.corners.len()
@@ -176,16 +181,22 @@ impl TriangleBvh {
         self.nearest_with(p, hint, &mut Vec::with_capacity(MAX_DEPTH))
     }
 
-    /// [`Self::nearest`] with a caller-kept traversal stack, so that a run of queries allocates once.
-    pub fn nearest_with(&self, p: Vec3, hint: Option<u32>, stack: &mut Vec<(u32, f64)>) -> Nearest {
+    /// [`Self::nearest`] with several hints (the nearest of them bounds the search) and a
+    /// caller-kept traversal stack, so that a run of queries allocates nothing.
+    pub fn nearest_with(
+        &self,
+        p: Vec3,
+        hints: impl IntoIterator<Item = u32>,
+        stack: &mut Vec<(u32, f64)>,
+    ) -> Nearest {
         stack.clear();
         let mut best = Nearest {
             triangle: 0,
             distance_squared: f64::INFINITY,
         };
-        if let Some(h) = hint {
+        for h in hints {
             let d = self.triangle_distance_squared(h, p);
-            if d.is_finite() {
+            if d < best.distance_squared {
                 best = Nearest {
                     triangle: h,
                     distance_squared: d,
@@ -200,7 +211,14 @@ impl TriangleBvh {
                     .get(n.first as usize..(n.first + n.count) as usize)
                     .unwrap_or(&[]);
                 for &t in leaf {
-                    let d = self.triangle_distance_squared(t, p);
+                    let Some(c) = self.corners.get(t as usize) else {
+                        continue;
+                    };
+                    // The triangle's own box: a few comparisons that spare most exact tests.
+                    if corner_box_distance_squared(c, p) >= best.distance_squared {
+                        continue;
+                    }
+                    let d = point_triangle_distance_squared(p, c[0], c[1], c[2]);
                     if d < best.distance_squared {
                         best = Nearest {
                             triangle: t,
@@ -246,6 +264,18 @@ impl TriangleBvh {
             .get(node as usize)
             .map_or(f64::INFINITY, |n| n.distance_squared(p))
     }
+}
+
+/// Squared distance from `p` to the bounding box of a triangle's corners.
+fn corner_box_distance_squared(c: &[Vec3; 3], p: Vec3) -> f64 {
+    let mut d2 = 0.0;
+    for (a, x) in p.iter().enumerate() {
+        let lo = c[0][a].min(c[1][a]).min(c[2][a]);
+        let hi = c[0][a].max(c[1][a]).max(c[2][a]);
+        let d = (lo - x).max(x - hi).max(0.0);
+        d2 += d * d;
+    }
+    d2
 }
 
 /// Builds the subtree over `order[..]` (whose first slot is `offset` in the whole order) and returns
