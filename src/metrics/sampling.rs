@@ -164,10 +164,9 @@ pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64)
         }
         // Centroids of the upward (corner sum n − 1) and downward (n − 2) sub-triangles.
         let nf = n as f64;
-        for (sum, shift) in [(n - 1, 1.0 / 3.0), (n.wrapping_sub(2), 2.0 / 3.0)] {
-            if sum > n {
-                continue; // n = 1 has no downward sub-triangle
-            }
+        let upward = (n - 1, 1.0 / 3.0);
+        let downward = n.checked_sub(2).map(|sum| (sum, 2.0 / 3.0));
+        for (sum, shift) in std::iter::once(upward).chain(downward) {
             for i in 0..=sum {
                 for j in 0..=(sum - i) {
                     let k = sum - i - j;
