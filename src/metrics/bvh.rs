@@ -6,7 +6,7 @@
 //! almost always the triangle the previous sample hit (or the same-numbered triangle, when the
 //! connectivity is shared), so the query takes a *hint* triangle whose distance bounds the search from
 //! the start; that bound is what makes a 200-frame sequence take seconds. The tree itself is a plain
-//! median split: built per frame in O(n log n), a few milliseconds for 14k triangles.
+//! median split, built once in O(n log n) and refitted to each later frame in O(n).
 
 use super::triangle::{point_triangle_distance_squared, Vec3};
 use crate::mesh::{Point, Triangle};
@@ -29,7 +29,12 @@ struct Node {
     count: u32,
     /// Inner: index of the right child.
     right: u32,
+    /// Index of the parent ([`NO_NODE`] at the root).
+    parent: u32,
 }
+
+/// The root's parent.
+const NO_NODE: u32 = u32::MAX;
 
 impl Node {
     fn distance_squared(&self, p: Vec3) -> f64 {
@@ -59,6 +64,8 @@ pub struct TriangleBvh {
     corners: Vec<[Vec3; 3]>,
     /// Triangle numbers in leaf order.
     order: Vec<u32>,
+    /// The leaf holding each triangle.
+    leaf_of: Vec<u32>,
 }
 
 impl TriangleBvh {
@@ -91,11 +98,23 @@ impl TriangleBvh {
             .collect();
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
         let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
-        build(&mut nodes, &mut order, 0, &corners, &centroids);
+        build(&mut nodes, &mut order, 0, NO_NODE, &corners, &centroids);
+        let mut leaf_of = vec![0u32; triangles.len()];
+        for (i, n) in nodes.iter().enumerate().filter(|(_, n)| n.count > 0) {
+            let held = order
+                .get(n.first as usize..(n.first + n.count) as usize)
+                .unwrap_or(&[]);
+            for &t in held {
+                if let Some(slot) = leaf_of.get_mut(t as usize) {
+                    *slot = i as u32;
+                }
+            }
+        }
         Some(Self {
             nodes,
             corners,
             order,
+            leaf_of,
         })
     }
 
@@ -153,6 +172,11 @@ impl TriangleBvh {
         true
     }
 
+    /// The corner positions of triangle `t` as the tree holds them.
+    pub fn corners(&self, t: u32) -> Option<&[Vec3; 3]> {
+        self.corners.get(t as usize)
+    }
+
     /// Number of triangles in the tree.
     pub fn len(&self) -> usize {
         self.corners.len()
@@ -176,23 +200,58 @@ impl TriangleBvh {
         self.nearest_with(p, hint, &mut Vec::with_capacity(MAX_DEPTH))
     }
 
-    /// [`Self::nearest`] with a caller-kept traversal stack, so that a run of queries allocates once.
-    pub fn nearest_with(&self, p: Vec3, hint: Option<u32>, stack: &mut Vec<(u32, f64)>) -> Nearest {
-        stack.clear();
+    /// [`Self::nearest`] with several hints (the nearest of them bounds the search) and a
+    /// caller-kept traversal stack, so that a run of queries allocates nothing.
+    pub fn nearest_with(
+        &self,
+        p: Vec3,
+        hints: impl IntoIterator<Item = u32>,
+        stack: &mut Vec<(u32, f64)>,
+    ) -> Nearest {
         let mut best = Nearest {
             triangle: 0,
             distance_squared: f64::INFINITY,
         };
-        if let Some(h) = hint {
+        for h in hints {
             let d = self.triangle_distance_squared(h, p);
-            if d.is_finite() {
+            if d < best.distance_squared {
                 best = Nearest {
                     triangle: h,
                     distance_squared: d,
                 };
             }
         }
-        let mut node = 0u32;
+        // With a hint, climb from its leaf: every other subtree is the sibling of a node on that
+        // path, and the siblings far from `p` are dismissed by one box test each. That skips the
+        // descent from the root, which was most of the cost of a well-hinted query.
+        let Some(&start) = self
+            .leaf_of
+            .get(best.triangle as usize)
+            .filter(|_| best.distance_squared.is_finite())
+        else {
+            self.descend(0, p, &mut best, stack);
+            return best;
+        };
+        self.descend(start, p, &mut best, stack);
+        let (mut child, mut node) = (
+            start,
+            self.nodes.get(start as usize).map_or(NO_NODE, |n| n.parent),
+        );
+        while let Some(n) = self.nodes.get(node as usize) {
+            let sibling = if n.first == child { n.right } else { n.first };
+            if self.box_distance(sibling, p) < best.distance_squared {
+                self.descend(sibling, p, &mut best, stack);
+            }
+            child = node;
+            node = n.parent;
+        }
+        best
+    }
+
+    /// Searches the subtree under `start` for anything nearer than `best`.
+    fn descend(&self, start: u32, p: Vec3, best: &mut Nearest, stack: &mut Vec<(u32, f64)>) {
+        stack.clear();
+        let mut node = start;
         while let Some(n) = self.nodes.get(node as usize) {
             if n.count > 0 {
                 let leaf = self
@@ -200,9 +259,16 @@ impl TriangleBvh {
                     .get(n.first as usize..(n.first + n.count) as usize)
                     .unwrap_or(&[]);
                 for &t in leaf {
-                    let d = self.triangle_distance_squared(t, p);
+                    let Some(c) = self.corners.get(t as usize) else {
+                        continue;
+                    };
+                    // The triangle's own box: a few comparisons that spare most exact tests.
+                    if corner_box_distance_squared(c, p) >= best.distance_squared {
+                        continue;
+                    }
+                    let d = point_triangle_distance_squared(p, c[0], c[1], c[2]);
                     if d < best.distance_squared {
-                        best = Nearest {
+                        *best = Nearest {
                             triangle: t,
                             distance_squared: d,
                         };
@@ -238,7 +304,6 @@ impl TriangleBvh {
                 None => break,
             }
         }
-        best
     }
 
     fn box_distance(&self, node: u32, p: Vec3) -> f64 {
@@ -248,12 +313,25 @@ impl TriangleBvh {
     }
 }
 
+/// Squared distance from `p` to the bounding box of a triangle's corners.
+fn corner_box_distance_squared(c: &[Vec3; 3], p: Vec3) -> f64 {
+    let mut d2 = 0.0;
+    for (a, x) in p.iter().enumerate() {
+        let lo = c[0][a].min(c[1][a]).min(c[2][a]);
+        let hi = c[0][a].max(c[1][a]).max(c[2][a]);
+        let d = (lo - x).max(x - hi).max(0.0);
+        d2 += d * d;
+    }
+    d2
+}
+
 /// Builds the subtree over `order[..]` (whose first slot is `offset` in the whole order) and returns
 /// its node index.
 fn build(
     nodes: &mut Vec<Node>,
     order: &mut [u32],
     offset: usize,
+    parent: u32,
     corners: &[[Vec3; 3]],
     centroids: &[Vec3],
 ) -> u32 {
@@ -280,6 +358,7 @@ fn build(
         first: offset as u32,
         count: order.len() as u32,
         right: 0,
+        parent,
     });
     if order.len() <= LEAF_SIZE {
         return index;
@@ -296,8 +375,8 @@ fn build(
     let key = |t: &u32| centroids.get(*t as usize).map_or(0.0, |m| m[axis]);
     order.select_nth_unstable_by(mid, |x, y| key(x).total_cmp(&key(y)));
     let (left, right) = order.split_at_mut(mid);
-    let l = build(nodes, left, offset, corners, centroids);
-    let r = build(nodes, right, offset + mid, corners, centroids);
+    let l = build(nodes, left, offset, index, corners, centroids);
+    let r = build(nodes, right, offset + mid, index, corners, centroids);
     if let Some(n) = nodes.get_mut(index as usize) {
         n.first = l;
         n.count = 0;

@@ -206,7 +206,7 @@ mod tests {
     fn identical_meshes_give_zero() {
         let m = patch(3);
         let r = compare(&m, &m).unwrap_or_else(|e| panic!("{e}"));
-        assert!(r.rmse < 1e-12 && r.hausdorff < 1e-12, "{r:?}");
+        assert_eq!((r.rmse, r.hausdorff), (0.0, 0.0), "{r:?}");
         assert_eq!(r.vertex_rmse, Some(0.0));
         assert_eq!(r.kg_error, Some(0.0));
         assert_eq!((r.frames, r.vertices), (3, 144));

@@ -1,8 +1,9 @@
 //! Surface-to-surface distances of one frame, as Metro computes them: sample one surface, measure
 //! each sample's exact distance to the other surface, take the area-weighted RMS and the maximum.
 
-use super::bvh::TriangleBvh;
+use super::bvh::{Nearest, TriangleBvh};
 use super::sampling::sample_surface;
+use super::triangle::Vec3;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
 use serde::Serialize;
@@ -66,8 +67,20 @@ pub fn one_sided(
     let mut last = None;
     let mut stack = Vec::new();
     for s in &samples {
-        let hint = if same_triangles { Some(s.face) } else { last };
-        let nearest = b.nearest_with(s.point, hint, &mut stack);
+        // The same-numbered face is right when the surfaces barely differ; the previous sample's
+        // answer when they differ a lot (a neighbouring sample has a neighbouring answer).
+        let same_face = if same_triangles { Some(s.face) } else { None };
+        let hints = same_face.into_iter().chain(last);
+        // A face that did not move holds its samples exactly (a query would add rounding noise).
+        let unmoved = same_triangles && b.corners(s.face) == Some(&corners(a, s.face));
+        let nearest = if unmoved {
+            Nearest {
+                triangle: s.face,
+                distance_squared: 0.0,
+            }
+        } else {
+            b.nearest_with(s.point, hints, &mut stack)
+        };
         last = Some(nearest.triangle);
         let d = nearest.distance_squared.sqrt();
         area += s.weight;
@@ -87,6 +100,17 @@ pub fn one_sided(
         samples: samples.len(),
         area,
     })
+}
+
+fn corners(s: Surface<'_>, face: u32) -> [Vec3; 3] {
+    let at = |i: u32| {
+        s.positions
+            .get(i as usize)
+            .map_or([f64::NAN; 3], |p| [p[0] as f64, p[1] as f64, p[2] as f64])
+    };
+    s.triangles
+        .get(face as usize)
+        .map_or([[f64::NAN; 3]; 3], |t| [at(t[0]), at(t[1]), at(t[2])])
 }
 
 /// Builds the nearest-triangle index of a surface, or says that it has no triangles.
