@@ -402,6 +402,56 @@ fn gltf_without_animation_is_an_error() {
     );
 }
 
+/// Two nodes share one mesh of two primitives that share their vertices (as multi-material meshes
+/// do); node 0 is moved by 10 in x and its morph target (vertex 2 up by 1 in z) is weighted 0 → 1
+/// over one second. Baked at 4 frames/s: 5 frames of 2 × 3 vertices and 2 × 2 triangles.
+#[test]
+fn morph_targets_and_shared_vertices_in_gltf() {
+    let floats: [f32; 22] = [
+        0., 0., 0., 1., 0., 0., 0., 1., 0., // positions
+        0., 0., 0., 0., 0., 0., 0., 0., 1., // target 0 displacements
+        0., 1., // key times
+        0., 1., // weights at the keys
+    ];
+    let bytes: Vec<u8> = floats.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],
+        "nodes":[{{"mesh":0,"translation":[10,0,0]}},{{"mesh":0}}],
+        "meshes":[{{"primitives":[
+            {{"attributes":{{"POSITION":0}},"targets":[{{"POSITION":1}}]}},
+            {{"attributes":{{"POSITION":0}},"targets":[{{"POSITION":1}}]}}]}}],
+        "animations":[{{"channels":[{{"sampler":0,"target":{{"node":0,"path":"weights"}}}}],
+            "samplers":[{{"input":2,"output":3,"interpolation":"LINEAR"}}]}}],
+        "accessors":[
+            {{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+            {{"bufferView":0,"byteOffset":36,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[0,0,1]}},
+            {{"bufferView":0,"byteOffset":72,"componentType":5126,"count":2,"type":"SCALAR","min":[0],"max":[1]}},
+            {{"bufferView":0,"byteOffset":80,"componentType":5126,"count":2,"type":"SCALAR"}}],
+        "bufferViews":[{{"buffer":0,"byteLength":88}}],
+        "buffers":[{{"byteLength":88,"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
+        base64(&bytes)
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("morph.gltf");
+    write(&path, &json);
+    let opts = ReadOptions {
+        fps: Some(4.0),
+        ..Default::default()
+    };
+    let mesh = read_animation(path.to_str().unwrap(), &opts).unwrap();
+    assert_eq!((mesh.vertex_count(), mesh.frame_count()), (6, 5));
+    assert_eq!(
+        mesh.triangles(),
+        [[0, 1, 2], [0, 1, 2], [3, 4, 5], [3, 4, 5]]
+    );
+    for f in 0..5 {
+        let frame = mesh.frame(f);
+        assert_eq!(frame[2], [10.0, 1.0, f as f32 / 4.0], "frame {f}");
+        assert_eq!(frame[1], [11.0, 0.0, 0.0]);
+        assert_eq!(frame[5], [0.0, 1.0, 0.0], "node 1 has no animated weights");
+    }
+}
+
 fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();

@@ -640,6 +640,21 @@ impl Part {
         ) {
             return Ok(None);
         }
+        // The reader would take quantised (KHR_mesh_quantization) positions for floats.
+        let float_vec3 = |a: &gltf::Accessor| {
+            a.data_type() == gltf::accessor::DataType::F32
+                && a.dimensions() == gltf::accessor::Dimensions::Vec3
+        };
+        let mut positions_accessors = primitive
+            .get(&gltf::Semantic::Positions)
+            .into_iter()
+            .chain(primitive.morph_targets().filter_map(|t| t.positions()));
+        if let Some(bad) = positions_accessors.find(|a| !float_vec3(a)) {
+            return Err(format!(
+                "{name}: positions in accessor {} are not float triples (quantised meshes are not supported)",
+                bad.index()
+            ));
+        }
         let reader = primitive.reader(|b| buffer_data(data, b));
         let Some(positions) = reader.read_positions() else {
             return Ok(None);
