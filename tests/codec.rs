@@ -505,3 +505,38 @@ fn jpeg_scalar_decode_equals_simd_decode() -> Result<()> {
     }
     Ok(())
 }
+
+#[test]
+fn jpeg_compact_form_drops_the_fixed_headers() -> Result<()> {
+    for (w, h, quality) in [(64, 64, 50), (256, 256, 75), (72, 40, 95), (8, 8, 1)] {
+        let plane = smooth_frame(w, h, 1, 0.2);
+        let full = jpeg::encode(&plane, quality)?;
+        let compact = jpeg::encode_compact(&plane, quality)?;
+        assert_eq!(
+            jpeg::decode_compact(&compact, w, h, quality)?,
+            jpeg::decode(&full, w, h)?,
+            "{w}×{h} q{quality}"
+        );
+        let saved = full.len() - compact.len();
+        println!(
+            "{w}×{h} q{quality}: {} → {} bytes",
+            full.len(),
+            compact.len()
+        );
+        // SOI, JFIF, frame header, two quantisation tables, scan header, EOI.
+        assert!(saved >= 150, "{w}×{h} q{quality}: only {saved} bytes saved");
+        // A plain JPEG starts with SOI, not with Huffman tables.
+        assert!(jpeg::decode_compact(&full, w, h, quality).is_err());
+    }
+    let compact = jpeg::encode_compact(&smooth_frame(64, 64, 0, 0.0), 75)?;
+    assert!(jpeg::decode_compact(&[], 64, 64, 75).is_err());
+    assert!(jpeg::decode_compact(&compact, 64, 64, 0).is_err());
+    for cut in [1, 3, 40, compact.len() / 2] {
+        let truncated = compact.get(..cut).unwrap_or_default();
+        assert!(
+            jpeg::decode_compact(truncated, 64, 64, 75).is_err(),
+            "cut at {cut}"
+        );
+    }
+    Ok(())
+}
