@@ -333,6 +333,14 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
             .collect::<Result<_>>()?;
         let dec = start.elapsed().as_secs_f64();
         let bytes: usize = coded.iter().map(Vec::len).sum();
+        let compact: usize = planes
+            .iter()
+            .map(|p| jpeg::encode_compact(p, quality).map(|c| c.len()))
+            .sum::<Result<_>>()?;
+        println!(
+            "jpeg  q{quality:<3}  compact form {:7.0} B/frame",
+            compact as f64 / f64::from(FRAMES)
+        );
         println!(
             "jpeg  q{quality:<3}  {:7.0} B/frame  PSNR {:5.2} dB  encode {:6.0} f/s  decode {:6.0} f/s",
             bytes as f64 / f64::from(FRAMES),
@@ -424,18 +432,23 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
         .collect();
     let tiled: Vec<Plane> = coords.iter().map(tile).collect();
     for quality in [50, 75, 90] {
-        let mut separate = 0;
-        let mut together = 0;
+        // [full, compact] bytes for three planes and for the tiled picture.
+        let (mut separate, mut together) = ([0; 2], [0; 2]);
         for (c, t) in coords.iter().zip(&tiled) {
             for p in c {
-                separate += jpeg::encode(p, quality)?.len();
+                separate[0] += jpeg::encode(p, quality)?.len();
+                separate[1] += jpeg::encode_compact(p, quality)?.len();
             }
-            together += jpeg::encode(t, quality)?.len();
+            together[0] += jpeg::encode(t, quality)?.len();
+            together[1] += jpeg::encode_compact(t, quality)?.len();
         }
+        let per_frame = |b: usize| b as f64 / f64::from(FRAMES);
         println!(
-            "jpeg  q{quality:<3} three planes {:7.0} B/frame, tiled 768×256 {:7.0} B/frame",
-            separate as f64 / f64::from(FRAMES),
-            together as f64 / f64::from(FRAMES)
+            "jpeg  q{quality:<3} three planes {:7.0} B/frame (compact {:7.0}), tiled 768×256 {:7.0} (compact {:7.0})",
+            per_frame(separate[0]),
+            per_frame(separate[1]),
+            per_frame(together[0]),
+            per_frame(together[1])
         );
     }
     for qscale in [2, 8, 20] {
