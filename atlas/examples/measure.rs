@@ -2,7 +2,7 @@
 //! vertices, L2 stretch and build time, per input.
 //!
 //! ```text
-//! cargo run --release -p atlas --example measure -- [--png DIR] [--jpeg] INPUT...
+//! cargo run --release -p atlas --example measure -- [--png DIR] [--jpeg] [--lattice SIDE] INPUT...
 //! ```
 //! An INPUT is a folder of numbered OBJ frames (the first is used), an `.obj`
 //! file or a `.glb` file (all primitives, bind pose, identical positions
@@ -203,6 +203,18 @@ fn main() -> Result<(), Box<dyn Error>> {
         args.remove(i);
         PathBuf::from(args.remove(i))
     });
+    let lattice: u32 = match args.iter().position(|a| a == "--lattice") {
+        Some(i) => {
+            args.remove(i);
+            args.remove(i).parse()?
+        }
+        None => 256,
+    };
+    let options = AtlasOptions {
+        width: lattice,
+        height: lattice,
+        ..AtlasOptions::default()
+    };
     let jpeg = args
         .iter()
         .position(|a| a == "--jpeg")
@@ -229,7 +241,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_default();
-        let built = build(&positions, &triangles, &partition, &AtlasOptions::default());
+        let built = build(&positions, &triangles, &partition, &options);
         let atlas = match built {
             Ok(a) => a,
             Err(e) => {

@@ -42,7 +42,8 @@ impl ChartLayout {
 
     /// The blocks the chart's triangles and vertices touch at scale `s`,
     /// or its whole frame when those hold fewer pixels than it has vertices.
-    fn shape(&self, s: f64, block: u32) -> Shape {
+    /// `None` when the frame cannot fit a `grid` of blocks in any orientation.
+    fn shape(&self, s: f64, block: u32, grid: [u32; 2]) -> Option<Shape> {
         let n = self.owned.len() as u64;
         let per_block = u64::from(block) * u64::from(block);
         let full = |bw: u32, bh: u32| Footprint {
@@ -54,13 +55,16 @@ impl ChartLayout {
             let nb = n.div_ceil(per_block).max(1);
             let bw = (nb as f64).sqrt().ceil().max(1.0) as u32;
             let bh = nb.div_ceil(u64::from(bw)) as u32;
-            return Shape {
+            return Some(Shape {
                 footprint: full(bw, bh),
                 offset: [0.0; 2],
-            };
+            });
         }
         let px = self.extent.map(|e| (e * s).round().min(1e6) as u32 + 1);
         let (bw, bh) = (px[0].div_ceil(block), px[1].div_ceil(block));
+        if bw.max(bh) > grid[0].max(grid[1]) || bw.min(bh) > grid[0].min(grid[1]) {
+            return None;
+        }
         let offset = [0, 1].map(|a| f64::from(([bw, bh][a] * block - px[a]) / 2));
         let rect = [0, 0, bw * block, bh * block];
         let mut touched = vec![false; (bw * bh) as usize];
@@ -77,14 +81,14 @@ impl ChartLayout {
             .filter(|&(x, y)| touched[(y * bw + x) as usize])
             .collect();
         if cells.len() as u64 * per_block >= n {
-            return Shape {
+            return Some(Shape {
                 footprint: Footprint {
                     width: bw,
                     height: bh,
                     cells,
                 },
                 offset,
-            };
+            });
         }
         let (mut gw, mut gh) = (u64::from(bw), u64::from(bh));
         while gw * gh * per_block < n {
@@ -94,10 +98,10 @@ impl ChartLayout {
                 gh += 1;
             }
         }
-        Shape {
+        Some(Shape {
             footprint: full(gw as u32, gh as u32),
             offset,
-        }
+        })
     }
 }
 
@@ -326,7 +330,11 @@ fn try_pack(
     s: f64,
     opts: &AtlasOptions,
 ) -> Option<(Vec<Shape>, Vec<Placement>)> {
-    let shapes: Vec<Shape> = charts.iter().map(|c| c.shape(s, opts.block)).collect();
+    let grid = [opts.width / opts.block, opts.height / opts.block];
+    let shapes: Vec<Shape> = charts
+        .iter()
+        .map(|c| c.shape(s, opts.block, grid))
+        .collect::<Option<_>>()?;
     let footprints: Vec<Footprint> = shapes.iter().map(|s| s.footprint.clone()).collect();
     let placed = pack(
         &footprints,
@@ -344,10 +352,16 @@ type Packing = (f64, Vec<Shape>, Vec<Placement>);
 /// largest scale found, not a proven optimum).
 fn best_scale(charts: &[ChartLayout], opts: &AtlasOptions) -> Result<Packing, AtlasError> {
     let Some(at_zero) = try_pack(charts, 0.0, opts) else {
-        let blocks = charts
+        let unbounded = [u32::MAX; 2];
+        let blocks: usize = charts
             .iter()
-            .map(|c| c.shape(0.0, opts.block).footprint.cells.len())
+            .filter_map(|c| c.shape(0.0, opts.block, unbounded))
+            .map(|s| s.footprint.cells.len())
             .sum();
+        let mut suggest = opts.width.max(opts.height).next_power_of_two();
+        while ((suggest / opts.block) as usize).pow(2) < 2 * blocks && suggest < 65536 {
+            suggest *= 2;
+        }
         return Err(AtlasError::ChartsDoNotFit {
             charts: charts.len(),
             blocks,
@@ -355,6 +369,7 @@ fn best_scale(charts: &[ChartLayout], opts: &AtlasOptions) -> Result<Packing, At
             block: opts.block,
             width: opts.width,
             height: opts.height,
+            suggest,
         });
     };
     let area: f64 = charts.iter().map(|c| c.stretch.area_2d()).sum();
