@@ -400,7 +400,17 @@ fn best_scale(charts: &[ChartLayout], opts: &AtlasOptions) -> Result<Packing, At
             break;
         }
     }
-    Ok((lo, best.0, best.1))
+    // The greedy packer can fail at one scale and succeed at a larger one:
+    // look a little above the bisection's answer too.
+    let mut found = lo;
+    for k in 1..=24 {
+        let s = lo * (1.0 + 0.025 * f64::from(k));
+        if let Some(p) = try_pack(charts, s, opts) {
+            found = s;
+            best = p;
+        }
+    }
+    Ok((found, best.0, best.1))
 }
 
 /// Where one chart sits: maps its local pixels to lattice pixels.

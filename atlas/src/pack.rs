@@ -111,7 +111,7 @@ pub(crate) fn pack(footprints: &[Footprint], grid_w: u32, grid_h: u32) -> Option
     let mut placed = vec![Placement::default(); footprints.len()];
     for i in order {
         let f = &footprints[i];
-        let mut best: Option<(u32, u32, Orientation)> = None;
+        let mut best: Option<((u32, u32), u32, u32, Orientation)> = None;
         for o in Orientation::ALL {
             let full = f.cells.len() == (f.width * f.height) as usize;
             // A full rectangle looks the same turned; a full square also transposed.
@@ -131,23 +131,26 @@ pub(crate) fn pack(footprints: &[Footprint], grid_w: u32, grid_h: u32) -> Option
                 .iter()
                 .map(|&c| o.cell(c, f.width, f.height))
                 .collect();
-            let limit = best.map_or(grid_h - oh, |(y, _, _)| y.min(grid_h - oh));
-            'search: for y in 0..=limit {
+            // Score: bottom edge, then left edge, so tall shapes lie down.
+            'search: for y in 0..=grid_h - oh {
                 for x in 0..=grid_w - ow {
-                    if best.is_some_and(|(by, bx, _)| (y, x) >= (by, bx)) {
-                        break 'search;
+                    if best.is_some_and(|(score, _, _, _)| (y + oh, x) >= score) {
+                        if x == 0 {
+                            break 'search;
+                        }
+                        break;
                     }
                     if cells
                         .iter()
                         .all(|&(cx, cy)| !used[((y + cy) * grid_w + x + cx) as usize])
                     {
-                        best = Some((y, x, o));
+                        best = Some(((y + oh, x), y, x, o));
                         break 'search;
                     }
                 }
             }
         }
-        let (by, bx, orientation) = best?;
+        let (_, by, bx, orientation) = best?;
         let p = Placement {
             bx,
             by,
