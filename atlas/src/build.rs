@@ -160,7 +160,7 @@ fn suggest_side(vertices: usize, opts: &AtlasOptions) -> u32 {
         .max(opts.height)
         .max(opts.block)
         .next_power_of_two();
-    while (side as usize) * (side as usize) < 2 * vertices && side < 65536 {
+    while (side as usize) * (side as usize) < 2 * vertices && side < 16384 {
         side *= 2;
     }
     side
@@ -359,7 +359,7 @@ fn best_scale(charts: &[ChartLayout], opts: &AtlasOptions) -> Result<Packing, At
             .map(|s| s.footprint.cells.len())
             .sum();
         let mut suggest = opts.width.max(opts.height).next_power_of_two();
-        while ((suggest / opts.block) as usize).pow(2) < 2 * blocks && suggest < 65536 {
+        while ((suggest / opts.block) as usize).pow(2) < 2 * blocks && suggest < 16384 {
             suggest *= 2;
         }
         return Err(AtlasError::ChartsDoNotFit {
