@@ -98,15 +98,22 @@ impl Placement {
 /// (bottom-left fill, so small charts drop into the gaps of big ones).
 /// `None` if one does not fit.
 pub(crate) fn pack(footprints: &[Footprint], grid_w: u32, grid_h: u32) -> Option<Vec<Placement>> {
+    let by_blocks = |f: &Footprint| (f.cells.len(), f.width.max(f.height));
+    let by_side = |f: &Footprint| (f.width.max(f.height) as usize, f.cells.len() as u32);
+    [by_blocks, by_side]
+        .iter()
+        .find_map(|key| pack_in_order(footprints, grid_w, grid_h, key))
+}
+
+/// [`pack`] with one order: decreasing `key`.
+fn pack_in_order(
+    footprints: &[Footprint],
+    grid_w: u32,
+    grid_h: u32,
+    key: &dyn Fn(&Footprint) -> (usize, u32),
+) -> Option<Vec<Placement>> {
     let mut order: Vec<usize> = (0..footprints.len()).collect();
-    order.sort_by_key(|&i| {
-        let f = &footprints[i];
-        (
-            std::cmp::Reverse(f.cells.len()),
-            std::cmp::Reverse(f.width.max(f.height)),
-            i,
-        )
-    });
+    order.sort_by_key(|&i| (std::cmp::Reverse(key(&footprints[i])), i));
     let mut used = vec![false; (grid_w * grid_h) as usize];
     let mut placed = vec![Placement::default(); footprints.len()];
     for i in order {
