@@ -211,7 +211,11 @@ fn assign_owners(
 /// Hands the vertices of charts owning fewer than `min` vertices to the
 /// neighbouring chart that owns most of their mesh neighbours, placed at the
 /// mean of those neighbours' 2D positions: a chart of a few vertices would
-/// otherwise hold a whole block alone. Returns how many vertices moved chart.
+/// otherwise hold a whole block alone. A chart takes in at most as many
+/// vertices as it owns, so that on coarse meshes made of small charts one
+/// chart does not swallow the rest onto a few pixels (measured on
+/// RiggedFigure: without the cap 116 of 130 vertices had to move). Returns how many
+/// vertices changed chart.
 fn absorb_small_charts(
     triangles: &[[u32; 3]],
     owner: &mut [Option<(u32, [f64; 2])>],
@@ -223,6 +227,7 @@ fn absorb_small_charts(
         count[*c as usize] += 1;
     }
     let small: Vec<bool> = count.iter().map(|&n| n > 0 && n < min).collect();
+    let mut room = count.clone();
     if !small.iter().any(|&s| s) {
         return 0;
     }
@@ -249,7 +254,7 @@ fn absorb_small_charts(
                 let Some((d, uv)) = owner[w as usize] else {
                     continue;
                 };
-                if small[d as usize] {
+                if small[d as usize] || room[d as usize] == 0 {
                     continue;
                 }
                 match tally.iter_mut().find(|t| t.0 == d) {
@@ -264,6 +269,7 @@ fn absorb_small_charts(
                 .into_iter()
                 .max_by_key(|t| (t.1, std::cmp::Reverse(t.0)));
             if let Some((d, n, sum)) = best {
+                room[d as usize] -= 1;
                 owner[v] = Some((d, [sum[0] / n as f64, sum[1] / n as f64]));
                 absorbed += 1;
                 changed = true;

@@ -48,7 +48,8 @@
 //!    corners for rasterisation. Charts left with fewer than
 //!    [`AtlasOptions::min_chart_vertices`] (8) vertices hand them to the
 //!    neighbouring chart owning most of their mesh neighbours, at the mean
-//!    of those neighbours' 2D positions ([`AtlasStats::absorbed_vertices`]);
+//!    of those neighbours' 2D positions ([`AtlasStats::absorbed_vertices`];
+//!    a chart takes in at most as many vertices as it owns);
 //!    charts owning no vertex are dropped. Vertices that no kept face charts
 //!    (isolated vertices, vertices of degenerate faces only) go to one extra
 //!    chart laid out as a plain grid ([`AtlasStats::faceless_vertices`]).
