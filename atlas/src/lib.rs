@@ -73,26 +73,38 @@
 //! [`Interior::Rasterised`] (default, as the paper) fixes the chart triangles'
 //! pixels to barycentric blends of the corner values; [`Interior::Free`]
 //! fixes only vertex pixels and leaves the rest to padding. Measured with
-//! JPEG on the x displacement between frames 1 and 11, free pixels filled by
-//! 300 Jacobi sweeps (a stand-in for the padding crate), Rasterised codes
-//! smaller at equal vertex error: dance 3858 B at rmse 0.0088 vs Free 5055 B
-//! at 0.0088; cow 3784 B at 0.0108 vs Free 5004 B at 0.0132; horse-gallop
-//! 2256 B at 0.0065 vs Free 2173 B at 0.0071 (rmse relative to the signal
-//! range; `cargo run --release -p atlas --example measure -- --jpeg DIR`).
+//! JPEG (8-bit, one channel) on the x displacement between frames 1 and 11,
+//! free pixels filled by 300 Jacobi sweeps (a stand-in for the padding
+//! crate), Rasterised codes smaller at equal vertex error on all four
+//! sequences tried (rmse relative to the signal range):
+//!
+//! | mesh | Rasterised q50 | Free q50 | Free q75 |
+//! |---|---|---|---|
+//! | pdance | 3895 B, 0.0089 | 3657 B, 0.0112 | 5150 B, 0.0092 |
+//! | pcow | 3600 B, 0.0096 | 3510 B, 0.0148 | 4855 B, 0.0121 |
+//! | horse-gallop | 2234 B, 0.0064 | 2161 B, 0.0070 | 2824 B, 0.0055 |
+//! | chickenCrossing | 4774 B, 0.0186 | 4181 B, 0.0222 | 5966 B, 0.0183 |
+//!
+//! With a plain mean fill instead, Free is far worse (dance q50: 0.0597 vs
+//! 0.0278). Command: `cargo run --release -p atlas --example measure --
+//! --jpeg /work/media-unpacked/pdance` (and the other folders).
 //!
 //! # Measured (256×256, K = 20 k-means partition, release build)
 //! `cargo run --release -p atlas --example measure -- /work/media-unpacked/pdance ...`
 //!
 //! | mesh | V | charts | packing | moved | L2 stretch | build |
 //! |---|---|---|---|---|---|---|
-//! | chickenCrossing | 3030 | 129 | 43.5% | 419 | 1.001 | 0.35 s |
-//! | pcow | 2904 | 57 | 47.5% | 96 | 1.002 | 0.32 s |
-//! | pdance | 7061 | 80 | 48.1% | 1820 | 1.004 | 0.59 s |
-//! | horse-gallop | 8431 | 97 | 48.5% | 2279 | 1.008 | 0.73 s |
+//! | chickenCrossing | 3030 | 145 | 40.7% | 400 | 1.001 | 0.16 s |
+//! | pcow | 2904 | 54 | 49.8% | 108 | 1.001 | 0.11 s |
+//! | pdance | 7061 | 82 | 49.1% | 1728 | 1.001 | 0.20 s |
+//! | horse-gallop | 8431 | 85 | 49.8% | 2294 | 1.001 | 0.21 s |
+//! | horse-collapse | 8431 | 92 | 48.9% | 2303 | 1.001 | 0.22 s |
+//! | walking_cat | 1297 | 57 | 45.6% | 122 | 1.002 | 0.08 s |
 //!
 //! Packing is chart pixels (covered by a chart triangle or a vertex) over
 //! lattice pixels. Moved vertices are many on dense meshes: at one common
-//! scale, regions with more vertices than pixels must spill.
+//! scale, regions with more vertices than pixels must spill. BrainStem
+//! (32559 welded vertices) needs 512×512.
 
 // `!(x > t)` is deliberate: unlike `x <= t` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
