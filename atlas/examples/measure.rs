@@ -183,7 +183,7 @@ fn jpeg_cost(
     quality: u8,
     sweeps: usize,
 ) -> Result<(usize, f64), Box<dyn Error>> {
-    let mut image = atlas.splat(values)?;
+    let mut image = atlas.try_splat(values)?;
     let fixed = atlas.fixed_mask();
     let (lo, hi) = values
         .iter()

@@ -13,7 +13,7 @@
 //! let triangles = [[0, 1, 2], [0, 2, 3]];
 //! let atlas = build(&positions, &triangles, &[0, 0, 1, 1], &AtlasOptions::default())?;
 //! let values = [1.0, 2.0, 3.0, 4.0];
-//! let image = atlas.splat(&values)?; // encoder: 256×256, row-major
+//! let image = atlas.splat(&values); // encoder: 256×256, row-major
 //! let back = sample(atlas.vertex_pixels(), atlas.width(), &image)?; // decoder
 //! assert_eq!(back, values);
 //! # Ok::<(), atlas::AtlasError>(())

@@ -97,7 +97,9 @@ fn check_invariants(atlas: &Atlas, vertices: usize) {
     let values: Vec<f32> = (0..vertices)
         .map(|v| (v as f32 * 0.37).sin() * 100.0 + v as f32)
         .collect();
-    let image = atlas.splat(&values).unwrap_or_default();
+    let image = atlas.try_splat(&values).unwrap_or_default();
+    assert_eq!(image, atlas.splat(&values));
+    assert!(atlas.try_splat(&values[1..]).is_err());
     let back = sample(px, atlas.width(), &image).unwrap_or_default();
     assert_eq!(back, values);
     let s = atlas.stats();
