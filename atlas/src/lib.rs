@@ -103,8 +103,10 @@
 //!
 //! Packing is chart pixels (covered by a chart triangle or a vertex) over
 //! lattice pixels. Moved vertices are many on dense meshes: at one common
-//! scale, regions with more vertices than pixels must spill. BrainStem
-//! (32559 welded vertices) needs 512×512.
+//! scale, regions with more vertices than pixels must spill: with
+//! `--lattice 512` dance moves 289 and horse-gallop 613 (packing 58.5%,
+//! 59.0%), with 1024 14 and 137. BrainStem (32559 welded vertices, 995
+//! charts) needs 512×512: 40.8% packing, 9457 moved, 2.1 s.
 
 // `!(x > t)` is deliberate: unlike `x <= t` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
