@@ -2,13 +2,14 @@
 //! vertices, L2 stretch and build time, per input.
 //!
 //! ```text
-//! cargo run --release -p atlas --example measure -- [--png DIR] [--jpeg] INPUT...
+//! cargo run --release -p atlas --example measure -- [--png DIR] [--jpeg] [--lattice SIDE] INPUT...
 //! ```
 //! An INPUT is a folder of numbered OBJ frames (the first is used), an `.obj`
 //! file or a `.glb` file (all primitives, bind pose, identical positions
 //! welded). The partition is a plain k-means (K = 20) on positions, a stand-in
 //! for the motion segmentation. With `--jpeg`, both interior modes are coded
-//! with JPEG (free pixels filled with the mean) for a frame-10 displacement
+//! with JPEG (free pixels filled with the mean, then also with 300 Jacobi
+//! smoothing sweeps as a stand-in for padding) for a frame-10 displacement
 //! signal, to compare sizes at matching error.
 //!
 //! The OBJ reader here is minimal (`v` and `f` lines) on purpose: this is a
@@ -146,10 +147,43 @@ fn kmeans(points: &[[f32; 3]], k: usize) -> Vec<u32> {
     label
 }
 
-/// JPEG-codes a splatted image (free pixels set to the fixed pixels' mean)
-/// and returns (bytes, vertex RMS error relative to the signal range).
-fn jpeg_cost(atlas: &Atlas, values: &[f32], quality: u8) -> Result<(usize, f64), Box<dyn Error>> {
-    let image = atlas.splat(values)?;
+/// Free pixels relaxed towards the mean of their 4 neighbours (Jacobi
+/// sweeps from the mean): a crude stand-in for the padding crate.
+fn smooth_fill(image: &mut [f32], fixed: &[bool], width: usize, sweeps: usize) {
+    let height = image.len() / width;
+    for _ in 0..sweeps {
+        let prev = image.to_vec();
+        for y in 0..height {
+            for x in 0..width {
+                let i = y * width + x;
+                if fixed[i] {
+                    continue;
+                }
+                let mut sum = 0.0;
+                let mut n = 0.0;
+                for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                    let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+                    if nx >= 0 && ny >= 0 && (nx as usize) < width && (ny as usize) < height {
+                        sum += prev[ny as usize * width + nx as usize];
+                        n += 1.0;
+                    }
+                }
+                image[i] = sum / n;
+            }
+        }
+    }
+}
+
+/// JPEG-codes a splatted image (free pixels set to the fixed pixels' mean,
+/// then `sweeps` smoothing sweeps) and returns (bytes, vertex RMS error
+/// relative to the signal range).
+fn jpeg_cost(
+    atlas: &Atlas,
+    values: &[f32],
+    quality: u8,
+    sweeps: usize,
+) -> Result<(usize, f64), Box<dyn Error>> {
+    let mut image = atlas.try_splat(values)?;
     let fixed = atlas.fixed_mask();
     let (lo, hi) = values
         .iter()
@@ -165,13 +199,15 @@ fn jpeg_cost(atlas: &Atlas, values: &[f32], quality: u8) -> Result<(usize, f64),
         .map(|(v, _)| f64::from(*v))
         .sum::<f64>()
         / n_fixed as f64;
+    for (v, f) in image.iter_mut().zip(&fixed) {
+        if !*f {
+            *v = mean as f32;
+        }
+    }
+    smooth_fill(&mut image, &fixed, atlas.width() as usize, sweeps);
     let bytes: Vec<u8> = image
         .iter()
-        .zip(&fixed)
-        .map(|(v, f)| {
-            let v = if *f { *v } else { mean as f32 };
-            ((v - lo) / range * 255.0).round().clamp(0.0, 255.0) as u8
-        })
+        .map(|v| ((v - lo) / range * 255.0).round().clamp(0.0, 255.0) as u8)
         .collect();
     let mut out = Vec::new();
     let enc = jpeg_encoder::Encoder::new(&mut out, quality);
@@ -203,6 +239,18 @@ fn main() -> Result<(), Box<dyn Error>> {
         args.remove(i);
         PathBuf::from(args.remove(i))
     });
+    let lattice: u32 = match args.iter().position(|a| a == "--lattice") {
+        Some(i) => {
+            args.remove(i);
+            args.remove(i).parse()?
+        }
+        None => 256,
+    };
+    let options = AtlasOptions {
+        width: lattice,
+        height: lattice,
+        ..AtlasOptions::default()
+    };
     let jpeg = args
         .iter()
         .position(|a| a == "--jpeg")
@@ -229,7 +277,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_default();
-        let built = build(&positions, &triangles, &partition, &AtlasOptions::default());
+        let built = build(&positions, &triangles, &partition, &options);
         let atlas = match built {
             Ok(a) => a,
             Err(e) => {
@@ -286,10 +334,12 @@ fn main() -> Result<(), Box<dyn Error>> {
                     .zip(&positions)
                     .map(|(a, b)| a[axis] - b[axis])
                     .collect();
-                for q in [50u8, 75, 90] {
-                    let (rb, re) = jpeg_cost(&atlas, &values, q)?;
-                    let (fb, fe) = jpeg_cost(&free, &values, q)?;
-                    println!("  jpeg axis {axis} q{q}: rasterised {rb} B rmse {re:.4} | free(mean fill) {fb} B rmse {fe:.4}");
+                for sweeps in [0, 300] {
+                    for q in [50u8, 75, 90] {
+                        let (rb, re) = jpeg_cost(&atlas, &values, q, sweeps)?;
+                        let (fb, fe) = jpeg_cost(&free, &values, q, sweeps)?;
+                        println!("  jpeg axis {axis} fill sweeps {sweeps:>3} q{q}: rasterised {rb:>6} B rmse {re:.4} | free {fb:>6} B rmse {fe:.4}");
+                    }
                 }
             }
         }

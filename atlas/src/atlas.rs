@@ -148,10 +148,8 @@ impl Atlas {
         &self.stats
     }
 
-    /// Writes one value per vertex into a row-major image: vertex pixels get
-    /// their value exactly, rasterised interior pixels the barycentric blend
-    /// of their triangle's corners, free pixels 0.
-    pub fn splat(&self, values: &[f32]) -> Result<Vec<f32>, AtlasError> {
+    /// [`Atlas::splat`] that first checks there is one value per vertex.
+    pub fn try_splat(&self, values: &[f32]) -> Result<Vec<f32>, AtlasError> {
         if values.len() != self.vertex_pixels.len() {
             return Err(AtlasError::Length {
                 what: "per-vertex values",
@@ -159,6 +157,15 @@ impl Atlas {
                 got: values.len(),
             });
         }
+        Ok(self.splat(values))
+    }
+
+    /// Writes one value per vertex into a row-major image: vertex pixels get
+    /// their value exactly, rasterised interior pixels the barycentric blend
+    /// of their triangle's corners, free pixels 0. Vertices without a value
+    /// (a short slice) read as 0 and extra values are ignored; use
+    /// [`Atlas::try_splat`] to have a length mismatch reported instead.
+    pub fn splat(&self, values: &[f32]) -> Vec<f32> {
         let mut image = vec![0.0f32; (self.width * self.height) as usize];
         for s in &self.interior {
             let v = s
@@ -168,13 +175,13 @@ impl Atlas {
                 *p = s.weights[0] * v[0] + s.weights[1] * v[1] + s.weights[2] * v[2];
             }
         }
-        for (px, value) in self.vertex_pixels.iter().zip(values) {
+        for (v, px) in self.vertex_pixels.iter().enumerate() {
             let i = px[1] as usize * self.width as usize + px[0] as usize;
             if let Some(p) = image.get_mut(i) {
-                *p = *value;
+                *p = values.get(v).copied().unwrap_or(0.0);
             }
         }
-        Ok(image)
+        image
     }
 }
 

@@ -40,7 +40,7 @@ pub enum AtlasError {
         suggest: u32,
     },
     /// Even at the smallest scale the charts' blocks do not fit.
-    #[error("{charts} charts need at least {blocks} blocks of {block}×{block} but the {width}×{height} lattice has {available}; use a larger --lattice")]
+    #[error("{charts} charts need at least {blocks} blocks of {block}×{block} but the {width}×{height} lattice has {available}; use --lattice {suggest}x{suggest}")]
     ChartsDoNotFit {
         /// Number of charts.
         charts: usize,
@@ -54,6 +54,8 @@ pub enum AtlasError {
         width: u32,
         /// Lattice height.
         height: u32,
+        /// A square lattice side with room for them.
+        suggest: u32,
     },
     /// The unwrapping library refused the mesh.
     #[error("parameterization failed: {0}")]

@@ -62,8 +62,8 @@ impl AtlasOptions {
                 self.width, self.height, self.block, self.block
             ));
         }
-        if self.width > 65536 || self.height > 65536 {
-            return bad("lattice sides must be at most 65536".into());
+        if self.width > 16384 || self.height > 16384 {
+            return bad("lattice sides must be at most 16384".into());
         }
         if !(self.max_stretch >= 1.0) {
             return bad(format!(

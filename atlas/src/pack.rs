@@ -98,20 +98,27 @@ impl Placement {
 /// (bottom-left fill, so small charts drop into the gaps of big ones).
 /// `None` if one does not fit.
 pub(crate) fn pack(footprints: &[Footprint], grid_w: u32, grid_h: u32) -> Option<Vec<Placement>> {
+    let by_blocks = |f: &Footprint| (f.cells.len(), f.width.max(f.height));
+    let by_side = |f: &Footprint| (f.width.max(f.height) as usize, f.cells.len() as u32);
+    [by_blocks, by_side]
+        .iter()
+        .find_map(|key| pack_in_order(footprints, grid_w, grid_h, key))
+}
+
+/// [`pack`] with one order: decreasing `key`.
+fn pack_in_order(
+    footprints: &[Footprint],
+    grid_w: u32,
+    grid_h: u32,
+    key: &dyn Fn(&Footprint) -> (usize, u32),
+) -> Option<Vec<Placement>> {
     let mut order: Vec<usize> = (0..footprints.len()).collect();
-    order.sort_by_key(|&i| {
-        let f = &footprints[i];
-        (
-            std::cmp::Reverse(f.cells.len()),
-            std::cmp::Reverse(f.width.max(f.height)),
-            i,
-        )
-    });
+    order.sort_by_key(|&i| (std::cmp::Reverse(key(&footprints[i])), i));
     let mut used = vec![false; (grid_w * grid_h) as usize];
     let mut placed = vec![Placement::default(); footprints.len()];
     for i in order {
         let f = &footprints[i];
-        let mut best: Option<(u32, u32, Orientation)> = None;
+        let mut best: Option<((u32, u32), u32, u32, Orientation)> = None;
         for o in Orientation::ALL {
             let full = f.cells.len() == (f.width * f.height) as usize;
             // A full rectangle looks the same turned; a full square also transposed.
@@ -131,23 +138,26 @@ pub(crate) fn pack(footprints: &[Footprint], grid_w: u32, grid_h: u32) -> Option
                 .iter()
                 .map(|&c| o.cell(c, f.width, f.height))
                 .collect();
-            let limit = best.map_or(grid_h - oh, |(y, _, _)| y.min(grid_h - oh));
-            'search: for y in 0..=limit {
+            // Score: bottom edge, then left edge, so tall shapes lie down.
+            'search: for y in 0..=grid_h - oh {
                 for x in 0..=grid_w - ow {
-                    if best.is_some_and(|(by, bx, _)| (y, x) >= (by, bx)) {
-                        break 'search;
+                    if best.is_some_and(|(score, _, _, _)| (y + oh, x) >= score) {
+                        if x == 0 {
+                            break 'search;
+                        }
+                        break;
                     }
                     if cells
                         .iter()
                         .all(|&(cx, cy)| !used[((y + cy) * grid_w + x + cx) as usize])
                     {
-                        best = Some((y, x, o));
+                        best = Some(((y + oh, x), y, x, o));
                         break 'search;
                     }
                 }
             }
         }
-        let (by, bx, orientation) = best?;
+        let (_, by, bx, orientation) = best?;
         let p = Placement {
             bx,
             by,

@@ -97,7 +97,9 @@ fn check_invariants(atlas: &Atlas, vertices: usize) {
     let values: Vec<f32> = (0..vertices)
         .map(|v| (v as f32 * 0.37).sin() * 100.0 + v as f32)
         .collect();
-    let image = atlas.splat(&values).unwrap_or_default();
+    let image = atlas.try_splat(&values).unwrap_or_default();
+    assert_eq!(image, atlas.splat(&values));
+    assert!(atlas.try_splat(&values[1..]).is_err());
     let back = sample(px, atlas.width(), &image).unwrap_or_default();
     assert_eq!(back, values);
     let s = atlas.stats();
@@ -241,5 +243,79 @@ fn png_is_written() -> Result<(), Box<dyn std::error::Error>> {
     let path = dir.path().join("atlas.png");
     atlas.write_png(&path)?;
     assert!(std::fs::metadata(&path)?.len() > 100);
+    Ok(())
+}
+
+#[test]
+fn forty_one_parts_like_chicken() -> Result<(), AtlasError> {
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    for k in 0..41 {
+        grid(
+            &mut p,
+            &mut t,
+            2,
+            [3.0 * (k % 7) as f32, 3.0 * (k / 7) as f32, 0.0],
+        );
+    }
+    let part: Vec<u32> = (0..p.len() as u32).map(|v| (v / 9) % 20).collect();
+    let atlas = build(&p, &t, &part, &AtlasOptions::default())?;
+    check_invariants(&atlas, p.len());
+    assert!(atlas.stats().seed_pieces >= 41);
+    Ok(())
+}
+
+#[test]
+fn tight_stretch_bound_splits_charts() -> Result<(), AtlasError> {
+    // A doubly curved cap: no flattening of it is isometric.
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    grid(&mut p, &mut t, 10, [0.0; 3]);
+    for q in &mut p {
+        let z = q[2] - 1.0;
+        q[0] *= 1.0 + 0.4 * z * z;
+        q[1] *= 1.0 + 0.4 * z * z;
+    }
+    let part = vec![0; p.len()];
+    let loose = build(&p, &t, &part, &AtlasOptions::default())?;
+    let tight = build(
+        &p,
+        &t,
+        &part,
+        &AtlasOptions {
+            max_stretch: 1.0 + 1e-9,
+            ..AtlasOptions::default()
+        },
+    )?;
+    check_invariants(&tight, p.len());
+    assert!(tight.stats().split_rounds >= 1);
+    assert!(tight.stats().charts >= loose.stats().charts);
+    Ok(())
+}
+
+/// The skinned figure that ships in the repo's media folder (bind pose).
+#[test]
+fn shipped_gltf_figure_builds() -> Result<(), Box<dyn std::error::Error>> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../media/RiggedFigure.glb");
+    let (doc, buffers, _) = gltf::import(path)?;
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    for mesh in doc.meshes() {
+        for prim in mesh.primitives() {
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let base = p.len() as u32;
+            p.extend(reader.read_positions().into_iter().flatten());
+            let idx: Vec<u32> = reader
+                .read_indices()
+                .map(|i| i.into_u32().collect())
+                .unwrap_or_default();
+            t.extend(
+                idx.chunks_exact(3)
+                    .map(|c| [base + c[0], base + c[1], base + c[2]]),
+            );
+        }
+    }
+    assert!(p.len() > 100);
+    // Unwelded glTF vertices share positions: they must still get distinct pixels.
+    let part: Vec<u32> = p.iter().map(|q| u32::from(q[1] > 0.0)).collect();
+    let atlas = build(&p, &t, &part, &AtlasOptions::default())?;
+    check_invariants(&atlas, p.len());
     Ok(())
 }
