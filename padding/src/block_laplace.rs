@@ -6,7 +6,7 @@
 //! paper writes 8 for all). The matrix is a graph Laplacian with the fixed pixels' rows removed; the
 //! block's 8-connected grid is connected, so with one fixed pixel it is SPD and CG applies.
 
-use crate::cg::{self, CgScratch};
+use crate::cg::{self, CgLimits, CgScratch};
 use crate::grid::{BlockGrid, BlockRect};
 use crate::PadStats;
 
@@ -34,8 +34,7 @@ impl BlockLaplace {
         rect: BlockRect,
         image: &mut [f32],
         fixed: &[bool],
-        tolerance: f64,
-        max_iterations: usize,
+        limits: CgLimits,
         stats: &mut PadStats,
     ) {
         let width = grid.width;
@@ -100,8 +99,7 @@ impl BlockLaplace {
             },
             &self.rhs,
             &mut self.x,
-            tolerance,
-            max_iterations,
+            limits,
             &mut self.scratch,
         );
         stats.record(report);

@@ -13,6 +13,13 @@ pub(crate) struct CgScratch {
     ap: Vec<f64>,
 }
 
+/// When to stop: ‖r‖₂ ≤ tolerance·‖b‖₂, or after max_iterations steps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CgLimits {
+    pub tolerance: f64,
+    pub max_iterations: usize,
+}
+
 /// How a solve ended.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct CgReport {
@@ -27,8 +34,7 @@ pub(crate) fn solve(
     mut apply: impl FnMut(&[f64], &mut [f64]),
     b: &[f64],
     x: &mut [f64],
-    tolerance: f64,
-    max_iterations: usize,
+    limits: CgLimits,
     scratch: &mut CgScratch,
 ) -> CgReport {
     let n = b.len();
@@ -44,10 +50,10 @@ pub(crate) fn solve(
     p.clear();
     p.extend_from_slice(r);
     let b_norm2 = dot(b, b);
-    let stop2 = tolerance * tolerance * b_norm2;
+    let stop2 = limits.tolerance * limits.tolerance * b_norm2;
     let mut rr = dot(r, r);
     let mut iterations = 0;
-    while rr > stop2 && iterations < max_iterations {
+    while rr > stop2 && iterations < limits.max_iterations {
         apply(p, ap);
         let pap = dot(p, ap);
         if pap <= 0.0 || !pap.is_finite() {
@@ -94,8 +100,10 @@ mod tests {
             },
             &[1.0, 2.0],
             &mut x,
-            1e-12,
-            10,
+            CgLimits {
+                tolerance: 1e-12,
+                max_iterations: 10,
+            },
             &mut CgScratch::default(),
         );
         assert!(report.converged);

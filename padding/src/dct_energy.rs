@@ -1,14 +1,14 @@
 //! Padding aimed at the codec rather than at smoothness: per 8×8 block, free pixels minimise the
-//! DCT coefficients' energy weighted by JPEG's quantiser, E = Σ_k (c_k / Q_k)², fixed pixels held.
+//! AC coefficients' energy weighted by JPEG's quantiser, E = Σ_{k≠0} (c_k / Q_k)², fixed pixels held.
 //!
 //! c_k / Q_k is what the codec rounds and entropy-codes, so a small E means few, small quantised
 //! coefficients. The Annex K luminance table is the weight; JPEG's quality setting scales that table
 //! uniformly (up to rounding and clamping), which leaves the minimiser unchanged, so one table serves
 //! every quality. With c = D·b (D the orthonormal 2-D DCT) and b = P·x + f (x the free pixels, f the
-//! fixed ones), E is minimised by Pᵀ DᵀWD P x = −Pᵀ DᵀWD f, an SPD system (W > 0, D orthogonal)
+//! fixed ones), E is minimised by Pᵀ DᵀWD P x = −Pᵀ DᵀWD f, an SPD system (W ≥ 0 with only DC unweighted, D orthogonal)
 //! solved by CG. Pixels of a block lying outside the image are treated as free.
 
-use crate::cg::{self, CgScratch};
+use crate::cg::{self, CgLimits, CgScratch};
 use crate::grid::{BlockGrid, BlockRect};
 use crate::PadStats;
 
@@ -18,10 +18,10 @@ const N: usize = SIDE * SIDE;
 
 /// ITU-T T.81 Annex K luminance quantisation table, row-major.
 const ANNEX_K_LUMA: [f64; N] = [
-    16., 11., 10., 16., 24., 40., 51., 61., 12., 12., 14., 19., 26., 58., 60., 55., 14., 13., 16., 24.,
-    40., 57., 69., 56., 14., 17., 22., 29., 51., 87., 80., 62., 18., 22., 37., 56., 68., 109., 103.,
-    77., 24., 35., 55., 64., 81., 104., 113., 92., 49., 64., 78., 87., 103., 121., 120., 101., 72.,
-    92., 95., 98., 112., 100., 103., 99.,
+    16., 11., 10., 16., 24., 40., 51., 61., 12., 12., 14., 19., 26., 58., 60., 55., 14., 13., 16.,
+    24., 40., 57., 69., 56., 14., 17., 22., 29., 51., 87., 80., 62., 18., 22., 37., 56., 68., 109.,
+    103., 77., 24., 35., 55., 64., 81., 104., 113., 92., 49., 64., 78., 87., 103., 121., 120.,
+    101., 72., 92., 95., 98., 112., 100., 103., 99.,
 ];
 
 /// Orthonormal DCT-II basis and weights, plus per-block work space.
@@ -51,7 +51,12 @@ impl Default for DctEnergy {
                         .cos();
             }
         }
-        let weight = ANNEX_K_LUMA.map(|q| 1.0 / (q * q));
+        let mut weight = ANNEX_K_LUMA.map(|q| 1.0 / (q * q));
+        // DC is coded as a difference from the previous block's DC, so its size is not its cost;
+        // weighting it would drag padded values towards 0. With DC free, a single fixed pixel still
+        // pins the system: a nonzero free-pixel vector with only a DC component would be a constant
+        // block that is 0 on the fixed pixels.
+        weight[0] = 0.0;
         DctEnergy {
             basis,
             weight,
@@ -65,15 +70,13 @@ impl Default for DctEnergy {
 
 impl DctEnergy {
     /// Pads the free pixels of one block that holds at least one fixed pixel.
-    #[allow(clippy::too_many_arguments)]
     pub fn pad_block(
         &mut self,
         grid: &BlockGrid,
         rect: BlockRect,
         image: &mut [f32],
         fixed: &[bool],
-        tolerance: f64,
-        max_iterations: usize,
+        limits: CgLimits,
         stats: &mut PadStats,
     ) {
         let width = grid.width;
@@ -133,8 +136,7 @@ impl DctEnergy {
             },
             &self.rhs,
             &mut self.x,
-            tolerance,
-            max_iterations,
+            limits,
             &mut self.scratch,
         );
         stats.record(report);

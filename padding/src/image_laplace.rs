@@ -4,7 +4,7 @@
 //! One system of up to width×height unknowns: CG warm-started by push–pull, which already has the
 //! low frequencies right, so the iteration cap mostly trims high-frequency error.
 
-use crate::cg::{self, CgScratch};
+use crate::cg::{self, CgLimits, CgScratch};
 use crate::{push_pull, PadStats};
 
 /// Fills every pixel with `held[i] == false`; needs at least one held pixel.
@@ -13,8 +13,7 @@ pub(crate) fn fill(
     width: usize,
     height: usize,
     held: &[bool],
-    tolerance: f64,
-    max_iterations: usize,
+    limits: CgLimits,
     stats: &mut PadStats,
 ) {
     push_pull::fill(image, width, height, held);
@@ -68,8 +67,7 @@ pub(crate) fn fill(
         },
         &rhs,
         &mut x,
-        tolerance,
-        max_iterations,
+        limits,
         &mut CgScratch::default(),
     );
     stats.record(report);

@@ -74,8 +74,10 @@ pub fn pad(
 ) -> Result<PadStats, PaddingError> {
     validate(image, width, height, fixed, previous, opts)?;
     let grid = BlockGrid::new(width, height, opts.block);
-    let tolerance = f64::from(opts.tolerance.max(0.0));
-    let max_iterations = opts.max_iterations;
+    let limits = cg::CgLimits {
+        tolerance: f64::from(opts.tolerance.max(0.0)),
+        max_iterations: opts.max_iterations,
+    };
     let mut stats = PadStats::default();
     let mut filled = grid.any_set(fixed);
     let mut held = fixed.to_vec();
@@ -97,15 +99,7 @@ pub fn pad(
                 .for_each(|(v, _)| *v = mid);
         }
         Method::PushPull => push_pull::fill(image, width, height, &held),
-        Method::Laplace => image_laplace::fill(
-            image,
-            width,
-            height,
-            &held,
-            tolerance,
-            max_iterations,
-            &mut stats,
-        ),
+        Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
         Method::Mean | Method::Cg | Method::DctEnergy => {
             let mut block_solver = BlockSolver::new(opts.method);
             let with_fixed = grid.any_set(fixed);
@@ -113,24 +107,12 @@ pub fn pad(
                 let rect = grid.rect(b);
                 match &mut block_solver {
                     BlockSolver::Mean => fill_block_mean(&grid, rect, image, fixed),
-                    BlockSolver::Laplace(solver) => solver.pad_block(
-                        &grid,
-                        rect,
-                        image,
-                        fixed,
-                        tolerance,
-                        max_iterations,
-                        &mut stats,
-                    ),
-                    BlockSolver::Dct(solver) => solver.pad_block(
-                        &grid,
-                        rect,
-                        image,
-                        fixed,
-                        tolerance,
-                        max_iterations,
-                        &mut stats,
-                    ),
+                    BlockSolver::Laplace(solver) => {
+                        solver.pad_block(&grid, rect, image, fixed, limits, &mut stats)
+                    }
+                    BlockSolver::Dct(solver) => {
+                        solver.pad_block(&grid, rect, image, fixed, limits, &mut stats)
+                    }
                 }
             }
             empty_blocks::fill_flat_from_neighbours(&grid, image, &mut filled, 0.0);
@@ -159,7 +141,9 @@ fn fill_block_mean(grid: &BlockGrid, rect: grid::BlockRect, image: &mut [f32], f
     let (sum, count) = grid
         .pixels(rect)
         .filter(|&i| fixed[i])
-        .fold((0.0f64, 0usize), |(s, c), i| (s + f64::from(image[i]), c + 1));
+        .fold((0.0f64, 0usize), |(s, c), i| {
+            (s + f64::from(image[i]), c + 1)
+        });
     if count == 0 {
         return;
     }

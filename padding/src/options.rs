@@ -21,7 +21,7 @@ pub enum Method {
     /// ψ minimised over the whole image rather than per block, so padding is smooth across block
     /// borders and fills empty blocks too (CG warm-started by push–pull).
     Laplace,
-    /// Per 8×8 block, minimise the DCT energy weighted by JPEG's quantiser, Σ_k (c_k / Q_k)²:
+    /// Per 8×8 block, minimise the AC energy weighted by JPEG's quantiser, Σ_{k≠0} (c_k / Q_k)²:
     /// what is left after quantisation is what costs bits.
     DctEnergy,
 }

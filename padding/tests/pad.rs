@@ -1,0 +1,323 @@
+//! Behaviour of `padding::pad` through its public API.
+
+use padding::{pad, Method, PaddingError, PaddingOptions};
+use proptest::prelude::*;
+
+fn opts(method: Method) -> PaddingOptions {
+    PaddingOptions {
+        tolerance: 1e-7,
+        ..PaddingOptions::with_method(method)
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn fixed_pixels_never_change(
+        width in 1usize..30,
+        height in 1usize..30,
+        seed in any::<u64>(),
+        density in 0.0f64..1.0,
+        with_previous in any::<bool>(),
+    ) {
+        let n = width * height;
+        let mut state = seed | 1;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let values: Vec<f32> = (0..n).map(|_| (next() * 510.0 - 255.0) as f32).collect();
+        let fixed: Vec<bool> = (0..n).map(|_| next() < density).collect();
+        let previous: Vec<f32> = (0..n).map(|_| (next() * 100.0) as f32).collect();
+        for method in Method::ALL {
+            let mut image = values.clone();
+            let prev = with_previous.then_some(previous.as_slice());
+            pad(&mut image, width, height, &fixed, prev, &opts(method)).unwrap();
+            for i in 0..n {
+                prop_assert!(image[i].is_finite(), "{method}: pixel {i} not finite");
+                if fixed[i] {
+                    prop_assert_eq!(image[i].to_bits(), values[i].to_bits(), "{} moved pixel {}", method, i);
+                }
+            }
+        }
+    }
+}
+
+/// The eq. 6 system of one block, built densely and solved by Gaussian elimination with partial pivoting.
+fn dense_block_laplace(values: &[f64], fixed: &[bool], w: usize, h: usize) -> Vec<f64> {
+    let free: Vec<usize> = (0..w * h).filter(|&i| !fixed[i]).collect();
+    let index_of = |i: usize| free.iter().position(|&f| f == i);
+    let n = free.len();
+    let mut a = vec![vec![0.0; n + 1]; n];
+    for (row, &p) in free.iter().enumerate() {
+        let (x, y) = ((p % w) as i64, (p / w) as i64);
+        for dy in -1..=1i64 {
+            for dx in -1..=1i64 {
+                let (nx, ny) = (x + dx, y + dy);
+                if (dx, dy) == (0, 0) || nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
+                    continue;
+                }
+                let q = (ny as usize) * w + nx as usize;
+                a[row][row] += 1.0;
+                match index_of(q) {
+                    Some(col) => a[row][col] -= 1.0,
+                    None => a[row][n] += values[q],
+                }
+            }
+        }
+    }
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
+            .unwrap();
+        a.swap(col, pivot);
+        let pivot_row = a[col].clone();
+        for (row, r) in a.iter_mut().enumerate() {
+            if row != col {
+                let factor = r[col] / pivot_row[col];
+                for (v, p) in r.iter_mut().zip(&pivot_row).skip(col) {
+                    *v -= factor * p;
+                }
+            }
+        }
+    }
+    let mut out = values.to_vec();
+    for (row, &p) in free.iter().enumerate() {
+        out[p] = a[row][n] / a[row][row];
+    }
+    out
+}
+
+#[test]
+fn cg_matches_a_dense_solve_on_small_blocks() {
+    // One block per image (image size ≤ block size), several shapes and masks, deterministic.
+    let cases: [(usize, usize, u32); 5] = [(8, 8, 3), (8, 8, 11), (5, 7, 2), (3, 3, 5), (8, 8, 29)];
+    for (w, h, stride) in cases {
+        let values: Vec<f64> = (0..w * h)
+            .map(|i| ((i as u32).wrapping_mul(2654435761) % 1000) as f64 / 7.0)
+            .collect();
+        let fixed: Vec<bool> = (0..w * h)
+            .map(|i| (i as u32 * 7 + 1) % stride == 0)
+            .collect();
+        assert!(fixed.iter().any(|&f| f) && fixed.iter().any(|&f| !f));
+        let expected = dense_block_laplace(&values, &fixed, w, h);
+        let mut image: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+        pad(&mut image, w, h, &fixed, None, &opts(Method::Cg)).unwrap();
+        for i in 0..w * h {
+            assert!(
+                (f64::from(image[i]) - expected[i]).abs() < 1e-3,
+                "{w}x{h} stride {stride}: pixel {i}: cg {} vs dense {}",
+                image[i],
+                expected[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn per_block_solves_are_independent() {
+    // Two 8x8 blocks side by side: each block's answer equals its own dense solve.
+    let (w, h) = (16, 8);
+    let values: Vec<f64> = (0..w * h).map(|i| ((i * 37) % 101) as f64).collect();
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % 5 == 0).collect();
+    let mut image: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+    pad(&mut image, w, h, &fixed, None, &opts(Method::Cg)).unwrap();
+    for bx in 0..2 {
+        let block_values: Vec<f64> = (0..64)
+            .map(|i| values[(i / 8) * w + bx * 8 + i % 8])
+            .collect();
+        let block_fixed: Vec<bool> = (0..64)
+            .map(|i| fixed[(i / 8) * w + bx * 8 + i % 8])
+            .collect();
+        let expected = dense_block_laplace(&block_values, &block_fixed, 8, 8);
+        for i in 0..64 {
+            let got = image[(i / 8) * w + bx * 8 + i % 8];
+            assert!(
+                (f64::from(got) - expected[i]).abs() < 1e-3,
+                "block {bx} pixel {i}"
+            );
+        }
+    }
+}
+
+#[test]
+fn all_fixed_is_untouched() {
+    let values: Vec<f32> = (0..64).map(|i| i as f32 * 1.5).collect();
+    for method in Method::ALL {
+        let mut image = values.clone();
+        pad(&mut image, 8, 8, &[true; 64], None, &opts(method)).unwrap();
+        assert_eq!(image, values, "{method}");
+    }
+}
+
+#[test]
+fn nothing_fixed_gives_zero_or_the_previous_frame() {
+    let previous: Vec<f32> = (0..100).map(|i| i as f32).collect();
+    for method in Method::ALL {
+        let mut image = vec![7.0f32; 100];
+        pad(&mut image, 10, 10, &[false; 100], None, &opts(method)).unwrap();
+        assert!(image.iter().all(|&v| v == 0.0), "{method}");
+        let mut image = vec![7.0f32; 100];
+        pad(
+            &mut image,
+            10,
+            10,
+            &[false; 100],
+            Some(&previous),
+            &opts(method),
+        )
+        .unwrap();
+        assert_eq!(image, previous, "{method}");
+    }
+}
+
+#[test]
+fn a_single_fixed_pixel_spreads_everywhere() {
+    for method in Method::ALL {
+        let mut image = vec![0.0f32; 24 * 16];
+        let mut fixed = vec![false; 24 * 16];
+        image[5 * 24 + 3] = 42.0;
+        fixed[5 * 24 + 3] = true;
+        pad(&mut image, 24, 16, &fixed, None, &opts(method)).unwrap();
+        assert!(
+            image.iter().all(|&v| (v - 42.0).abs() < 1e-3),
+            "{method}: {:?}",
+            image.iter().find(|&&v| (v - 42.0).abs() >= 1e-3)
+        );
+    }
+}
+
+#[test]
+fn p_frames_copy_previous_into_empty_blocks_only() {
+    let (w, h) = (16, 8);
+    let mut fixed = vec![false; w * h];
+    fixed[3 * w + 2] = true;
+    let previous: Vec<f32> = (0..w * h).map(|i| i as f32).collect();
+    for method in Method::ALL {
+        let mut image = vec![0.0f32; w * h];
+        image[3 * w + 2] = -5.0;
+        pad(&mut image, w, h, &fixed, Some(&previous), &opts(method)).unwrap();
+        for y in 0..h {
+            for x in 8..16 {
+                assert_eq!(image[y * w + x], previous[y * w + x], "{method}");
+            }
+        }
+        assert_eq!(image[3 * w + 2], -5.0);
+    }
+}
+
+#[test]
+fn intra_empty_blocks_are_flat_at_the_neighbours_border_mean() {
+    // Left block fully fixed with column value = x; right block empty: it gets the mean of column 7.
+    let (w, h) = (16, 8);
+    let mut image = vec![0.0f32; w * h];
+    let mut fixed = vec![false; w * h];
+    for y in 0..h {
+        for x in 0..8 {
+            image[y * w + x] = x as f32;
+            fixed[y * w + x] = true;
+        }
+    }
+    for method in [Method::Cg, Method::Mean, Method::DctEnergy] {
+        let mut padded = image.clone();
+        pad(&mut padded, w, h, &fixed, None, &opts(method)).unwrap();
+        for y in 0..h {
+            for x in 8..16 {
+                assert_eq!(padded[y * w + x], 7.0, "{method}");
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_inputs_are_errors_not_panics() {
+    let o = PaddingOptions::default();
+    let mut image = vec![0.0f32; 12];
+    assert!(matches!(
+        pad(&mut image, 0, 12, &[false; 12], None, &o),
+        Err(PaddingError::EmptyImage { .. })
+    ));
+    assert!(matches!(
+        pad(&mut image, 3, 5, &[false; 15], None, &o),
+        Err(PaddingError::SizeMismatch { what: "image", .. })
+    ));
+    assert!(matches!(
+        pad(&mut image, 3, 4, &[false; 11], None, &o),
+        Err(PaddingError::SizeMismatch { what: "mask", .. })
+    ));
+    assert!(matches!(
+        pad(&mut image, 3, 4, &[false; 12], Some(&[0.0; 3]), &o),
+        Err(PaddingError::SizeMismatch {
+            what: "previous",
+            ..
+        })
+    ));
+    assert!(matches!(
+        pad(&mut image, usize::MAX, 3, &[false; 12], None, &o),
+        Err(PaddingError::EmptyImage { .. })
+    ));
+    let zero_block = PaddingOptions {
+        block: 0,
+        ..o.clone()
+    };
+    assert!(matches!(
+        pad(&mut image, 3, 4, &[false; 12], None, &zero_block),
+        Err(PaddingError::BadBlock { .. })
+    ));
+    let dct16 = PaddingOptions {
+        block: 16,
+        ..PaddingOptions::with_method(Method::DctEnergy)
+    };
+    assert!(matches!(
+        pad(&mut image, 3, 4, &[false; 12], None, &dct16),
+        Err(PaddingError::BadBlock { .. })
+    ));
+    image[5] = f32::NAN;
+    let mut fixed = [false; 12];
+    fixed[5] = true;
+    assert!(matches!(
+        pad(&mut image, 3, 4, &fixed, None, &o),
+        Err(PaddingError::NonFinite { index: 5, .. })
+    ));
+}
+
+#[test]
+fn method_names_round_trip() {
+    for method in Method::ALL {
+        assert_eq!(method.to_string().parse::<Method>().unwrap(), method);
+    }
+    assert_eq!("Zero".parse::<Method>().unwrap(), Method::MidGrey);
+    assert_eq!("push-pull".parse::<Method>().unwrap(), Method::PushPull);
+    assert!(matches!(
+        "bogus".parse::<Method>(),
+        Err(PaddingError::UnknownMethod(_))
+    ));
+}
+
+#[test]
+fn smooth_methods_reproduce_a_linear_ramp() {
+    // A linear ramp in x has zero Laplacian, so per-block and whole-image ψ minimisers that see
+    // the ramp on each block's edge columns reproduce it inside.
+    let (w, h) = (16, 16);
+    let ramp: Vec<f32> = (0..w * h).map(|i| (i % w) as f32 * 3.0).collect();
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % 8 == 0 || i % 8 == 7).collect();
+    for method in [Method::Cg, Method::Laplace] {
+        let mut image: Vec<f32> = ramp
+            .iter()
+            .zip(&fixed)
+            .map(|(&v, &f)| if f { v } else { -99.0 })
+            .collect();
+        pad(&mut image, w, h, &fixed, None, &opts(method)).unwrap();
+        for i in 0..w * h {
+            assert!(
+                (image[i] - ramp[i]).abs() < 1e-2,
+                "{method} pixel {i}: {} vs {}",
+                image[i],
+                ramp[i]
+            );
+        }
+    }
+}
