@@ -1,0 +1,112 @@
+//! Pad, code with JPEG, decode, and measure bytes and the error on fixed pixels.
+
+use std::time::Instant;
+
+use padding::{pad, Method, PaddingOptions};
+
+use crate::images::{Sample, Sequence};
+
+/// Totals of one (sequence, method, quality).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Point {
+    pub bytes_per_frame: f64,
+    /// RMS error over all fixed pixels, in grey levels (0–255 scale).
+    pub rmse: f64,
+}
+
+/// Everything measured for one method on one sequence.
+pub struct MethodResult {
+    pub method: Method,
+    /// One point per quality of the sweep, in sweep order.
+    pub points: Vec<Point>,
+    pub pad_ms_per_frame: f64,
+    pub cg_iterations_per_frame: f64,
+    pub unconverged: usize,
+}
+
+/// Pads every sample with `method` and codes it at every quality in `qualities`.
+pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<MethodResult, String> {
+    let options = PaddingOptions::with_method(method);
+    let mut bytes = vec![0usize; qualities.len()];
+    let mut sse = vec![0.0f64; qualities.len()];
+    let mut fixed_count = 0usize;
+    let mut pad_seconds = 0.0;
+    let mut iterations = 0usize;
+    let mut unconverged = 0usize;
+    for sample in &sequence.samples {
+        let mut image = sample.grey.clone();
+        let start = Instant::now();
+        let stats = pad(&mut image, sample.width, sample.height, &sample.fixed, None, &options)
+            .map_err(|e| e.to_string())?;
+        pad_seconds += start.elapsed().as_secs_f64();
+        iterations += stats.cg_iterations;
+        unconverged += stats.unconverged;
+        let grey: Vec<u8> = image.iter().map(|&v| v.round().clamp(0.0, 255.0) as u8).collect();
+        fixed_count += sample.fixed.iter().filter(|&&f| f).count();
+        for (q, &quality) in qualities.iter().enumerate() {
+            let (coded, decoded) = jpeg_round_trip(&grey, sample, quality)?;
+            bytes[q] += coded;
+            sse[q] += fixed_sse(sample, &decoded);
+        }
+    }
+    let frames = sequence.frames();
+    Ok(MethodResult {
+        method,
+        points: bytes
+            .iter()
+            .zip(&sse)
+            .map(|(&b, &e)| Point {
+                bytes_per_frame: b as f64 / frames,
+                rmse: (e / fixed_count.max(1) as f64).sqrt(),
+            })
+            .collect(),
+        pad_ms_per_frame: pad_seconds * 1000.0 / frames,
+        cg_iterations_per_frame: iterations as f64 / frames,
+        unconverged,
+    })
+}
+
+/// Baseline JPEG (Annex K tables scaled by quality, standard Huffman tables, one grey channel).
+fn jpeg_round_trip(grey: &[u8], sample: &Sample, quality: u8) -> Result<(usize, Vec<u8>), String> {
+    let mut coded = Vec::new();
+    let encoder = jpeg_encoder::Encoder::new(&mut coded, quality);
+    let (w, h) = (
+        u16::try_from(sample.width).map_err(|_| "image too wide for JPEG")?,
+        u16::try_from(sample.height).map_err(|_| "image too tall for JPEG")?,
+    );
+    encoder.encode(grey, w, h, jpeg_encoder::ColorType::Luma).map_err(|e| e.to_string())?;
+    let decoded = image::load_from_memory_with_format(&coded, image::ImageFormat::Jpeg)
+        .map_err(|e| e.to_string())?
+        .to_luma8()
+        .into_raw();
+    Ok((coded.len(), decoded))
+}
+
+fn fixed_sse(sample: &Sample, decoded: &[u8]) -> f64 {
+    sample
+        .grey
+        .iter()
+        .zip(decoded)
+        .zip(&sample.fixed)
+        .filter(|(_, &f)| f)
+        .map(|((&r, &d), _)| (f64::from(r) - f64::from(d)).powi(2))
+        .sum()
+}
+
+/// Bytes per frame `result` would need to reach `target` RMSE: linear interpolation of log(bytes)
+/// against log(error) between the two sweep points that bracket `target`; None outside the sweep.
+pub fn bytes_at_error(result: &MethodResult, target: f64) -> Option<f64> {
+    let mut points = result.points.clone();
+    points.sort_by(|a, b| a.rmse.total_cmp(&b.rmse));
+    points.windows(2).find_map(|pair| {
+        let (a, b) = (pair[0], pair[1]);
+        if target < a.rmse || target > b.rmse {
+            return None;
+        }
+        if (b.rmse - a.rmse).abs() < 1e-12 {
+            return Some(a.bytes_per_frame.min(b.bytes_per_frame));
+        }
+        let t = (target.ln() - a.rmse.ln()) / (b.rmse.ln() - a.rmse.ln());
+        Some((a.bytes_per_frame.ln() * (1.0 - t) + b.bytes_per_frame.ln() * t).exp())
+    })
+}
