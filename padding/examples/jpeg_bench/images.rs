@@ -24,7 +24,11 @@ impl Sequence {
     }
 
     pub fn fixed_fraction(&self) -> f64 {
-        let fixed: usize = self.samples.iter().map(|s| s.fixed.iter().filter(|&&f| f).count()).sum();
+        let fixed: usize = self
+            .samples
+            .iter()
+            .map(|s| s.fixed.iter().filter(|&&f| f).count())
+            .sum();
         let total: usize = self.samples.iter().map(|s| s.fixed.len()).sum();
         fixed as f64 / total.max(1) as f64
     }
@@ -38,14 +42,27 @@ impl Sample {
             .iter()
             .zip(&fixed)
             .filter(|(_, &f)| f)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (&v, _)| (lo.min(v), hi.max(v)));
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (&v, _)| {
+                (lo.min(v), hi.max(v))
+            });
         let span = if hi > lo { hi - lo } else { 1.0 };
         let grey = raw
             .iter()
             .zip(&fixed)
-            .map(|(&v, &f)| if f { ((v - lo) / span * 255.0).round() as f32 } else { 0.0 })
+            .map(|(&v, &f)| {
+                if f {
+                    ((v - lo) / span * 255.0).round() as f32
+                } else {
+                    0.0
+                }
+            })
             .collect();
-        Sample { width, height, grey, fixed }
+        Sample {
+            width,
+            height,
+            grey,
+            fixed,
+        }
     }
 }
 
@@ -57,21 +74,33 @@ pub fn read_folder(dir: &Path, per_frame: usize) -> Result<Sequence, String> {
         .filter_map(|entry| entry.ok().map(|e| e.path()))
         .filter(|p| {
             p.extension().is_some_and(|e| e == "png")
-                && !p.file_stem().is_some_and(|s| s.to_string_lossy().ends_with("_mask"))
+                && !p
+                    .file_stem()
+                    .is_some_and(|s| s.to_string_lossy().ends_with("_mask"))
         })
         .collect();
     names.sort();
     let mut samples = Vec::new();
     for path in names {
-        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let mask_path = path.with_file_name(format!("{stem}_mask.png"));
         if !mask_path.exists() {
             continue;
         }
-        let image = image::open(&path).map_err(|e| format!("{}: {e}", path.display()))?.to_luma16();
-        let mask = image::open(&mask_path).map_err(|e| format!("{}: {e}", mask_path.display()))?.to_luma8();
+        let image = image::open(&path)
+            .map_err(|e| format!("{}: {e}", path.display()))?
+            .to_luma16();
+        let mask = image::open(&mask_path)
+            .map_err(|e| format!("{}: {e}", mask_path.display()))?
+            .to_luma8();
         if image.dimensions() != mask.dimensions() {
-            return Err(format!("{}: mask size differs from the image", mask_path.display()));
+            return Err(format!(
+                "{}: mask size differs from the image",
+                mask_path.display()
+            ));
         }
         let (w, h) = (image.width() as usize, image.height() as usize);
         let raw: Vec<f64> = image.pixels().map(|p| f64::from(p.0[0])).collect();
@@ -81,8 +110,15 @@ pub fn read_folder(dir: &Path, per_frame: usize) -> Result<Sequence, String> {
     if samples.is_empty() {
         return Err(format!("{}: no NAME.png with NAME_mask.png", dir.display()));
     }
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    Ok(Sequence { name, samples, per_frame })
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok(Sequence {
+        name,
+        samples,
+        per_frame,
+    })
 }
 
 /// Writes a sequence as `NNNN_C.png` (16-bit, fixed pixels only) and `NNNN_C_mask.png`, readable by
@@ -97,8 +133,11 @@ pub fn write_folder(sequence: &Sequence, dir: &Path) -> Result<(), String> {
         let image = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, values)
             .ok_or("image buffer size")?;
         let mask = image::GrayImage::from_raw(w, h, mask).ok_or("mask buffer size")?;
-        image.save(dir.join(format!("{stem}.png"))).map_err(|e| e.to_string())?;
-        mask.save(dir.join(format!("{stem}_mask.png"))).map_err(|e| e.to_string())?;
+        image
+            .save(dir.join(format!("{stem}.png")))
+            .map_err(|e| e.to_string())?;
+        mask.save(dir.join(format!("{stem}_mask.png")))
+            .map_err(|e| e.to_string())?;
     }
     Ok(())
 }

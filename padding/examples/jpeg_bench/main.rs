@@ -34,7 +34,9 @@ fn main() {
 
 fn run() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let mode = args.next().ok_or("usage: jpeg_bench synth|folder [options] DIR...")?;
+    let mode = args
+        .next()
+        .ok_or("usage: jpeg_bench synth|folder [options] DIR...")?;
     let mut frames = 16usize;
     let mut per_frame = 1usize;
     let mut dump: Option<PathBuf> = None;
@@ -43,7 +45,9 @@ fn run() -> Result<(), String> {
         let mut value = || args.next().ok_or(format!("{arg} needs a value"));
         match arg.as_str() {
             "--frames" => frames = value()?.parse().map_err(|e| format!("--frames: {e}"))?,
-            "--per-frame" => per_frame = value()?.parse().map_err(|e| format!("--per-frame: {e}"))?,
+            "--per-frame" => {
+                per_frame = value()?.parse().map_err(|e| format!("--per-frame: {e}"))?
+            }
             "--dump" => dump = Some(PathBuf::from(value()?)),
             _ => dirs.push(PathBuf::from(arg)),
         }
@@ -82,7 +86,9 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
     );
     println!("Bytes/frame and RMSE on fixed pixels (grey levels), per JPEG quality:\n");
     print!("| method |");
-    REPORTED.iter().for_each(|q| print!(" q{q} bytes | q{q} RMSE |"));
+    REPORTED
+        .iter()
+        .for_each(|q| print!(" q{q} bytes | q{q} RMSE |"));
     println!(" pad ms/frame | CG iters/frame |");
     println!("|---|{}---:|---:|", "---:|---:|".repeat(REPORTED.len()));
     for r in results {
@@ -95,7 +101,11 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
             " {:.2} | {:.0}{} |",
             r.pad_ms_per_frame,
             r.cg_iterations_per_frame,
-            if r.unconverged > 0 { format!(" ({} capped)", r.unconverged) } else { String::new() }
+            if r.unconverged > 0 {
+                format!(" ({} capped)", r.unconverged)
+            } else {
+                String::new()
+            }
         );
     }
     let Some(reference) = results.iter().find(|r| r.method == Method::Cg) else {
@@ -103,7 +113,12 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
     };
     println!("\nBytes/frame at the RMSE `cg` reaches at q50 / q75 / q90 (log–log interpolation over q {:?}):\n", SWEEP);
     print!("| method |");
-    REPORTED.iter().for_each(|q| print!(" at cg-q{q} RMSE {:.3} |", reference.points[sweep_index(*q)].rmse));
+    REPORTED.iter().for_each(|q| {
+        print!(
+            " at cg-q{q} RMSE {:.3} |",
+            reference.points[sweep_index(*q)].rmse
+        )
+    });
     println!(" mean vs cg |");
     println!("|---|{}---:|", "---:|".repeat(REPORTED.len()));
     for r in results {
@@ -111,7 +126,10 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
         let mut ratios = Vec::new();
         for &q in &REPORTED {
             let target = reference.points[sweep_index(q)].rmse;
-            let (mine, theirs) = (measure::bytes_at_error(r, target), measure::bytes_at_error(reference, target));
+            let (mine, theirs) = (
+                measure::bytes_at_error(r, target),
+                measure::bytes_at_error(reference, target),
+            );
             match mine {
                 Some(b) => {
                     print!(" {b:.0} |");

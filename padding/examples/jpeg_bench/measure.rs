@@ -36,12 +36,22 @@ pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<Meth
     for sample in &sequence.samples {
         let mut image = sample.grey.clone();
         let start = Instant::now();
-        let stats = pad(&mut image, sample.width, sample.height, &sample.fixed, None, &options)
-            .map_err(|e| e.to_string())?;
+        let stats = pad(
+            &mut image,
+            sample.width,
+            sample.height,
+            &sample.fixed,
+            None,
+            &options,
+        )
+        .map_err(|e| e.to_string())?;
         pad_seconds += start.elapsed().as_secs_f64();
         iterations += stats.cg_iterations;
         unconverged += stats.unconverged;
-        let grey: Vec<u8> = image.iter().map(|&v| v.round().clamp(0.0, 255.0) as u8).collect();
+        let grey: Vec<u8> = image
+            .iter()
+            .map(|&v| v.round().clamp(0.0, 255.0) as u8)
+            .collect();
         fixed_count += sample.fixed.iter().filter(|&&f| f).count();
         for (q, &quality) in qualities.iter().enumerate() {
             let (coded, decoded) = jpeg_round_trip(&grey, sample, quality)?;
@@ -74,7 +84,9 @@ fn jpeg_round_trip(grey: &[u8], sample: &Sample, quality: u8) -> Result<(usize, 
         u16::try_from(sample.width).map_err(|_| "image too wide for JPEG")?,
         u16::try_from(sample.height).map_err(|_| "image too tall for JPEG")?,
     );
-    encoder.encode(grey, w, h, jpeg_encoder::ColorType::Luma).map_err(|e| e.to_string())?;
+    encoder
+        .encode(grey, w, h, jpeg_encoder::ColorType::Luma)
+        .map_err(|e| e.to_string())?;
     let decoded = image::load_from_memory_with_format(&coded, image::ImageFormat::Jpeg)
         .map_err(|e| e.to_string())?
         .to_luma8()
