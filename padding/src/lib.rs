@@ -30,7 +30,7 @@ pub use error::PaddingError;
 pub use options::{Method, PaddingOptions};
 
 use block_laplace::BlockLaplace;
-use dct_energy::DctEnergy;
+use dct_energy::{DctEnergy, Weighting};
 use grid::BlockGrid;
 
 /// What a call to [`pad`] did, for benches and diagnostics.
@@ -63,7 +63,7 @@ impl PadStats {
 /// fixed pixel and no previous frame is filled with 0.
 ///
 /// Errors (never panics) on an empty image, buffers whose length is not `width × height`, a zero
-/// block size (or not 8 for [`Method::DctEnergy`]), or a non-finite fixed or previous pixel.
+/// block size (or not 8 for the DCT-based [`Method::DctEnergy`] and [`Method::Biharmonic`]), or a non-finite fixed or previous pixel.
 pub fn pad(
     image: &mut [f32],
     width: usize,
@@ -100,7 +100,7 @@ pub fn pad(
         }
         Method::PushPull => push_pull::fill(image, width, height, &held),
         Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
-        Method::Mean | Method::Cg | Method::DctEnergy => {
+        Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic => {
             let mut block_solver = BlockSolver::new(opts.method);
             let with_fixed = grid.any_set(fixed);
             for b in (0..grid.len()).filter(|&b| with_fixed[b]) {
@@ -131,7 +131,8 @@ impl BlockSolver {
     fn new(method: Method) -> Self {
         match method {
             Method::Cg => BlockSolver::Laplace(Box::default()),
-            Method::DctEnergy => BlockSolver::Dct(Box::default()),
+            Method::DctEnergy => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Quantiser))),
+            Method::Biharmonic => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Biharmonic))),
             _ => BlockSolver::Mean,
         }
     }
@@ -218,7 +219,9 @@ fn validate(
             why: "blocks must be at least one pixel wide",
         });
     }
-    if opts.method == Method::DctEnergy && opts.block != dct_energy::SIDE {
+    if matches!(opts.method, Method::DctEnergy | Method::Biharmonic)
+        && opts.block != dct_energy::SIDE
+    {
         return Err(PaddingError::BadBlock {
             block: opts.block,
             method: opts.method.to_string(),

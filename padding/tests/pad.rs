@@ -221,7 +221,12 @@ fn intra_empty_blocks_are_flat_at_the_neighbours_border_mean() {
             fixed[y * w + x] = true;
         }
     }
-    for method in [Method::Cg, Method::Mean, Method::DctEnergy] {
+    for method in [
+        Method::Cg,
+        Method::Mean,
+        Method::DctEnergy,
+        Method::Biharmonic,
+    ] {
         let mut padded = image.clone();
         pad(&mut padded, w, h, &fixed, None, &opts(method)).unwrap();
         for y in 0..h {
@@ -267,14 +272,16 @@ fn bad_inputs_are_errors_not_panics() {
         pad(&mut image, 3, 4, &[false; 12], None, &zero_block),
         Err(PaddingError::BadBlock { .. })
     ));
-    let dct16 = PaddingOptions {
-        block: 16,
-        ..PaddingOptions::with_method(Method::DctEnergy)
-    };
-    assert!(matches!(
-        pad(&mut image, 3, 4, &[false; 12], None, &dct16),
-        Err(PaddingError::BadBlock { .. })
-    ));
+    for method in [Method::DctEnergy, Method::Biharmonic] {
+        let dct16 = PaddingOptions {
+            block: 16,
+            ..PaddingOptions::with_method(method)
+        };
+        assert!(matches!(
+            pad(&mut image, 3, 4, &[false; 12], None, &dct16),
+            Err(PaddingError::BadBlock { .. })
+        ));
+    }
     image[5] = f32::NAN;
     let mut fixed = [false; 12];
     fixed[5] = true;
@@ -318,6 +325,71 @@ fn smooth_methods_reproduce_a_linear_ramp() {
                 image[i],
                 ramp[i]
             );
+        }
+    }
+}
+
+/// w(u, v) of the DCT coefficient in row u, column v.
+type CoefficientWeight<'a> = dyn Fn(usize, usize) -> f64 + 'a;
+
+/// Σ_{k≠0} w_k c_k² of an 8×8 block, with a textbook (slow) orthonormal DCT.
+fn weighted_ac_energy(block: &[f64], weight: impl Fn(usize, usize) -> f64) -> f64 {
+    let alpha = |k: usize| {
+        if k == 0 {
+            (1.0f64 / 8.0).sqrt()
+        } else {
+            (2.0f64 / 8.0).sqrt()
+        }
+    };
+    let mut energy = 0.0;
+    for u in 0..8 {
+        for v in 0..8 {
+            if (u, v) == (0, 0) {
+                continue;
+            }
+            let mut c = 0.0;
+            for y in 0..8 {
+                for x in 0..8 {
+                    c += block[y * 8 + x]
+                        * (std::f64::consts::PI * (2 * y + 1) as f64 * u as f64 / 16.0).cos()
+                        * (std::f64::consts::PI * (2 * x + 1) as f64 * v as f64 / 16.0).cos();
+                }
+            }
+            energy += weight(u, v) * (alpha(u) * alpha(v) * c).powi(2);
+        }
+    }
+    energy
+}
+
+#[test]
+fn dct_methods_reach_their_energy_minimum() {
+    const ANNEX_K: [f64; 64] = [
+        16., 11., 10., 16., 24., 40., 51., 61., 12., 12., 14., 19., 26., 58., 60., 55., 14., 13.,
+        16., 24., 40., 57., 69., 56., 14., 17., 22., 29., 51., 87., 80., 62., 18., 22., 37., 56.,
+        68., 109., 103., 77., 24., 35., 55., 64., 81., 104., 113., 92., 49., 64., 78., 87., 103.,
+        121., 120., 101., 72., 92., 95., 98., 112., 100., 103., 99.,
+    ];
+    let lambda = |k: usize| 2.0 - 2.0 * (std::f64::consts::PI * k as f64 / 8.0).cos();
+    let values: Vec<f32> = (0..64).map(|i| ((i * 53) % 97) as f32).collect();
+    let fixed: Vec<bool> = (0..64).map(|i| (i * 5 + 2) % 7 < 3).collect();
+    let cases: [(Method, &CoefficientWeight<'_>); 2] = [
+        (Method::DctEnergy, &|u, v| ANNEX_K[u * 8 + v].powi(-2)),
+        (Method::Biharmonic, &|u, v| (lambda(u) + lambda(v)).powi(2)),
+    ];
+    for (method, weight) in cases {
+        let mut image = values.clone();
+        pad(&mut image, 8, 8, &fixed, None, &opts(method)).unwrap();
+        let block: Vec<f64> = image.iter().map(|&v| f64::from(v)).collect();
+        let best = weighted_ac_energy(&block, weight);
+        for i in (0..64).filter(|&i| !fixed[i]) {
+            for step in [-0.05, 0.05] {
+                let mut moved = block.clone();
+                moved[i] += step;
+                assert!(
+                    weighted_ac_energy(&moved, weight) >= best * (1.0 - 1e-9),
+                    "{method}: moving pixel {i} by {step} lowers the energy"
+                );
+            }
         }
     }
 }
