@@ -89,7 +89,7 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
     REPORTED
         .iter()
         .for_each(|q| print!(" q{q} bytes | q{q} RMSE |"));
-    println!(" pad ms/frame | CG iters/frame |");
+    println!(" pad ms/frame | CG iters/system |");
     println!("|---|{}---:|---:|", "---:|---:|".repeat(REPORTED.len()));
     for r in results {
         print!("| {} |", r.method);
@@ -98,9 +98,9 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
             print!(" {:.0} | {:.3} |", p.bytes_per_frame, p.rmse);
         }
         println!(
-            " {:.2} | {:.0}{} |",
+            " {:.2} | {:.1}{} |",
             r.pad_ms_per_frame,
-            r.cg_iterations_per_frame,
+            r.cg_iterations_per_system,
             if r.unconverged > 0 {
                 format!(" ({} capped)", r.unconverged)
             } else {

@@ -20,7 +20,7 @@ pub struct MethodResult {
     /// One point per quality of the sweep, in sweep order.
     pub points: Vec<Point>,
     pub pad_ms_per_frame: f64,
-    pub cg_iterations_per_frame: f64,
+    pub cg_iterations_per_system: f64,
     pub unconverged: usize,
 }
 
@@ -32,6 +32,7 @@ pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<Meth
     let mut fixed_count = 0usize;
     let mut pad_seconds = 0.0;
     let mut iterations = 0usize;
+    let mut systems = 0usize;
     let mut unconverged = 0usize;
     for sample in &sequence.samples {
         let mut image = sample.grey.clone();
@@ -47,6 +48,7 @@ pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<Meth
         .map_err(|e| e.to_string())?;
         pad_seconds += start.elapsed().as_secs_f64();
         iterations += stats.cg_iterations;
+        systems += stats.systems;
         unconverged += stats.unconverged;
         let grey: Vec<u8> = image
             .iter()
@@ -71,7 +73,7 @@ pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<Meth
             })
             .collect(),
         pad_ms_per_frame: pad_seconds * 1000.0 / frames,
-        cg_iterations_per_frame: iterations as f64 / frames,
+        cg_iterations_per_system: iterations as f64 / systems.max(1) as f64,
         unconverged,
     })
 }
