@@ -1,5 +1,6 @@
 //! Blocks with no fixed pixel: copied from the previous frame (P-frames: the codec skips them) or, in
-//! intra frames, set flat to the mean of the pixels bordering them in already-padded blocks.
+//! intra frames, set flat: by default to the mean of the pixels bordering them in already-padded
+//! blocks (see [`crate::EmptyBlocks`]).
 //!
 //! Flat is what costs JPEG least in an empty block: a flat block is a DC value and an end-of-block
 //! code, and taking the neighbours' border mean keeps that DC close to the neighbours' (DC is coded
@@ -24,6 +25,16 @@ pub(crate) fn copy_from_previous(
             held[i] = true;
         }
         *done = true;
+    }
+}
+
+/// Sets every block not `filled` to `value`.
+pub(crate) fn fill_flat(grid: &BlockGrid, image: &mut [f32], filled: &mut [bool], value: f32) {
+    for (b, done) in filled.iter_mut().enumerate() {
+        if !*done {
+            grid.pixels(grid.rect(b)).for_each(|i| image[i] = value);
+            *done = true;
+        }
     }
 }
 
@@ -72,12 +83,7 @@ pub(crate) fn fill_flat_from_neighbours(
         }
         if assignments.is_empty() {
             // Unreachable on a connected block grid; kept so a logic slip cannot loop forever.
-            for (b, done) in filled.iter_mut().enumerate() {
-                if !*done {
-                    grid.pixels(grid.rect(b)).for_each(|i| image[i] = fallback);
-                    *done = true;
-                }
-            }
+            fill_flat(grid, image, filled, fallback);
             break;
         }
         for &(b, value) in &assignments {

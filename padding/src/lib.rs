@@ -27,7 +27,7 @@ mod options;
 mod push_pull;
 
 pub use error::PaddingError;
-pub use options::{Method, PaddingOptions};
+pub use options::{EmptyBlocks, Method, PaddingOptions};
 
 use block_laplace::BlockLaplace;
 use dct_energy::{DctEnergy, Weighting};
@@ -115,7 +115,15 @@ pub fn pad(
                     }
                 }
             }
-            empty_blocks::fill_flat_from_neighbours(&grid, image, &mut filled, 0.0);
+            match opts.empty_blocks {
+                EmptyBlocks::NeighbourMean => {
+                    empty_blocks::fill_flat_from_neighbours(&grid, image, &mut filled, 0.0);
+                }
+                EmptyBlocks::FixedMean => {
+                    let mean = fixed_mean(image, fixed);
+                    empty_blocks::fill_flat(&grid, image, &mut filled, mean);
+                }
+            }
         }
     }
     Ok(stats)
@@ -153,6 +161,21 @@ fn fill_block_mean(grid: &BlockGrid, rect: grid::BlockRect, image: &mut [f32], f
         if !fixed[i] {
             image[i] = mean;
         }
+    }
+}
+
+fn fixed_mean(image: &[f32], fixed: &[bool]) -> f32 {
+    let (sum, count) = image
+        .iter()
+        .zip(fixed)
+        .filter(|(_, &f)| f)
+        .fold((0.0f64, 0usize), |(s, c), (&v, _)| {
+            (s + f64::from(v), c + 1)
+        });
+    if count == 0 {
+        0.0
+    } else {
+        (sum / count as f64) as f32
     }
 }
 

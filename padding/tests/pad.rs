@@ -1,6 +1,6 @@
 //! Behaviour of `padding::pad` through its public API.
 
-use padding::{pad, Method, PaddingError, PaddingOptions};
+use padding::{pad, EmptyBlocks, Method, PaddingError, PaddingOptions};
 use proptest::prelude::*;
 
 fn opts(method: Method) -> PaddingOptions {
@@ -391,5 +391,24 @@ fn dct_methods_reach_their_energy_minimum() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn empty_blocks_can_take_the_fixed_mean_instead() {
+    // Left block fully fixed with column value = x (mean 3.5); the empty right block gets 3.5.
+    let (w, h) = (16, 8);
+    let image: Vec<f32> = (0..w * h)
+        .map(|i| if i % w < 8 { (i % w) as f32 } else { 0.0 })
+        .collect();
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % w < 8).collect();
+    let options = PaddingOptions {
+        empty_blocks: EmptyBlocks::FixedMean,
+        ..opts(Method::Biharmonic)
+    };
+    let mut padded = image.clone();
+    pad(&mut padded, w, h, &fixed, None, &options).unwrap();
+    for i in (0..w * h).filter(|i| i % w >= 8) {
+        assert_eq!(padded[i], 3.5);
     }
 }

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use padding::{pad, Method, PaddingOptions};
+use padding::{pad, PaddingOptions};
 
 use crate::images::{Sample, Sequence};
 
@@ -16,7 +16,7 @@ pub struct Point {
 
 /// Everything measured for one method on one sequence.
 pub struct MethodResult {
-    pub method: Method,
+    pub label: String,
     /// One point per quality of the sweep, in sweep order.
     pub points: Vec<Point>,
     pub pad_ms_per_frame: f64,
@@ -24,9 +24,13 @@ pub struct MethodResult {
     pub unconverged: usize,
 }
 
-/// Pads every sample with `method` and codes it at every quality in `qualities`.
-pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<MethodResult, String> {
-    let options = PaddingOptions::with_method(method);
+/// Pads every sample with `options` and codes it at every quality in `qualities`.
+pub fn run(
+    sequence: &Sequence,
+    label: &str,
+    options: &PaddingOptions,
+    qualities: &[u8],
+) -> Result<MethodResult, String> {
     let mut bytes = vec![0usize; qualities.len()];
     let mut sse = vec![0.0f64; qualities.len()];
     let mut fixed_count = 0usize;
@@ -43,7 +47,7 @@ pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<Meth
             sample.height,
             &sample.fixed,
             None,
-            &options,
+            options,
         )
         .map_err(|e| e.to_string())?;
         pad_seconds += start.elapsed().as_secs_f64();
@@ -63,7 +67,7 @@ pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<Meth
     }
     let frames = sequence.frames();
     Ok(MethodResult {
-        method,
+        label: label.to_string(),
         points: bytes
             .iter()
             .zip(&sse)
