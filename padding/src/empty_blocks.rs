@@ -1,10 +1,6 @@
 //! Blocks with no fixed pixel: copied from the previous frame (P-frames: the codec skips them) or, in
-//! intra frames, set flat: by default to the mean of the pixels bordering them in already-padded
-//! blocks (see [`crate::EmptyBlocks`]).
-//!
-//! Flat is what costs JPEG least in an empty block: a flat block is a DC value and an end-of-block
-//! code, and taking the neighbours' border mean keeps that DC close to the neighbours' (DC is coded
-//! as a difference from the previous block) and keeps the step at the block edge small.
+//! intra frames, set flat (a DC value and an end-of-block code for JPEG) at a level chosen by
+//! [`crate::EmptyBlocks`].
 
 use crate::grid::BlockGrid;
 
@@ -25,6 +21,27 @@ pub(crate) fn copy_from_previous(
             held[i] = true;
         }
         *done = true;
+    }
+}
+
+/// Sets every block not `filled` to the mean of the block before it in raster order (which is
+/// filled by then), or to `first` while no block before it is.
+pub(crate) fn fill_from_raster_previous(
+    grid: &BlockGrid,
+    image: &mut [f32],
+    filled: &mut [bool],
+    first: f32,
+) {
+    let mut previous_mean = first;
+    for (b, done) in filled.iter_mut().enumerate() {
+        let rect = grid.rect(b);
+        if !*done {
+            grid.pixels(rect).for_each(|i| image[i] = previous_mean);
+            *done = true;
+        } else {
+            let sum: f64 = grid.pixels(rect).map(|i| f64::from(image[i])).sum();
+            previous_mean = (sum / (rect.w * rect.h) as f64) as f32;
+        }
     }
 }
 

@@ -59,7 +59,7 @@ impl PadStats {
 ///
 /// `previous` is the previous padded frame (same size) when coding P-frames: blocks without a fixed
 /// pixel copy it, so the codec can skip them. Without it (intra), such blocks are filled as the
-/// method says (block methods: flat, at the mean of the bordering padded pixels). An image with no
+/// method says (block methods: flat, see [`EmptyBlocks`]). An image with no
 /// fixed pixel and no previous frame is filled with 0.
 ///
 /// Errors (never panics) on an empty image, buffers whose length is not `width × height`, a zero
@@ -122,6 +122,10 @@ pub fn pad(
                 EmptyBlocks::FixedMean => {
                     let mean = fixed_mean(image, fixed);
                     empty_blocks::fill_flat(&grid, image, &mut filled, mean);
+                }
+                EmptyBlocks::RasterPrevious => {
+                    let mean = fixed_mean(image, fixed);
+                    empty_blocks::fill_from_raster_previous(&grid, image, &mut filled, mean);
                 }
             }
         }

@@ -92,17 +92,22 @@ impl FromStr for Method {
 }
 
 /// How the block methods (`cg`, `mean`, `dct`, `biharmonic`) fill, in intra frames, the blocks
-/// that hold no fixed pixel. Either way the block is flat, so JPEG codes it as a DC value and an
-/// end-of-block.
+/// that hold no fixed pixel. Each way the block is flat, so JPEG codes it as a DC value and an
+/// end-of-block; they differ in the DC, which JPEG codes as the difference from the previous
+/// block's DC in raster order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum EmptyBlocks {
-    /// The mean of the bordering pixels of adjacent already-filled blocks, growing outwards from
-    /// the charts: DC stays close to the neighbours' (DC is coded as a difference) and the step at
-    /// the block edge is small. Measured cheaper than `FixedMean`.
+    /// The mean of the previous block in raster order (the fixed-pixel mean before the first
+    /// filled block): DC differences are 0 along every run of empty blocks, paid only where a chart
+    /// starts again. Measured the cheapest of the three.
     #[default]
-    NeighbourMean,
-    /// The mean of all fixed pixels of the image.
+    RasterPrevious,
+    /// The mean of all fixed pixels of the image: equal DCs within runs of empty blocks, but a DC
+    /// step both where a run starts and where it ends.
     FixedMean,
+    /// The mean of the bordering pixels of adjacent already-filled blocks, growing outwards from
+    /// the charts: the smallest step at block edges, but a different DC in almost every block.
+    NeighbourMean,
 }
 
 /// Settings of [`crate::pad`]. `Default` is what the encoder should use: [`Method::Biharmonic`], the
@@ -133,7 +138,7 @@ impl Default for PaddingOptions {
             block: 8,
             tolerance: 1e-5,
             max_iterations: 400,
-            empty_blocks: EmptyBlocks::NeighbourMean,
+            empty_blocks: EmptyBlocks::RasterPrevious,
         }
     }
 }

@@ -228,7 +228,11 @@ fn intra_empty_blocks_are_flat_at_the_neighbours_border_mean() {
         Method::Biharmonic,
     ] {
         let mut padded = image.clone();
-        pad(&mut padded, w, h, &fixed, None, &opts(method)).unwrap();
+        let options = PaddingOptions {
+            empty_blocks: EmptyBlocks::NeighbourMean,
+            ..opts(method)
+        };
+        pad(&mut padded, w, h, &fixed, None, &options).unwrap();
         for y in 0..h {
             for x in 8..16 {
                 assert_eq!(padded[y * w + x], 7.0, "{method}");
@@ -411,4 +415,27 @@ fn empty_blocks_can_take_the_fixed_mean_instead() {
     for i in (0..w * h).filter(|i| i % w >= 8) {
         assert_eq!(padded[i], 3.5);
     }
+}
+
+#[test]
+fn empty_blocks_by_default_repeat_the_previous_block_in_raster_order() {
+    // Blocks: [empty, fixed at 10 | empty, empty]: the first empty block precedes any filled one
+    // and takes the fixed mean (10); the second row's blocks follow the fixed block and take its mean.
+    let (w, h) = (16, 16);
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % w >= 8 && i / w < 8).collect();
+    let image: Vec<f32> = fixed.iter().map(|&f| if f { 10.0 } else { 0.0 }).collect();
+    for method in [Method::Cg, Method::Biharmonic] {
+        let mut padded = image.clone();
+        pad(&mut padded, w, h, &fixed, None, &opts(method)).unwrap();
+        assert!(padded.iter().all(|&v| v == 10.0), "{method}");
+    }
+    // A ramp block: the following empty block takes the ramp block's mean, 3.5.
+    let (w, h) = (16, 8);
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % w < 8).collect();
+    let image: Vec<f32> = (0..w * h)
+        .map(|i| if i % w < 8 { (i % w) as f32 } else { 0.0 })
+        .collect();
+    let mut padded = image.clone();
+    pad(&mut padded, w, h, &fixed, None, &opts(Method::Biharmonic)).unwrap();
+    assert!((0..w * h).filter(|i| i % w >= 8).all(|i| padded[i] == 3.5));
 }

@@ -68,13 +68,20 @@ fn run() -> Result<(), String> {
             .iter()
             .map(|&m| (m.to_string(), PaddingOptions::with_method(m)))
             .collect();
-        variants.push((
-            "biharmonic, empty blocks at fixed mean".into(),
-            PaddingOptions {
-                empty_blocks: EmptyBlocks::FixedMean,
-                ..PaddingOptions::with_method(Method::Biharmonic)
-            },
-        ));
+        for (name, empty_blocks) in [
+            ("fixed mean", EmptyBlocks::FixedMean),
+            ("neighbour mean", EmptyBlocks::NeighbourMean),
+        ] {
+            for method in [Method::Cg, Method::Biharmonic] {
+                variants.push((
+                    format!("{method}, empty blocks at {name}"),
+                    PaddingOptions {
+                        empty_blocks,
+                        ..PaddingOptions::with_method(method)
+                    },
+                ));
+            }
+        }
         let results = variants
             .iter()
             .map(|(label, options)| measure::run(&sequence, label, options, &SWEEP))
