@@ -32,10 +32,12 @@ proptest! {
         let values: Vec<f32> = (0..n).map(|_| (next() * 510.0 - 255.0) as f32).collect();
         let fixed: Vec<bool> = (0..n).map(|_| next() < density).collect();
         let previous: Vec<f32> = (0..n).map(|_| (next() * 100.0) as f32).collect();
-        for method in Method::ALL {
+        let empty_fills = [EmptyBlocks::RasterPrevious, EmptyBlocks::FixedMean, EmptyBlocks::NeighbourMean];
+        for (method, empty_blocks) in Method::ALL.into_iter().flat_map(|m| empty_fills.map(|e| (m, e))) {
             let mut image = values.clone();
             let prev = with_previous.then_some(previous.as_slice());
-            pad(&mut image, width, height, &fixed, prev, &opts(method)).unwrap();
+            let options = PaddingOptions { empty_blocks, ..opts(method) };
+            pad(&mut image, width, height, &fixed, prev, &options).unwrap();
             for i in 0..n {
                 prop_assert!(image[i].is_finite(), "{method}: pixel {i} not finite");
                 if fixed[i] {
