@@ -100,8 +100,8 @@ pub fn pad(
         }
         Method::PushPull => push_pull::fill(image, width, height, &held),
         Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
-        Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic => {
-            let mut block_solver = BlockSolver::new(opts.method);
+        Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic | Method::Snap => {
+            let mut block_solver = BlockSolver::new(opts);
             let with_fixed = grid.any_set(fixed);
             for b in (0..grid.len()).filter(|&b| with_fixed[b]) {
                 let rect = grid.rect(b);
@@ -140,11 +140,14 @@ enum BlockSolver {
 }
 
 impl BlockSolver {
-    fn new(method: Method) -> Self {
-        match method {
+    fn new(opts: &PaddingOptions) -> Self {
+        match opts.method {
             Method::Cg => BlockSolver::Laplace(Box::default()),
             Method::DctEnergy => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Quantiser))),
             Method::Biharmonic => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Biharmonic))),
+            Method::Snap => BlockSolver::Dct(Box::new(
+                DctEnergy::new(Weighting::Biharmonic).with_snap(opts.jpeg_quality),
+            )),
             _ => BlockSolver::Mean,
         }
     }
@@ -246,8 +249,10 @@ fn validate(
             why: "blocks must be at least one pixel wide",
         });
     }
-    if matches!(opts.method, Method::DctEnergy | Method::Biharmonic)
-        && opts.block != dct_energy::SIDE
+    if matches!(
+        opts.method,
+        Method::DctEnergy | Method::Biharmonic | Method::Snap
+    ) && opts.block != dct_energy::SIDE
     {
         return Err(PaddingError::BadBlock {
             block: opts.block,

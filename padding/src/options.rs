@@ -27,11 +27,14 @@ pub enum Method {
     /// Per 8×8 block, minimise ‖Δb‖² (thin-plate smoothness, in the DCT basis Σ λ_k² c_k²), fixed
     /// pixels held: continues the chart's gradient instead of flattening at its border.
     Biharmonic,
+    /// `biharmonic`, then alternately quantised at `jpeg_quality` and given back its fixed pixels,
+    /// so the coefficients JPEG will drop are already ~0 (the error they would cause moves to free pixels).
+    Snap,
 }
 
 impl Method {
     /// Every method, in the order the bench reports them.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 8] = [
         Method::MidGrey,
         Method::Mean,
         Method::PushPull,
@@ -39,10 +42,11 @@ impl Method {
         Method::Laplace,
         Method::DctEnergy,
         Method::Biharmonic,
+        Method::Snap,
     ];
 
     /// The names accepted by [`FromStr`] (the `--padding` values).
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 8] = [
         "midgrey",
         "mean",
         "pushpull",
@@ -50,6 +54,7 @@ impl Method {
         "laplace",
         "dct",
         "biharmonic",
+        "snap",
     ];
 
     /// The `--padding` name of this method.
@@ -62,6 +67,7 @@ impl Method {
             Method::Laplace => "laplace",
             Method::DctEnergy => "dct",
             Method::Biharmonic => "biharmonic",
+            Method::Snap => "snap",
         }
     }
 }
@@ -85,6 +91,7 @@ impl FromStr for Method {
             "laplace" => Method::Laplace,
             "dct" | "dct-energy" | "dctenergy" => Method::DctEnergy,
             "biharmonic" | "thin-plate" => Method::Biharmonic,
+            "snap" => Method::Snap,
             _ => return Err(PaddingError::UnknownMethod(s.to_string())),
         };
         Ok(method)
@@ -130,6 +137,8 @@ pub struct PaddingOptions {
     pub max_iterations: usize,
     /// Fill of blocks without fixed pixels in intra frames (block methods only).
     pub empty_blocks: EmptyBlocks,
+    /// The JPEG quality the image will be coded at (1–100); only [`Method::Snap`] uses it.
+    pub jpeg_quality: u8,
 }
 
 impl Default for PaddingOptions {
@@ -140,6 +149,7 @@ impl Default for PaddingOptions {
             tolerance: 1e-5,
             max_iterations: 400,
             empty_blocks: EmptyBlocks::RasterPrevious,
+            jpeg_quality: 75,
         }
     }
 }

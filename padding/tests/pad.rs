@@ -441,3 +441,46 @@ fn empty_blocks_by_default_repeat_the_previous_block_in_raster_order() {
     pad(&mut padded, w, h, &fixed, None, &opts(Method::Biharmonic)).unwrap();
     assert!((0..w * h).filter(|i| i % w >= 8).all(|i| padded[i] == 3.5));
 }
+
+#[test]
+fn snap_leaves_less_energy_in_the_coefficients_jpeg_drops() {
+    // Annex K at quality 75 (libjpeg scaling: 200 − 2q = 50 %).
+    const ANNEX_K: [f64; 64] = [
+        16., 11., 10., 16., 24., 40., 51., 61., 12., 12., 14., 19., 26., 58., 60., 55., 14., 13.,
+        16., 24., 40., 57., 69., 56., 14., 17., 22., 29., 51., 87., 80., 62., 18., 22., 37., 56.,
+        68., 109., 103., 77., 24., 35., 55., 64., 81., 104., 113., 92., 49., 64., 78., 87., 103.,
+        121., 120., 101., 72., 92., 95., 98., 112., 100., 103., 99.,
+    ];
+    let step = |u: usize, v: usize| ((ANNEX_K[u * 8 + v] * 50.0 + 50.0) / 100.0).floor();
+    let values: Vec<f32> = (0..64)
+        .map(|i| ((i * 53) % 97) as f32 + (i / 8) as f32 * 9.0)
+        .collect();
+    let fixed: Vec<bool> = (0..64).map(|i| (i % 8) < 4 && (i / 8) < 5).collect();
+    let dropped = |method: Method| {
+        let mut image = values.clone();
+        let options = PaddingOptions {
+            jpeg_quality: 75,
+            ..opts(method)
+        };
+        pad(&mut image, 8, 8, &fixed, None, &options).unwrap();
+        let block: Vec<f64> = image.iter().map(|&v| f64::from(v)).collect();
+        // Energy of the coefficients the quantiser zeroes: the weight keeps a coefficient only if it
+        // is under half its step, so each coefficient is tested on its own.
+        let mut total = 0.0;
+        for u in 0..8 {
+            for v in 0..8 {
+                let only = |a: usize, b: usize| if (a, b) == (u, v) { 1.0 } else { 0.0 };
+                let c2 = weighted_ac_energy(&block, only);
+                if (u, v) != (0, 0) && c2.sqrt() < 0.5 * step(u, v) {
+                    total += c2;
+                }
+            }
+        }
+        total
+    };
+    let (snap, biharmonic) = (dropped(Method::Snap), dropped(Method::Biharmonic));
+    assert!(
+        snap < 0.5 * biharmonic,
+        "snap {snap} vs biharmonic {biharmonic}"
+    );
+}
