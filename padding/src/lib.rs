@@ -63,7 +63,7 @@ impl PadStats {
 /// fixed pixel and no previous frame is filled with 0.
 ///
 /// Errors (never panics) on an empty image, buffers whose length is not `width × height`, a zero
-/// block size (or not 8 for the DCT-based [`Method::DctEnergy`] and [`Method::Biharmonic`]), or a non-finite fixed or previous pixel.
+/// block size (or not 8 for the DCT-based `dct`, `biharmonic` and `snap`), or a non-finite fixed or previous pixel.
 pub fn pad(
     image: &mut [f32],
     width: usize,
