@@ -10,6 +10,11 @@
 //!   harmonic fill with kinks at the chart border, this continues the chart's gradient, and JPEG
 //!   spends fewer high-frequency coefficients on it (the measured winner).
 //!
+//! `snap` follows the biharmonic solve with 30 rounds of: DCT, zero the AC coefficients JPEG's
+//! quantiser at the target quality would round to 0 (|c_k| < Q_k/2), inverse DCT, put the fixed pixels
+//! back. The coefficients JPEG will drop are then ~0 already, so dropping them moves little error onto
+//! the fixed pixels (alternating projections; 100 rounds measured only 0.2 % better than 30).
+//!
 //! With b = P·x + f (x the free pixels, f the fixed ones), E is minimised by
 //! Pᵀ DᵀWD P x = −Pᵀ DᵀWD f, an SPD system solved by CG: W ≥ 0 with only DC unweighted and D
 //! orthogonal, so a null vector would be a constant block that is 0 on the fixed pixels. Pixels of a
@@ -37,6 +42,9 @@ pub(crate) struct DctEnergy {
     /// basis[k * SIDE + n] = α_k cos(π (2n+1) k / 16).
     basis: [f64; N],
     weight: [f64; N],
+    /// JPEG quantiser steps (orthonormal-DCT units, equal to JPEG's table entries) at the target
+    /// quality, when the solve is followed by snapping to what the quantiser keeps.
+    snap_steps: Option<[f64; N]>,
     unknowns: Vec<usize>,
     rhs: Vec<f64>,
     x: Vec<f64>,
@@ -85,6 +93,7 @@ impl DctEnergy {
         DctEnergy {
             basis,
             weight,
+            snap_steps: None,
             unknowns: Vec::new(),
             rhs: Vec::new(),
             x: Vec::new(),
@@ -94,6 +103,23 @@ impl DctEnergy {
 }
 
 impl DctEnergy {
+    /// After each solve, alternate (SNAP_ROUNDS times) between the JPEG quantiser at `quality`
+    /// (Annex K table scaled as libjpeg does) and putting the fixed pixels back.
+    pub fn with_snap(mut self, quality: u8) -> Self {
+        let quality = u32::from(quality.clamp(1, 100));
+        let scale = if quality < 50 {
+            5000 / quality
+        } else {
+            200 - quality * 2
+        };
+        self.snap_steps = Some(ANNEX_K_LUMA.map(|t| {
+            ((t * scale as f64 + 50.0) / 100.0)
+                .floor()
+                .clamp(1.0, 255.0)
+        }));
+        self
+    }
+
     /// Pads the free pixels of one block that holds at least one fixed pixel.
     pub fn pad_block(
         &mut self,
@@ -165,6 +191,29 @@ impl DctEnergy {
             &mut self.scratch,
         );
         stats.record(report);
+        if let Some(steps) = &self.snap_steps {
+            let mut block = known;
+            for (&u, &value) in self.unknowns.iter().zip(&self.x) {
+                block[u] = value;
+            }
+            for _ in 0..SNAP_ROUNDS {
+                let mut c = [0.0; N];
+                transform(basis, &block, &mut c, false);
+                for (ck, q) in c.iter_mut().zip(steps).skip(1) {
+                    if ck.abs() < 0.5 * q {
+                        *ck = 0.0;
+                    }
+                }
+                let mut back = [0.0; N];
+                transform(basis, &c, &mut back, true);
+                for &u in &self.unknowns {
+                    block[u] = back[u];
+                }
+            }
+            for (x, &u) in self.x.iter_mut().zip(&self.unknowns) {
+                *x = block[u];
+            }
+        }
         for (&u, &value) in self.unknowns.iter().zip(&self.x) {
             let (x, y) = (u % SIDE, u / SIDE);
             if x < rect.w && y < rect.h && !is_fixed[u] {
@@ -173,6 +222,9 @@ impl DctEnergy {
         }
     }
 }
+
+/// Projection rounds of `snap` (see the module doc).
+const SNAP_ROUNDS: usize = 30;
 
 /// Separable 2-D DCT (`inverse == false`: c = D b Dᵀ) or its transpose (b = Dᵀ c D).
 fn transform(basis: &[f64; N], input: &[f64; N], output: &mut [f64; N], inverse: bool) {

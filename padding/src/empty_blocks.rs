@@ -1,9 +1,6 @@
 //! Blocks with no fixed pixel: copied from the previous frame (P-frames: the codec skips them) or, in
-//! intra frames, set flat to the mean of the pixels bordering them in already-padded blocks.
-//!
-//! Flat is what costs JPEG least in an empty block: a flat block is a DC value and an end-of-block
-//! code, and taking the neighbours' border mean keeps that DC close to the neighbours' (DC is coded
-//! as a difference from the previous block) and keeps the step at the block edge small.
+//! intra frames, set flat (a DC value and an end-of-block code for JPEG) at a level chosen by
+//! [`crate::EmptyBlocks`].
 
 use crate::grid::BlockGrid;
 
@@ -24,6 +21,37 @@ pub(crate) fn copy_from_previous(
             held[i] = true;
         }
         *done = true;
+    }
+}
+
+/// Sets every block not `filled` to the mean of the block before it in raster order (which is
+/// filled by then), or to `first` while no block before it is.
+pub(crate) fn fill_from_raster_previous(
+    grid: &BlockGrid,
+    image: &mut [f32],
+    filled: &mut [bool],
+    first: f32,
+) {
+    let mut previous_mean = first;
+    for (b, done) in filled.iter_mut().enumerate() {
+        let rect = grid.rect(b);
+        if !*done {
+            grid.pixels(rect).for_each(|i| image[i] = previous_mean);
+            *done = true;
+        } else {
+            let sum: f64 = grid.pixels(rect).map(|i| f64::from(image[i])).sum();
+            previous_mean = (sum / (rect.w * rect.h) as f64) as f32;
+        }
+    }
+}
+
+/// Sets every block not `filled` to `value`.
+pub(crate) fn fill_flat(grid: &BlockGrid, image: &mut [f32], filled: &mut [bool], value: f32) {
+    for (b, done) in filled.iter_mut().enumerate() {
+        if !*done {
+            grid.pixels(grid.rect(b)).for_each(|i| image[i] = value);
+            *done = true;
+        }
     }
 }
 
@@ -72,12 +100,7 @@ pub(crate) fn fill_flat_from_neighbours(
         }
         if assignments.is_empty() {
             // Unreachable on a connected block grid; kept so a logic slip cannot loop forever.
-            for (b, done) in filled.iter_mut().enumerate() {
-                if !*done {
-                    grid.pixels(grid.rect(b)).for_each(|i| image[i] = fallback);
-                    *done = true;
-                }
-            }
+            fill_flat(grid, image, filled, fallback);
             break;
         }
         for &(b, value) in &assignments {

@@ -27,7 +27,7 @@ mod options;
 mod push_pull;
 
 pub use error::PaddingError;
-pub use options::{Method, PaddingOptions};
+pub use options::{EmptyBlocks, Method, PaddingOptions};
 
 use block_laplace::BlockLaplace;
 use dct_energy::{DctEnergy, Weighting};
@@ -59,11 +59,11 @@ impl PadStats {
 ///
 /// `previous` is the previous padded frame (same size) when coding P-frames: blocks without a fixed
 /// pixel copy it, so the codec can skip them. Without it (intra), such blocks are filled as the
-/// method says (block methods: flat, at the mean of the bordering padded pixels). An image with no
+/// method says (block methods: flat, see [`EmptyBlocks`]). An image with no
 /// fixed pixel and no previous frame is filled with 0.
 ///
 /// Errors (never panics) on an empty image, buffers whose length is not `width × height`, a zero
-/// block size (or not 8 for the DCT-based [`Method::DctEnergy`] and [`Method::Biharmonic`]), or a non-finite fixed or previous pixel.
+/// block size (or not 8 for the DCT-based `dct`, `biharmonic` and `snap`), or a non-finite fixed or previous pixel.
 pub fn pad(
     image: &mut [f32],
     width: usize,
@@ -100,8 +100,8 @@ pub fn pad(
         }
         Method::PushPull => push_pull::fill(image, width, height, &held),
         Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
-        Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic => {
-            let mut block_solver = BlockSolver::new(opts.method);
+        Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic | Method::Snap => {
+            let mut block_solver = BlockSolver::new(opts);
             let with_fixed = grid.any_set(fixed);
             for b in (0..grid.len()).filter(|&b| with_fixed[b]) {
                 let rect = grid.rect(b);
@@ -115,7 +115,19 @@ pub fn pad(
                     }
                 }
             }
-            empty_blocks::fill_flat_from_neighbours(&grid, image, &mut filled, 0.0);
+            match opts.empty_blocks {
+                EmptyBlocks::NeighbourMean => {
+                    empty_blocks::fill_flat_from_neighbours(&grid, image, &mut filled, 0.0);
+                }
+                EmptyBlocks::FixedMean => {
+                    let mean = fixed_mean(image, fixed);
+                    empty_blocks::fill_flat(&grid, image, &mut filled, mean);
+                }
+                EmptyBlocks::RasterPrevious => {
+                    let mean = fixed_mean(image, fixed);
+                    empty_blocks::fill_from_raster_previous(&grid, image, &mut filled, mean);
+                }
+            }
         }
     }
     Ok(stats)
@@ -128,11 +140,14 @@ enum BlockSolver {
 }
 
 impl BlockSolver {
-    fn new(method: Method) -> Self {
-        match method {
+    fn new(opts: &PaddingOptions) -> Self {
+        match opts.method {
             Method::Cg => BlockSolver::Laplace(Box::default()),
             Method::DctEnergy => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Quantiser))),
             Method::Biharmonic => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Biharmonic))),
+            Method::Snap => BlockSolver::Dct(Box::new(
+                DctEnergy::new(Weighting::Biharmonic).with_snap(opts.jpeg_quality),
+            )),
             _ => BlockSolver::Mean,
         }
     }
@@ -153,6 +168,21 @@ fn fill_block_mean(grid: &BlockGrid, rect: grid::BlockRect, image: &mut [f32], f
         if !fixed[i] {
             image[i] = mean;
         }
+    }
+}
+
+fn fixed_mean(image: &[f32], fixed: &[bool]) -> f32 {
+    let (sum, count) = image
+        .iter()
+        .zip(fixed)
+        .filter(|(_, &f)| f)
+        .fold((0.0f64, 0usize), |(s, c), (&v, _)| {
+            (s + f64::from(v), c + 1)
+        });
+    if count == 0 {
+        0.0
+    } else {
+        (sum / count as f64) as f32
     }
 }
 
@@ -219,8 +249,10 @@ fn validate(
             why: "blocks must be at least one pixel wide",
         });
     }
-    if matches!(opts.method, Method::DctEnergy | Method::Biharmonic)
-        && opts.block != dct_energy::SIDE
+    if matches!(
+        opts.method,
+        Method::DctEnergy | Method::Biharmonic | Method::Snap
+    ) && opts.block != dct_energy::SIDE
     {
         return Err(PaddingError::BadBlock {
             block: opts.block,

@@ -18,7 +18,7 @@ pub(crate) fn fill(image: &mut [f32], width: usize, height: usize, held: &[bool]
     }
     let mut filled = levels.pop().map(|l| l.value).unwrap_or_default();
     while let Some(level) = levels.pop() {
-        filled = level.pull(&levels_dims(&level), &filled);
+        filled = level.pull(coarse_dims(&level), &filled);
     }
     for ((pixel, &value), &h) in image.iter_mut().zip(&filled).zip(held) {
         if !h {
@@ -27,7 +27,8 @@ pub(crate) fn fill(image: &mut [f32], width: usize, height: usize, held: &[bool]
     }
 }
 
-fn levels_dims(level: &Level) -> (usize, usize) {
+/// Size of the level one push above `level`.
+fn coarse_dims(level: &Level) -> (usize, usize) {
     (level.width.div_ceil(2), level.height.div_ceil(2))
 }
 
@@ -40,7 +41,7 @@ struct Level {
 
 impl Level {
     fn push(&self) -> Level {
-        let (cw, ch) = levels_dims(self);
+        let (cw, ch) = coarse_dims(self);
         let mut value = vec![0.0; cw * ch];
         let mut weight = vec![0.0; cw * ch];
         for cy in 0..ch {
@@ -70,8 +71,7 @@ impl Level {
     }
 
     /// This level with its holes filled from `coarse` (fully filled, `dims` in size).
-    fn pull(&self, dims: &(usize, usize), coarse: &[f64]) -> Vec<f64> {
-        let (cw, ch) = *dims;
+    fn pull(&self, (cw, ch): (usize, usize), coarse: &[f64]) -> Vec<f64> {
         let sample = |x: usize, y: usize| coarse[y.min(ch - 1) * cw + x.min(cw - 1)];
         let mut out = Vec::with_capacity(self.value.len());
         for y in 0..self.height {

@@ -1,6 +1,6 @@
 //! Behaviour of `padding::pad` through its public API.
 
-use padding::{pad, Method, PaddingError, PaddingOptions};
+use padding::{pad, EmptyBlocks, Method, PaddingError, PaddingOptions};
 use proptest::prelude::*;
 
 fn opts(method: Method) -> PaddingOptions {
@@ -32,10 +32,12 @@ proptest! {
         let values: Vec<f32> = (0..n).map(|_| (next() * 510.0 - 255.0) as f32).collect();
         let fixed: Vec<bool> = (0..n).map(|_| next() < density).collect();
         let previous: Vec<f32> = (0..n).map(|_| (next() * 100.0) as f32).collect();
-        for method in Method::ALL {
+        let empty_fills = [EmptyBlocks::RasterPrevious, EmptyBlocks::FixedMean, EmptyBlocks::NeighbourMean];
+        for (method, empty_blocks) in Method::ALL.into_iter().flat_map(|m| empty_fills.map(|e| (m, e))) {
             let mut image = values.clone();
             let prev = with_previous.then_some(previous.as_slice());
-            pad(&mut image, width, height, &fixed, prev, &opts(method)).unwrap();
+            let options = PaddingOptions { empty_blocks, ..opts(method) };
+            pad(&mut image, width, height, &fixed, prev, &options).unwrap();
             for i in 0..n {
                 prop_assert!(image[i].is_finite(), "{method}: pixel {i} not finite");
                 if fixed[i] {
@@ -228,7 +230,11 @@ fn intra_empty_blocks_are_flat_at_the_neighbours_border_mean() {
         Method::Biharmonic,
     ] {
         let mut padded = image.clone();
-        pad(&mut padded, w, h, &fixed, None, &opts(method)).unwrap();
+        let options = PaddingOptions {
+            empty_blocks: EmptyBlocks::NeighbourMean,
+            ..opts(method)
+        };
+        pad(&mut padded, w, h, &fixed, None, &options).unwrap();
         for y in 0..h {
             for x in 8..16 {
                 assert_eq!(padded[y * w + x], 7.0, "{method}");
@@ -392,4 +398,89 @@ fn dct_methods_reach_their_energy_minimum() {
             }
         }
     }
+}
+
+#[test]
+fn empty_blocks_can_take_the_fixed_mean_instead() {
+    // Left block fully fixed with column value = x (mean 3.5); the empty right block gets 3.5.
+    let (w, h) = (16, 8);
+    let image: Vec<f32> = (0..w * h)
+        .map(|i| if i % w < 8 { (i % w) as f32 } else { 0.0 })
+        .collect();
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % w < 8).collect();
+    let options = PaddingOptions {
+        empty_blocks: EmptyBlocks::FixedMean,
+        ..opts(Method::Biharmonic)
+    };
+    let mut padded = image.clone();
+    pad(&mut padded, w, h, &fixed, None, &options).unwrap();
+    for i in (0..w * h).filter(|i| i % w >= 8) {
+        assert_eq!(padded[i], 3.5);
+    }
+}
+
+#[test]
+fn empty_blocks_by_default_repeat_the_previous_block_in_raster_order() {
+    // Blocks: [empty, fixed at 10 | empty, empty]: the first empty block precedes any filled one
+    // and takes the fixed mean (10); the second row's blocks follow the fixed block and take its mean.
+    let (w, h) = (16, 16);
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % w >= 8 && i / w < 8).collect();
+    let image: Vec<f32> = fixed.iter().map(|&f| if f { 10.0 } else { 0.0 }).collect();
+    for method in [Method::Cg, Method::Biharmonic] {
+        let mut padded = image.clone();
+        pad(&mut padded, w, h, &fixed, None, &opts(method)).unwrap();
+        assert!(padded.iter().all(|&v| v == 10.0), "{method}");
+    }
+    // A ramp block: the following empty block takes the ramp block's mean, 3.5.
+    let (w, h) = (16, 8);
+    let fixed: Vec<bool> = (0..w * h).map(|i| i % w < 8).collect();
+    let image: Vec<f32> = (0..w * h)
+        .map(|i| if i % w < 8 { (i % w) as f32 } else { 0.0 })
+        .collect();
+    let mut padded = image.clone();
+    pad(&mut padded, w, h, &fixed, None, &opts(Method::Biharmonic)).unwrap();
+    assert!((0..w * h).filter(|i| i % w >= 8).all(|i| padded[i] == 3.5));
+}
+
+#[test]
+fn snap_leaves_less_energy_in_the_coefficients_jpeg_drops() {
+    // Annex K at quality 75 (libjpeg scaling: 200 − 2q = 50 %).
+    const ANNEX_K: [f64; 64] = [
+        16., 11., 10., 16., 24., 40., 51., 61., 12., 12., 14., 19., 26., 58., 60., 55., 14., 13.,
+        16., 24., 40., 57., 69., 56., 14., 17., 22., 29., 51., 87., 80., 62., 18., 22., 37., 56.,
+        68., 109., 103., 77., 24., 35., 55., 64., 81., 104., 113., 92., 49., 64., 78., 87., 103.,
+        121., 120., 101., 72., 92., 95., 98., 112., 100., 103., 99.,
+    ];
+    let step = |u: usize, v: usize| ((ANNEX_K[u * 8 + v] * 50.0 + 50.0) / 100.0).floor();
+    let values: Vec<f32> = (0..64)
+        .map(|i| ((i * 53) % 97) as f32 + (i / 8) as f32 * 9.0)
+        .collect();
+    let fixed: Vec<bool> = (0..64).map(|i| (i % 8) < 4 && (i / 8) < 5).collect();
+    let dropped = |method: Method| {
+        let mut image = values.clone();
+        let options = PaddingOptions {
+            jpeg_quality: 75,
+            ..opts(method)
+        };
+        pad(&mut image, 8, 8, &fixed, None, &options).unwrap();
+        let block: Vec<f64> = image.iter().map(|&v| f64::from(v)).collect();
+        // Energy of the coefficients the quantiser zeroes: the weight keeps a coefficient only if it
+        // is under half its step, so each coefficient is tested on its own.
+        let mut total = 0.0;
+        for u in 0..8 {
+            for v in 0..8 {
+                let only = |a: usize, b: usize| if (a, b) == (u, v) { 1.0 } else { 0.0 };
+                let c2 = weighted_ac_energy(&block, only);
+                if (u, v) != (0, 0) && c2.sqrt() < 0.5 * step(u, v) {
+                    total += c2;
+                }
+            }
+        }
+        total
+    };
+    let (snap, biharmonic) = (dropped(Method::Snap), dropped(Method::Biharmonic));
+    assert!(
+        snap < 0.5 * biharmonic,
+        "snap {snap} vs biharmonic {biharmonic}"
+    );
 }

@@ -15,7 +15,7 @@ mod synth;
 
 use std::path::PathBuf;
 
-use padding::Method;
+use padding::{EmptyBlocks, Method, PaddingOptions};
 
 use images::Sequence;
 use measure::MethodResult;
@@ -64,9 +64,27 @@ fn run() -> Result<(), String> {
         if let Some(root) = &dump {
             images::write_folder(&sequence, &root.join(&sequence.name))?;
         }
-        let results = Method::ALL
+        let mut variants: Vec<(String, PaddingOptions)> = Method::ALL
             .iter()
-            .map(|&m| measure::run(&sequence, m, &SWEEP))
+            .map(|&m| (m.to_string(), PaddingOptions::with_method(m)))
+            .collect();
+        for (name, empty_blocks) in [
+            ("fixed mean", EmptyBlocks::FixedMean),
+            ("neighbour mean", EmptyBlocks::NeighbourMean),
+        ] {
+            for method in [Method::Cg, Method::Biharmonic] {
+                variants.push((
+                    format!("{method}, empty blocks at {name}"),
+                    PaddingOptions {
+                        empty_blocks,
+                        ..PaddingOptions::with_method(method)
+                    },
+                ));
+            }
+        }
+        let results = variants
+            .iter()
+            .map(|(label, options)| measure::run(&sequence, label, options, &SWEEP))
             .collect::<Result<Vec<_>, _>>()?;
         print_tables(&sequence, &results);
     }
@@ -92,7 +110,7 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
     println!(" pad ms/frame | CG iters/system |");
     println!("|---|{}---:|---:|", "---:|---:|".repeat(REPORTED.len()));
     for r in results {
-        print!("| {} |", r.method);
+        print!("| {} |", r.label);
         for &q in &REPORTED {
             let p = r.points[sweep_index(q)];
             print!(" {:.0} | {:.3} |", p.bytes_per_frame, p.rmse);
@@ -108,7 +126,7 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
             }
         );
     }
-    let Some(reference) = results.iter().find(|r| r.method == Method::Cg) else {
+    let Some(reference) = results.iter().find(|r| r.label == Method::Cg.name()) else {
         return;
     };
     println!("\nBytes/frame at the RMSE `cg` reaches at q50 / q75 / q90 (log–log interpolation over q {:?}):\n", SWEEP);
@@ -122,7 +140,7 @@ fn print_tables(sequence: &Sequence, results: &[MethodResult]) {
     println!(" mean vs cg |");
     println!("|---|{}---:|", "---:|".repeat(REPORTED.len()));
     for r in results {
-        print!("| {} |", r.method);
+        print!("| {} |", r.label);
         let mut ratios = Vec::new();
         for &q in &REPORTED {
             let target = reference.points[sweep_index(q)].rmse;

@@ -16,7 +16,7 @@ pub struct Point {
 
 /// Everything measured for one method on one sequence.
 pub struct MethodResult {
-    pub method: Method,
+    pub label: String,
     /// One point per quality of the sweep, in sweep order.
     pub points: Vec<Point>,
     pub pad_ms_per_frame: f64,
@@ -24,9 +24,13 @@ pub struct MethodResult {
     pub unconverged: usize,
 }
 
-/// Pads every sample with `method` and codes it at every quality in `qualities`.
-pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<MethodResult, String> {
-    let options = PaddingOptions::with_method(method);
+/// Pads every sample with `options` and codes it at every quality in `qualities`.
+pub fn run(
+    sequence: &Sequence,
+    label: &str,
+    options: &PaddingOptions,
+    qualities: &[u8],
+) -> Result<MethodResult, String> {
     let mut bytes = vec![0usize; qualities.len()];
     let mut sse = vec![0.0f64; qualities.len()];
     let mut fixed_count = 0usize;
@@ -34,36 +38,49 @@ pub fn run(sequence: &Sequence, method: Method, qualities: &[u8]) -> Result<Meth
     let mut iterations = 0usize;
     let mut systems = 0usize;
     let mut unconverged = 0usize;
+    // Methods that read `jpeg_quality` are padded once per quality; the others once per image.
+    let per_quality = options.method == Method::Snap;
+    let mut pads = 0usize;
     for sample in &sequence.samples {
-        let mut image = sample.grey.clone();
-        let start = Instant::now();
-        let stats = pad(
-            &mut image,
-            sample.width,
-            sample.height,
-            &sample.fixed,
-            None,
-            &options,
-        )
-        .map_err(|e| e.to_string())?;
-        pad_seconds += start.elapsed().as_secs_f64();
-        iterations += stats.cg_iterations;
-        systems += stats.systems;
-        unconverged += stats.unconverged;
-        let grey: Vec<u8> = image
-            .iter()
-            .map(|&v| v.round().clamp(0.0, 255.0) as u8)
-            .collect();
         fixed_count += sample.fixed.iter().filter(|&&f| f).count();
+        let mut grey = Vec::new();
         for (q, &quality) in qualities.iter().enumerate() {
+            if grey.is_empty() || per_quality {
+                let options = PaddingOptions {
+                    jpeg_quality: quality,
+                    ..options.clone()
+                };
+                let mut image = sample.grey.clone();
+                let start = Instant::now();
+                let stats = pad(
+                    &mut image,
+                    sample.width,
+                    sample.height,
+                    &sample.fixed,
+                    None,
+                    &options,
+                )
+                .map_err(|e| e.to_string())?;
+                pad_seconds += start.elapsed().as_secs_f64();
+                pads += 1;
+                iterations += stats.cg_iterations;
+                systems += stats.systems;
+                unconverged += stats.unconverged;
+                grey = image
+                    .iter()
+                    .map(|&v| v.round().clamp(0.0, 255.0) as u8)
+                    .collect();
+            }
             let (coded, decoded) = jpeg_round_trip(&grey, sample, quality)?;
             bytes[q] += coded;
             sse[q] += fixed_sse(sample, &decoded);
         }
     }
+    // Time of one padding of every image of a frame.
+    pad_seconds *= sequence.samples.len() as f64 / pads.max(1) as f64;
     let frames = sequence.frames();
     Ok(MethodResult {
-        method,
+        label: label.to_string(),
         points: bytes
             .iter()
             .zip(&sse)
