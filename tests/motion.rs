@@ -178,6 +178,53 @@ fn plain_k_means_recovers_separate_parts_too() {
     assert_eq!(rand_index(partition.labels(), &truth), 1.0);
 }
 
+/// A tube twisting about its axis, the angle growing along it: smooth motion no few affine maps fit.
+fn twisted_tube() -> AnimatedMesh {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, 0.0, 8.0, 41);
+    let frames = (0..FRAMES)
+        .map(|f| {
+            let t = f as f32 / (FRAMES - 1) as f32;
+            points
+                .iter()
+                .map(|p| {
+                    let a = t * 0.4 * p[0] * p[0] / 8.0;
+                    [
+                        p[0],
+                        a.cos() * p[1] - a.sin() * p[2],
+                        a.sin() * p[1] + a.cos() * p[2],
+                    ]
+                })
+                .collect()
+        })
+        .collect();
+    AnimatedMesh::new(tris, frames).unwrap()
+}
+
+fn residual_energy(mesh: &AnimatedMesh, partition: &Partition) -> f64 {
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), partition, 17).unwrap();
+    (0..mesh.frame_count())
+        .map(|f| {
+            energy(&residuals(
+                mesh.frame(f),
+                &track.predict(f, mesh.frame(0), partition),
+            ))
+        })
+        .sum()
+}
+
+#[test]
+fn border_refinement_lowers_the_residual_energy() {
+    let mesh = twisted_tube();
+    let plain = SegmentOptions {
+        refine_passes: 0,
+        ..options(5)
+    };
+    let plain = residual_energy(&mesh, &segment(&mesh, &plain).unwrap());
+    let refined = residual_energy(&mesh, &segment(&mesh, &options(5)).unwrap());
+    assert!(refined < plain, "refined {refined} vs plain {plain}");
+}
+
 #[test]
 fn segmentation_is_deterministic() {
     let (mesh, _) = connected_parts();

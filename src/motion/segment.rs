@@ -114,12 +114,19 @@ impl Partition {
 
 /// Segments the vertices into clusters of similar affine motion (MCGV §3.1, eq. 1).
 ///
-/// Each vertex is described by the affine maps, frame 0 → frame i, that best fit its `ring`-ring,
-/// written in the unit frame of frame 0 (bounding-box centre at the origin, diagonal 1). The linear
-/// part is weighted by the RMS radius of the shape so that both parts measure displacement: a change
-/// δ of a linear coefficient moves a typical vertex by about that radius × δ. Then k-means
-/// (k-means++ seeded by `opts.seed`, one run). Clusters with fewer than [`MIN_CLUSTER_SIZE`]
-/// vertices are dissolved, smallest first, into the nearest remaining centroid; empty ones vanish.
+/// 1. Each vertex is described by the affine maps, frame 0 → sampled frame i, that best fit its
+///    `ring`-ring, in the unit frame of frame 0 (bounding-box centre at the origin, diagonal 1). The
+///    linear part is weighted by the RMS radius of the shape so both parts measure displacement: a
+///    change δ of a linear coefficient moves a typical vertex by about radius × δ.
+/// 2. k-means (k-means++ seeded by `opts.seed`, one run) is trained on the vertices whose ring moves
+///    affinely (ring misfit ≤ 4 × median); every vertex then takes its nearest centroid. Rings
+///    straddling differently moving parts give far-off descriptors that would otherwise draw
+///    centroids away from the parts; those vertices take the cluster whose affine maps predict their
+///    trajectory best instead.
+/// 3. `opts.refine_passes` passes move cluster borders to lower the prediction error (see
+///    [`SegmentOptions::refine_passes`]).
+/// 4. Clusters with fewer than [`MIN_CLUSTER_SIZE`] vertices are dissolved, smallest first, into the
+///    nearest remaining k-means centroid; empty ones vanish; labels are renumbered in order of first vertex.
 pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> {
     if opts.clusters == 0 {
         return Err(Error::Usage(
