@@ -2,8 +2,8 @@
 //! motion energy, largest residual, and the time of each stage.
 //!
 //! `cargo bench --bench motion [-- DIR_OR_FILE ...]`; with no arguments, every sequence found under
-//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). `REFINE=N` sets
-//! `SegmentOptions::refine_passes`.
+//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
+//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`.
 
 use mcgv_video::mesh::Point;
 use mcgv_video::motion::{
@@ -55,14 +55,19 @@ fn default_inputs() -> Vec<PathBuf> {
     inputs.into_iter().filter(|p| p.exists()).collect()
 }
 
+/// A segmentation option overridden from the environment.
+fn knob<T: std::str::FromStr>(name: &str) -> Option<T> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
 fn measure(name: &str, mesh: &AnimatedMesh) {
     let start = Instant::now();
+    let defaults = SegmentOptions::default();
     let opts = SegmentOptions {
-        refine_passes: std::env::var("REFINE")
-            .ok()
-            .and_then(|r| r.parse().ok())
-            .unwrap_or(SegmentOptions::default().refine_passes),
-        ..SegmentOptions::default()
+        refine_passes: knob("REFINE").unwrap_or(defaults.refine_passes),
+        feature_frames: knob("FEATURE_FRAMES").unwrap_or(defaults.feature_frames),
+        max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
+        ..defaults
     };
     let partition = match segment(mesh, &opts) {
         Ok(p) => p,
