@@ -145,7 +145,8 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
         return Partition::from_labels(vec![0; v_count], 1);
     }
     let sampled = SampledMotion::new(mesh, opts.feature_frames);
-    let (features, misfit) = motion_features(mesh, &sampled, opts.ring);
+    let adjacency = VertexAdjacency::new(v_count, mesh.triangles());
+    let (features, misfit) = motion_features(&adjacency, &sampled, opts.ring);
     let inliers = affine_rings(&misfit);
     let training = if inliers.len() >= k {
         features.select(Axis(0), &inliers)
@@ -170,7 +171,6 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
         assign_by_trajectory(&mut labels, &inliers, &sampled, k);
     }
     if opts.refine_passes > 0 {
-        let adjacency = VertexAdjacency::new(v_count, mesh.triangles());
         refine_borders(&mut labels, &adjacency, &sampled, k, opts.refine_passes);
     }
     let labels = dissolve_small_clusters(labels, &features, model.centroids(), k);
@@ -356,11 +356,11 @@ fn refine_borders(
 /// The per-vertex motion descriptors α^v (one row per vertex, 12 per sampled frame) and how far each
 /// vertex's ring is from moving affinely (RMS fit error, unit coordinates).
 fn motion_features(
-    mesh: &AnimatedMesh,
+    adjacency: &VertexAdjacency,
     motion: &SampledMotion,
     ring: usize,
 ) -> (Array2<f32>, Vec<f32>) {
-    let v_count = mesh.vertex_count();
+    let v_count = adjacency.vertex_count();
     let rest = &motion.rest;
     let radius = (rest
         .iter()
@@ -369,7 +369,6 @@ fn motion_features(
         / v_count as f64)
         .sqrt()
         .max(1e-6);
-    let adjacency = VertexAdjacency::new(v_count, mesh.triangles());
     let dim = 12 * motion.frames.len();
     let mut data = vec![0f32; v_count * dim];
     let mut misfit = vec![0f32; v_count];
@@ -379,7 +378,7 @@ fn motion_features(
         .for_each_init(
             || (KRingScratch::new(v_count), Vec::new()),
             |(scratch, source), (v, (row, misfit))| {
-                let ring = scratch.k_ring(&adjacency, v, ring);
+                let ring = scratch.k_ring(adjacency, v, ring);
                 source.clear();
                 source.extend(ring.iter().map(|&u| rest[u as usize]));
                 let solver = AffineSolver::new(source, RING_LAMBDA);
