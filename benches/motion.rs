@@ -3,11 +3,13 @@
 //!
 //! `cargo bench --bench motion [-- DIR_OR_FILE ...]`; with no arguments, every sequence found under
 //! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
-//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`.
+//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`;
+//! `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
 
 use mcgv_video::mesh::Point;
 use mcgv_video::motion::{
-    energy, residuals, segment, AffineTrack, SegmentOptions, DEFAULT_AFFINE_BITS,
+    energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions,
+    DEFAULT_AFFINE_BITS,
 };
 use mcgv_video::AnimatedMesh;
 use std::path::{Path, PathBuf};
@@ -74,6 +76,13 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
         Err(e) => return println!("{name:<22} segmentation failed: {e}"),
     };
     let segment_time = start.elapsed().as_secs_f64();
+    if let Ok(dir) = std::env::var("PICTURES") {
+        let path = Path::new(&dir).join(format!("{name}.png"));
+        let (frame0, labels) = (mesh.frame(0), partition.labels());
+        if let Err(e) = render_partition_png(frame0, mesh.triangles(), labels, 512, &path) {
+            println!("{name}: picture not written: {e}");
+        }
+    }
 
     // The reference is the original frame 0: the decoded one is not available to this stage alone.
     let start = Instant::now();
