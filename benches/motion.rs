@@ -26,8 +26,16 @@ fn main() {
         args.iter().map(PathBuf::from).collect()
     };
     println!(
-        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>9} {:>9}",
-        "sequence", "V", "F", "K", "resid/motion", "max % diag", "segment s", "predict s"
+        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>11} {:>9} {:>9}",
+        "sequence",
+        "V",
+        "F",
+        "K",
+        "resid/motion",
+        "max % diag",
+        "quant % diag",
+        "segment s",
+        "predict s"
     );
     for input in inputs {
         let name = input.file_name().map_or_else(
@@ -105,13 +113,27 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
             .fold(largest, f64::max);
     }
     let predict_time = start.elapsed().as_secs_f64();
+    // What quantisation alone costs: the 17-bit prediction against a (nearly) unquantised one.
+    let quantisation =
+        AffineTrack::fit(mesh.frames(), reference, &partition, 30).map_or(f64::NAN, |fine| {
+            (0..mesh.frame_count())
+                .flat_map(|f| {
+                    residuals(
+                        &track.predict(f, reference, &partition),
+                        &fine.predict(f, reference, &partition),
+                    )
+                })
+                .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+                .fold(0.0, f64::max)
+        });
     println!(
-        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>9.3} {:>9.3}",
+        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
         mesh.vertex_count(),
         mesh.frame_count(),
         partition.clusters(),
         residual_energy / motion_energy.max(f64::MIN_POSITIVE),
         100.0 * largest / mesh.bbox_diagonal(),
+        100.0 * quantisation / mesh.bbox_diagonal(),
         segment_time,
         predict_time
     );
