@@ -79,6 +79,22 @@ fn connected_parts() -> (AnimatedMesh, Vec<usize>) {
     (piecewise_affine(points, tris, &part), part)
 }
 
+/// The tube as a triangle soup: every triangle with its own three vertices, as some exporters
+/// write meshes; copies of a vertex move together.
+fn tube_soup() -> (AnimatedMesh, Vec<usize>) {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, 0.0, 8.0, 41);
+    let soup_points: Vec<Point> = tris.iter().flatten().map(|&v| points[v as usize]).collect();
+    let soup_tris: Vec<Triangle> = (0..tris.len() as u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    let part: Vec<usize> = soup_points
+        .iter()
+        .map(|p| ((p[0] / 2.0) as usize).min(3))
+        .collect();
+    (piecewise_affine(soup_points, soup_tris, &part), part)
+}
+
 /// Four separate tubes, one per part.
 fn separate_parts() -> (AnimatedMesh, Vec<usize>) {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
@@ -223,6 +239,14 @@ fn border_refinement_lowers_the_residual_energy() {
     let plain = residual_energy(&mesh, &segment(&mesh, &plain).unwrap());
     let refined = residual_energy(&mesh, &segment(&mesh, &options(5)).unwrap());
     assert!(refined < plain, "refined {refined} vs plain {plain}");
+}
+
+#[test]
+fn a_triangle_soup_is_segmented_like_the_welded_mesh() {
+    let (mesh, truth) = tube_soup();
+    let partition = segment(&mesh, &options(4)).unwrap();
+    let score = rand_index(partition.labels(), &truth);
+    assert!(score > 0.98, "Rand index {score}");
 }
 
 #[test]

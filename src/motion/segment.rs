@@ -3,7 +3,7 @@
 use super::fit::{apply, AffineCoefficients, AffineSolver, UnitFrame};
 use crate::error::{Error, Result};
 use crate::mesh::topology::{KRingScratch, VertexAdjacency};
-use crate::mesh::AnimatedMesh;
+use crate::mesh::{AnimatedMesh, Triangle};
 use linfa::traits::{Fit, Predict};
 use linfa::DatasetBase;
 use linfa_clustering::{KMeans, KMeansInit};
@@ -145,7 +145,7 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
         return Partition::from_labels(vec![0; v_count], 1);
     }
     let sampled = SampledMotion::new(mesh, opts.feature_frames);
-    let adjacency = VertexAdjacency::new(v_count, mesh.triangles());
+    let adjacency = welded_adjacency(mesh);
     let (features, misfit) = motion_features(&adjacency, &sampled, opts.ring);
     let inliers = affine_rings(&misfit);
     let training = if inliers.len() >= k {
@@ -175,6 +175,24 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     }
     let labels = dissolve_small_clusters(labels, &features, model.centroids(), k);
     compact(labels)
+}
+
+/// The mesh's vertex adjacency, plus an edge between vertices at the very same frame-0 position.
+/// Exporters split vertices along UV and normal seams (glTF meshes often fall into dozens of
+/// pieces, a triangle soup at worst); the copies move together, and without these edges their
+/// rings would stop at every seam, down to a lone flat triangle.
+fn welded_adjacency(mesh: &AnimatedMesh) -> VertexAdjacency {
+    let mut first_at = std::collections::HashMap::new();
+    let mut edges: Vec<Triangle> = mesh.triangles().to_vec();
+    for (v, p) in mesh.frame(0).iter().enumerate() {
+        let key = p.map(f32::to_bits);
+        let first = *first_at.entry(key).or_insert(v as u32);
+        if first != v as u32 {
+            // A degenerate triangle contributes just the edge (first, v).
+            edges.push([first, v as u32, v as u32]);
+        }
+    }
+    VertexAdjacency::new(mesh.vertex_count(), &edges)
 }
 
 /// Frame 0 and the sampled frames of an animation, in the unit frame of frame 0.
