@@ -2,12 +2,14 @@
 //! motion energy, largest residual, and the time of each stage.
 //!
 //! `cargo bench --bench motion [-- DIR_OR_FILE ...]`; with no arguments, every sequence found under
-//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). `REFINE=N` sets
-//! `SegmentOptions::refine_passes`.
+//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
+//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`;
+//! `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
 
 use mcgv_video::mesh::Point;
 use mcgv_video::motion::{
-    energy, residuals, segment, AffineTrack, SegmentOptions, DEFAULT_AFFINE_BITS,
+    energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions,
+    DEFAULT_AFFINE_BITS,
 };
 use mcgv_video::AnimatedMesh;
 use std::path::{Path, PathBuf};
@@ -24,8 +26,16 @@ fn main() {
         args.iter().map(PathBuf::from).collect()
     };
     println!(
-        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>9} {:>9}",
-        "sequence", "V", "F", "K", "resid/motion", "max % diag", "segment s", "predict s"
+        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>11} {:>9} {:>9}",
+        "sequence",
+        "V",
+        "F",
+        "K",
+        "resid/motion",
+        "max % diag",
+        "quant % diag",
+        "segment s",
+        "predict s"
     );
     for input in inputs {
         let name = input.file_name().map_or_else(
@@ -55,20 +65,32 @@ fn default_inputs() -> Vec<PathBuf> {
     inputs.into_iter().filter(|p| p.exists()).collect()
 }
 
+/// A segmentation option overridden from the environment.
+fn knob<T: std::str::FromStr>(name: &str) -> Option<T> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
 fn measure(name: &str, mesh: &AnimatedMesh) {
     let start = Instant::now();
+    let defaults = SegmentOptions::default();
     let opts = SegmentOptions {
-        refine_passes: std::env::var("REFINE")
-            .ok()
-            .and_then(|r| r.parse().ok())
-            .unwrap_or(SegmentOptions::default().refine_passes),
-        ..SegmentOptions::default()
+        refine_passes: knob("REFINE").unwrap_or(defaults.refine_passes),
+        feature_frames: knob("FEATURE_FRAMES").unwrap_or(defaults.feature_frames),
+        max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
+        ..defaults
     };
     let partition = match segment(mesh, &opts) {
         Ok(p) => p,
         Err(e) => return println!("{name:<22} segmentation failed: {e}"),
     };
     let segment_time = start.elapsed().as_secs_f64();
+    if let Ok(dir) = std::env::var("PICTURES") {
+        let path = Path::new(&dir).join(format!("{name}.png"));
+        let (frame0, labels) = (mesh.frame(0), partition.labels());
+        if let Err(e) = render_partition_png(frame0, mesh.triangles(), labels, 512, &path) {
+            println!("{name}: picture not written: {e}");
+        }
+    }
 
     // The reference is the original frame 0: the decoded one is not available to this stage alone.
     let start = Instant::now();
@@ -91,13 +113,27 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
             .fold(largest, f64::max);
     }
     let predict_time = start.elapsed().as_secs_f64();
+    // What quantisation alone costs: the 17-bit prediction against a (nearly) unquantised one.
+    let quantisation =
+        AffineTrack::fit(mesh.frames(), reference, &partition, 30).map_or(f64::NAN, |fine| {
+            (0..mesh.frame_count())
+                .flat_map(|f| {
+                    residuals(
+                        &track.predict(f, reference, &partition),
+                        &fine.predict(f, reference, &partition),
+                    )
+                })
+                .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+                .fold(0.0, f64::max)
+        });
     println!(
-        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>9.3} {:>9.3}",
+        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
         mesh.vertex_count(),
         mesh.frame_count(),
         partition.clusters(),
         residual_energy / motion_energy.max(f64::MIN_POSITIVE),
         100.0 * largest / mesh.bbox_diagonal(),
+        100.0 * quantisation / mesh.bbox_diagonal(),
         segment_time,
         predict_time
     );

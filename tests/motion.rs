@@ -79,6 +79,22 @@ fn connected_parts() -> (AnimatedMesh, Vec<usize>) {
     (piecewise_affine(points, tris, &part), part)
 }
 
+/// The tube as a triangle soup: every triangle with its own three vertices, as some exporters
+/// write meshes; copies of a vertex move together.
+fn tube_soup() -> (AnimatedMesh, Vec<usize>) {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, 0.0, 8.0, 41);
+    let soup_points: Vec<Point> = tris.iter().flatten().map(|&v| points[v as usize]).collect();
+    let soup_tris: Vec<Triangle> = (0..tris.len() as u32)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    let part: Vec<usize> = soup_points
+        .iter()
+        .map(|p| ((p[0] / 2.0) as usize).min(3))
+        .collect();
+    (piecewise_affine(soup_points, soup_tris, &part), part)
+}
+
 /// Four separate tubes, one per part.
 fn separate_parts() -> (AnimatedMesh, Vec<usize>) {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
@@ -176,6 +192,61 @@ fn plain_k_means_recovers_separate_parts_too() {
     };
     let partition = segment(&mesh, &opts).unwrap();
     assert_eq!(rand_index(partition.labels(), &truth), 1.0);
+}
+
+/// A tube twisting about its axis, the angle growing along it: smooth motion no few affine maps fit.
+fn twisted_tube() -> AnimatedMesh {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, 0.0, 8.0, 41);
+    let frames = (0..FRAMES)
+        .map(|f| {
+            let t = f as f32 / (FRAMES - 1) as f32;
+            points
+                .iter()
+                .map(|p| {
+                    let a = t * 0.4 * p[0] * p[0] / 8.0;
+                    [
+                        p[0],
+                        a.cos() * p[1] - a.sin() * p[2],
+                        a.sin() * p[1] + a.cos() * p[2],
+                    ]
+                })
+                .collect()
+        })
+        .collect();
+    AnimatedMesh::new(tris, frames).unwrap()
+}
+
+fn residual_energy(mesh: &AnimatedMesh, partition: &Partition) -> f64 {
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), partition, 17).unwrap();
+    (0..mesh.frame_count())
+        .map(|f| {
+            energy(&residuals(
+                mesh.frame(f),
+                &track.predict(f, mesh.frame(0), partition),
+            ))
+        })
+        .sum()
+}
+
+#[test]
+fn border_refinement_lowers_the_residual_energy() {
+    let mesh = twisted_tube();
+    let plain = SegmentOptions {
+        refine_passes: 0,
+        ..options(5)
+    };
+    let plain = residual_energy(&mesh, &segment(&mesh, &plain).unwrap());
+    let refined = residual_energy(&mesh, &segment(&mesh, &options(5)).unwrap());
+    assert!(refined < plain, "refined {refined} vs plain {plain}");
+}
+
+#[test]
+fn a_triangle_soup_is_segmented_like_the_welded_mesh() {
+    let (mesh, truth) = tube_soup();
+    let partition = segment(&mesh, &options(4)).unwrap();
+    let score = rand_index(partition.labels(), &truth);
+    assert!(score > 0.98, "Rand index {score}");
 }
 
 #[test]
