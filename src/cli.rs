@@ -121,6 +121,13 @@ pub struct InspectArgs {
     /// Frames whose images to write with --png (default: 0).
     #[arg(long, value_delimiter = ',')]
     pub frames: Vec<usize>,
+    /// The original animation: with --png, also write the raw and padded residual images the encoder
+    /// made (the encoder's analysis is re-run; it is deterministic).
+    #[arg(long)]
+    pub original: Option<String>,
+    /// How to read the original.
+    #[command(flatten)]
+    pub input_args: InputArgs,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,

@@ -1,1 +1,3 @@
 //! codec (see DESIGN.md).
+
+pub mod abbreviated;

@@ -1,1 +1,5 @@
-//! geometry_image (see DESIGN.md).
+//! Geometry images: residuals quantised to 8 bits over stored ranges, placed at each vertex's lattice pixel.
+
+pub mod quantise;
+
+pub use quantise::{AxisRange, FrameRanges, RangeMode};

@@ -118,3 +118,34 @@ pub fn bounding_box(points: &[Point]) -> (Point, Point) {
         (lo, hi)
     }
 }
+
+impl AnimatedMesh {
+    /// The same animation with vertices renumbered: new vertex `i` is old vertex `order[i]`.
+    pub fn permuted(&self, order: &[u32]) -> Result<Self> {
+        let v = self.vertex_count();
+        let mut new_index = vec![u32::MAX; v];
+        if order.len() != v {
+            return Err(Error::Mesh(format!(
+                "a permutation of {} entries for {v} vertices",
+                order.len()
+            )));
+        }
+        for (i, &old) in order.iter().enumerate() {
+            match new_index.get_mut(old as usize) {
+                Some(slot) if *slot == u32::MAX => *slot = i as u32,
+                _ => return Err(Error::Mesh("vertex order is not a permutation".into())),
+            }
+        }
+        let triangles = self
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| new_index[i as usize]))
+            .collect();
+        let frames = self
+            .frames
+            .iter()
+            .map(|f| order.iter().map(|&old| f[old as usize]).collect())
+            .collect();
+        Ok(Self { triangles, frames })
+    }
+}

@@ -1,4 +1,9 @@
-//! stream (see DESIGN.md).
+//! The `.mcgv` stream: container, byte serialisation, entropy coding and the parts it holds.
+
+pub mod bytes;
+pub mod container;
+pub mod frame_index;
+pub mod header;
 
 pub mod entropy;
 pub mod first_frame;

@@ -1,0 +1,387 @@
+//! The `.mcgv` container: a magic number, a version, and a table of tagged parts, each with a length
+//! and a CRC-32 of its payload.
+//!
+//! The coded images are one part whose payload is a run of per-frame chunks; their offsets, lengths
+//! and checksums live in the frame index, so a single frame can be read and verified without
+//! touching (or trusting) any other frame's bytes.
+
+use crate::error::{Error, Result};
+use crate::stream::bytes::{ByteReader, ByteWriter};
+use std::fs::File;
+use std::io::{BufReader, Read, Seek, SeekFrom, Write};
+use std::path::Path;
+
+/// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
+pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
+
+/// The container version this build writes and reads.
+pub const VERSION: u16 = 1;
+
+/// Bytes of a part header: tag, checksum kind, length, CRC.
+pub const PART_HEADER_LEN: usize = 17;
+
+/// Bytes of the file header: magic, version, reserved, part count.
+pub const FILE_HEADER_LEN: usize = 16;
+
+/// Largest number of parts a file may declare: refuses absurd headers before allocating.
+const MAX_PARTS: u32 = 64;
+
+/// A part's four-character tag.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Tag(pub [u8; 4]);
+
+impl Tag {
+    /// Stream parameters (V, F, K, lattice, codec, quantisation).
+    pub const HEADER: Tag = Tag(*b"HEAD");
+    /// First frame: connectivity and geometry.
+    pub const FIRST_FRAME: Tag = Tag(*b"MESH");
+    /// Cluster label per vertex.
+    pub const PARTITION: Tag = Tag(*b"PART");
+    /// Lattice coordinate per vertex.
+    pub const LATTICE: Tag = Tag(*b"LATC");
+    /// Quantised affine coefficients per cluster and frame.
+    pub const AFFINE: Tag = Tag(*b"AFFN");
+    /// Residual quantisation ranges.
+    pub const RANGES: Tag = Tag(*b"RANG");
+    /// Codec set-up shared by all frames (e.g. JPEG tables).
+    pub const CODEC_SETUP: Tag = Tag(*b"CSET");
+    /// Offset, length, checksum and key flag of each frame chunk.
+    pub const FRAME_INDEX: Tag = Tag(*b"INDX");
+    /// The coded images, one chunk per frame.
+    pub const FRAMES: Tag = Tag(*b"FRMS");
+
+    /// A human-readable name, for reports and errors.
+    pub fn name(self) -> &'static str {
+        match &self.0 {
+            b"HEAD" => "header",
+            b"MESH" => "first frame",
+            b"PART" => "partition",
+            b"LATC" => "lattice coordinates",
+            b"AFFN" => "affine coefficients",
+            b"RANG" => "residual ranges",
+            b"CSET" => "codec set-up",
+            b"INDX" => "frame index",
+            b"FRMS" => "images",
+            _ => "unknown part",
+        }
+    }
+}
+
+impl std::fmt::Display for Tag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} ({})", String::from_utf8_lossy(&self.0), self.name())
+    }
+}
+
+/// Whether a part's CRC covers its whole payload, or its chunks carry their own (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Checksum {
+    /// One CRC-32 over the payload.
+    Whole,
+    /// The payload's chunks are checked through the frame index.
+    Chunked,
+}
+
+/// Builds a container in memory; [`ContainerWriter::write_atomic`] puts it on disk.
+#[derive(Debug, Default)]
+pub struct ContainerWriter {
+    parts: Vec<(Tag, Vec<u8>, Checksum)>,
+}
+
+impl ContainerWriter {
+    /// An empty container.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a part; parts are written in the order added.
+    pub fn add(&mut self, tag: Tag, payload: Vec<u8>, checksum: Checksum) {
+        self.parts.push((tag, payload, checksum));
+    }
+
+    /// Bytes each part takes in the file (payload plus its part header), by part name, in file order.
+    pub fn part_sizes(&self) -> Vec<(String, u64)> {
+        self.parts
+            .iter()
+            .map(|(tag, payload, _)| {
+                (
+                    tag.name().to_string(),
+                    (PART_HEADER_LEN + payload.len()) as u64,
+                )
+            })
+            .collect()
+    }
+
+    /// The whole file as bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = ByteWriter::new();
+        w.raw(&MAGIC)
+            .u16(VERSION)
+            .u16(0)
+            .u32(self.parts.len() as u32);
+        for (tag, payload, checksum) in &self.parts {
+            let crc = match checksum {
+                Checksum::Whole => crc32fast::hash(payload),
+                Checksum::Chunked => 0,
+            };
+            w.raw(&tag.0)
+                .u8(matches!(checksum, Checksum::Chunked) as u8)
+                .u64(payload.len() as u64)
+                .u32(crc)
+                .raw(payload);
+        }
+        w.into_bytes()
+    }
+
+    /// Writes the file to a temporary file beside `path` and renames it into place, so a failure
+    /// never leaves a half-written file at `path`.
+    pub fn write_atomic(&self, path: &Path) -> Result<u64> {
+        let bytes = self.to_bytes();
+        write_file_atomic(path, &bytes)?;
+        Ok(bytes.len() as u64)
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::io(path, e))?;
+    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
+    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
+/// Where one part lies in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PartEntry {
+    /// The part's tag.
+    pub tag: Tag,
+    /// Offset of the payload from the start of the file.
+    pub offset: u64,
+    /// Payload length in bytes.
+    pub len: u64,
+    /// CRC-32 of the payload (unused for chunked parts).
+    pub crc: u32,
+    /// How the payload is checked.
+    pub checksum: Checksum,
+}
+
+/// Reads a container lazily: the part table at open, payloads on request, verified against their CRC.
+#[derive(Debug)]
+pub struct ContainerReader<R> {
+    source: R,
+    parts: Vec<PartEntry>,
+    file_len: u64,
+}
+
+impl ContainerReader<BufReader<File>> {
+    /// Opens a `.mcgv` file and reads its part table.
+    pub fn open(path: &Path) -> Result<Self> {
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        Self::new(BufReader::new(file))
+    }
+}
+
+impl<R: Read + Seek> ContainerReader<R> {
+    /// Reads the part table of a container from any seekable source.
+    pub fn new(mut source: R) -> Result<Self> {
+        let io = |e: std::io::Error| Error::Stream(format!("reading the part table: {e}"));
+        let file_len = source.seek(SeekFrom::End(0)).map_err(io)?;
+        source.seek(SeekFrom::Start(0)).map_err(io)?;
+        let mut head = [0u8; 16];
+        read_exact_or(&mut source, &mut head, "the file header")?;
+        let mut r = ByteReader::new(&head, "file header");
+        if r.take(8)? != MAGIC {
+            return Err(Error::Stream(
+                "not a .mcgv file (wrong magic number)".into(),
+            ));
+        }
+        let version = r.u16()?;
+        if version != VERSION {
+            return Err(Error::Stream(format!(
+                "stream version {version}; this build reads version {VERSION}"
+            )));
+        }
+        let _reserved = r.u16()?;
+        let count = r.u32()?;
+        if count > MAX_PARTS {
+            return Err(Error::Stream(format!(
+                "header claims {count} parts (at most {MAX_PARTS})"
+            )));
+        }
+        let mut parts = Vec::with_capacity(count as usize);
+        let mut pos = 16u64;
+        for i in 0..count {
+            let mut ph = [0u8; 17];
+            read_exact_or(&mut source, &mut ph, "a part header")?;
+            let mut r = ByteReader::new(&ph, "part header");
+            let mut tag = [0u8; 4];
+            tag.copy_from_slice(r.take(4)?);
+            let checksum = match r.u8()? {
+                0 => Checksum::Whole,
+                1 => Checksum::Chunked,
+                other => {
+                    return Err(Error::Stream(format!(
+                        "part {i}: unknown checksum kind {other}"
+                    )))
+                }
+            };
+            let len = r.u64()?;
+            let crc = r.u32()?;
+            let offset = pos + 17;
+            let end = offset
+                .checked_add(len)
+                .filter(|&e| e <= file_len)
+                .ok_or_else(|| {
+                    Error::Stream(format!(
+                        "part {} claims {len} bytes but the file ends first (truncated file?)",
+                        Tag(tag)
+                    ))
+                })?;
+            parts.push(PartEntry {
+                tag: Tag(tag),
+                offset,
+                len,
+                crc,
+                checksum,
+            });
+            pos = end;
+            source.seek(SeekFrom::Start(pos)).map_err(io)?;
+        }
+        if pos != file_len {
+            return Err(Error::Stream(format!(
+                "{} bytes after the last part (file damaged or concatenated?)",
+                file_len - pos
+            )));
+        }
+        Ok(Self {
+            source,
+            parts,
+            file_len,
+        })
+    }
+
+    /// The part table.
+    pub fn parts(&self) -> &[PartEntry] {
+        &self.parts
+    }
+
+    /// Total file length in bytes.
+    pub fn file_len(&self) -> u64 {
+        self.file_len
+    }
+
+    /// The entry of a part that must be present.
+    pub fn entry(&self, tag: Tag) -> Result<PartEntry> {
+        self.parts
+            .iter()
+            .find(|p| p.tag == tag)
+            .copied()
+            .ok_or_else(|| Error::Stream(format!("missing part {tag}")))
+    }
+
+    /// Whether a part is present.
+    pub fn has(&self, tag: Tag) -> bool {
+        self.parts.iter().any(|p| p.tag == tag)
+    }
+
+    /// A whole part's payload, verified against its CRC.
+    pub fn part(&mut self, tag: Tag) -> Result<Vec<u8>> {
+        let e = self.entry(tag)?;
+        let bytes = self.read_at(e.offset, e.len, tag)?;
+        if e.checksum == Checksum::Whole && crc32fast::hash(&bytes) != e.crc {
+            return Err(Error::Stream(format!(
+                "part {tag} fails its checksum (damaged file)"
+            )));
+        }
+        Ok(bytes)
+    }
+
+    /// A chunk `[offset, offset+len)` of a chunked part, verified against `crc`.
+    pub fn chunk(
+        &mut self,
+        tag: Tag,
+        offset: u64,
+        len: u64,
+        crc: u32,
+        what: &str,
+    ) -> Result<Vec<u8>> {
+        let e = self.entry(tag)?;
+        let within = offset.checked_add(len).is_some_and(|end| end <= e.len);
+        if !within {
+            return Err(Error::Stream(format!("{what} lies outside part {tag}")));
+        }
+        let bytes = self.read_at(e.offset + offset, len, tag)?;
+        if crc32fast::hash(&bytes) != crc {
+            return Err(Error::Stream(format!(
+                "{what} fails its checksum (damaged file)"
+            )));
+        }
+        Ok(bytes)
+    }
+
+    fn read_at(&mut self, offset: u64, len: u64, tag: Tag) -> Result<Vec<u8>> {
+        // Lengths were checked against the file size at open, so this allocation is bounded by it.
+        let io = |e: std::io::Error| Error::Stream(format!("reading part {tag}: {e}"));
+        self.source.seek(SeekFrom::Start(offset)).map_err(io)?;
+        let mut buf = vec![0u8; len as usize];
+        read_exact_or(&mut self.source, &mut buf, "a part")?;
+        Ok(buf)
+    }
+}
+
+fn read_exact_or<R: Read>(source: &mut R, buf: &mut [u8], what: &str) -> Result<()> {
+    source.read_exact(buf).map_err(|e| match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => {
+            Error::Stream(format!("file ends inside {what} (truncated)"))
+        }
+        _ => Error::Stream(format!("reading {what}: {e}")),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Cursor;
+
+    fn sample() -> Vec<u8> {
+        let mut w = ContainerWriter::new();
+        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
+        w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked);
+        w.to_bytes()
+    }
+
+    #[test]
+    fn round_trip_parts_and_chunks() {
+        let bytes = sample();
+        let mut r = ContainerReader::new(Cursor::new(bytes)).unwrap();
+        assert_eq!(r.part(Tag::HEADER).unwrap(), b"hello");
+        let crc = crc32fast::hash(b"345");
+        assert_eq!(r.chunk(Tag::FRAMES, 3, 3, crc, "frame 1").unwrap(), b"345");
+        assert!(r.chunk(Tag::FRAMES, 3, 3, crc ^ 1, "frame 1").is_err());
+        assert!(r.chunk(Tag::FRAMES, 8, 3, crc, "frame 1").is_err());
+        assert!(r.part(Tag::AFFINE).is_err());
+    }
+
+    #[test]
+    fn every_truncation_and_a_flipped_bit_are_errors() {
+        let bytes = sample();
+        for cut in 0..bytes.len() {
+            assert!(
+                ContainerReader::new(Cursor::new(bytes[..cut].to_vec())).is_err(),
+                "cut {cut}"
+            );
+        }
+        let mut flipped = bytes.clone();
+        flipped[16 + 17 + 1] ^= 0x10; // inside the header payload
+        let mut r = ContainerReader::new(Cursor::new(flipped)).unwrap();
+        assert!(r.part(Tag::HEADER).is_err());
+        let mut extra = bytes;
+        extra.push(0);
+        assert!(ContainerReader::new(Cursor::new(extra)).is_err());
+    }
+}

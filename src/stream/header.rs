@@ -1,0 +1,221 @@
+//! The stream header: everything the decoder must know before it reads any other part.
+
+use crate::error::{Error, Result};
+use crate::stream::bytes::{ByteReader, ByteWriter};
+
+/// The residual image codec recorded in the stream.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CodecKind {
+    /// One JPEG picture per frame: every frame decodes on its own.
+    Jpeg,
+    /// MPEG-4 Part 2: I-frames every `gop` frames, P-frames between.
+    Mpeg4,
+}
+
+impl CodecKind {
+    fn id(self) -> u8 {
+        match self {
+            CodecKind::Jpeg => 0,
+            CodecKind::Mpeg4 => 1,
+        }
+    }
+
+    fn from_id(id: u8) -> Result<Self> {
+        match id {
+            0 => Ok(CodecKind::Jpeg),
+            1 => Ok(CodecKind::Mpeg4),
+            _ => Err(Error::Stream(format!("unknown codec id {id}"))),
+        }
+    }
+
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            CodecKind::Jpeg => "jpeg",
+            CodecKind::Mpeg4 => "mpeg4",
+        }
+    }
+}
+
+/// Stream parameters.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Header {
+    /// Vertices per frame `V`.
+    pub vertices: u32,
+    /// Frames `F`.
+    pub frames: u32,
+    /// Triangles of the shared connectivity.
+    pub triangles: u32,
+    /// Motion clusters `K`.
+    pub clusters: u32,
+    /// Geometry-image lattice width in pixels.
+    pub lattice_width: u16,
+    /// Geometry-image lattice height in pixels.
+    pub lattice_height: u16,
+    /// The residual image codec.
+    pub codec: CodecKind,
+    /// The `--quality` the stream was made with (1..100).
+    pub quality: u8,
+    /// The MPEG-4 quantiser (0 for JPEG streams).
+    pub qscale: u8,
+    /// Frames per group of pictures (MPEG-4: an I-frame starts each group; JPEG: 1).
+    pub gop: u32,
+    /// Bits per quantised affine coefficient.
+    pub affine_bits: u8,
+    /// Bits per coordinate of the first frame's geometry.
+    pub first_frame_bits: u8,
+    /// Name of the padding method the encoder used (informational: the decoder does not pad).
+    pub padding: String,
+    /// The `--clusters` asked for (segmentation may use fewer); lets `inspect` re-run the analysis.
+    pub requested_clusters: u32,
+    /// Whether the first-frame coder was allowed to reorder vertices.
+    pub reorder: bool,
+    /// Charts in the atlas (informational).
+    pub charts: u32,
+    /// Lattice pixels covered by chart blocks (informational: packing efficiency).
+    pub chart_pixels: u32,
+}
+
+/// Upper bound on any count in the header, far above any real animation and far below what would let
+/// a forged header exhaust memory before the parts' real sizes are checked.
+const MAX_COUNT: u32 = 1 << 28;
+
+impl Header {
+    /// Packing efficiency of the atlas: chart pixels / lattice pixels.
+    pub fn packing_efficiency(&self) -> f64 {
+        self.chart_pixels as f64 / (self.lattice_width as f64 * self.lattice_height as f64)
+    }
+
+    /// Serialises the header.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = ByteWriter::new();
+        w.u32(self.vertices)
+            .u32(self.frames)
+            .u32(self.triangles)
+            .u32(self.clusters)
+            .u16(self.lattice_width)
+            .u16(self.lattice_height)
+            .u8(self.codec.id())
+            .u8(self.quality)
+            .u8(self.qscale)
+            .u32(self.gop)
+            .u8(self.affine_bits)
+            .u8(self.first_frame_bits)
+            .blob(self.padding.as_bytes())
+            .u32(self.requested_clusters)
+            .u8(self.reorder as u8)
+            .u32(self.charts)
+            .u32(self.chart_pixels);
+        w.into_bytes()
+    }
+
+    /// Parses and sanity-checks a header.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = ByteReader::new(bytes, "header");
+        let h = Header {
+            vertices: r.u32()?,
+            frames: r.u32()?,
+            triangles: r.u32()?,
+            clusters: r.u32()?,
+            lattice_width: r.u16()?,
+            lattice_height: r.u16()?,
+            codec: CodecKind::from_id(r.u8()?)?,
+            quality: r.u8()?,
+            qscale: r.u8()?,
+            gop: r.u32()?,
+            affine_bits: r.u8()?,
+            first_frame_bits: r.u8()?,
+            padding: String::from_utf8_lossy(r.blob()?).into_owned(),
+            requested_clusters: r.u32()?,
+            reorder: r.u8()? != 0,
+            charts: r.u32()?,
+            chart_pixels: r.u32()?,
+        };
+        r.finish()?;
+        for (what, n) in [
+            ("vertices", h.vertices),
+            ("frames", h.frames),
+            ("triangles", h.triangles),
+            ("clusters", h.clusters),
+        ] {
+            if n > MAX_COUNT {
+                return Err(Error::Stream(format!(
+                    "header claims {n} {what} (limit {MAX_COUNT})"
+                )));
+            }
+        }
+        if h.vertices == 0 || h.frames == 0 || h.clusters == 0 || h.clusters > h.vertices {
+            return Err(Error::Stream(format!(
+                "header is inconsistent: {} vertices, {} frames, {} clusters",
+                h.vertices, h.frames, h.clusters
+            )));
+        }
+        if h.lattice_width == 0
+            || h.lattice_height == 0
+            || h.lattice_width % 16 != 0
+            || h.lattice_height % 16 != 0
+        {
+            return Err(Error::Stream(format!(
+                "lattice {}x{} is not a positive multiple of 16",
+                h.lattice_width, h.lattice_height
+            )));
+        }
+        if !(1..=32).contains(&h.affine_bits)
+            || !(1..=24).contains(&h.first_frame_bits)
+            || h.gop == 0
+        {
+            return Err(Error::Stream(
+                "header has out-of-range quantisation parameters".into(),
+            ));
+        }
+        Ok(h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Header {
+        Header {
+            vertices: 3030,
+            frames: 400,
+            triangles: 5664,
+            clusters: 20,
+            lattice_width: 256,
+            lattice_height: 256,
+            codec: CodecKind::Mpeg4,
+            quality: 75,
+            qscale: 4,
+            gop: 50,
+            affine_bits: 17,
+            first_frame_bits: 12,
+            padding: "cg".into(),
+            requested_clusters: 20,
+            reorder: false,
+            charts: 31,
+            chart_pixels: 40_000,
+        }
+    }
+
+    #[test]
+    fn round_trip() {
+        let h = sample();
+        assert_eq!(Header::from_bytes(&h.to_bytes()).unwrap(), h);
+    }
+
+    #[test]
+    fn refuses_absurd_counts_before_allocating() {
+        let mut h = sample();
+        h.vertices = 1_000_000_000;
+        assert!(Header::from_bytes(&h.to_bytes()).is_err());
+        let mut h = sample();
+        h.clusters = 0;
+        assert!(Header::from_bytes(&h.to_bytes()).is_err());
+        let bytes = sample().to_bytes();
+        for cut in 0..bytes.len() {
+            assert!(Header::from_bytes(&bytes[..cut]).is_err());
+        }
+    }
+}

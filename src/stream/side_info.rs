@@ -1,0 +1,197 @@
+//! Entropy coding of the side information: the partition, the lattice coordinates and the affine
+//! coefficients. Each is written once as a traversal generic over [`SymbolCoder`], so the encoder and
+//! the decoder cannot drift apart.
+//!
+//! What is exploited: labels are spatially coherent (a vertex usually shares the label most of its
+//! already-coded neighbours have); lattice coordinates of mesh neighbours are near each other; affine
+//! coefficients change slowly from frame to frame.
+
+use crate::error::{Error, Result};
+use crate::mesh::topology::VertexAdjacency;
+use crate::mesh::Triangle;
+use crate::motion::{AffineTrack, QuantisedAffine};
+use crate::stream::bytes::{ByteReader, ByteWriter};
+use crate::stream::entropy::{self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel};
+
+/// Refuses a decode that would need more symbols than `bytes` can possibly hold, before allocating.
+fn check_capacity(symbols: u64, bytes: usize, what: &str) -> Result<()> {
+    if symbols > entropy::max_symbols(bytes) {
+        return Err(Error::Stream(format!("{what}: {symbols} values cannot fit in {bytes} bytes")));
+    }
+    Ok(())
+}
+
+/// The label most common among `v`'s already-coded neighbours (lowest on ties), if any.
+fn predicted_label(adj: &VertexAdjacency, labels: &[u32], v: usize, counts: &mut Vec<(u32, u32)>) -> Option<u32> {
+    counts.clear();
+    for &w in adj.neighbours(v).iter().filter(|&&w| (w as usize) < v) {
+        let l = labels[w as usize];
+        match counts.iter_mut().find(|(lab, _)| *lab == l) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((l, 1)),
+        }
+    }
+    counts.iter().max_by_key(|&&(l, n)| (n, std::cmp::Reverse(l))).map(|&(l, _)| l)
+}
+
+fn code_partition<C: SymbolCoder>(c: &mut C, labels: &mut [u32], clusters: usize, adj: &VertexAdjacency) -> Result<()> {
+    let mut hit = [BitModel::default(), BitModel::default()];
+    let mut small = SymbolModel::new(clusters);
+    let mut large = UIntModel::default();
+    let mut counts = Vec::new();
+    for v in 0..labels.len() {
+        let (ctx, guess) = match predicted_label(adj, labels, v, &mut counts) {
+            Some(l) => (0, l),
+            None => (1, if v > 0 { labels[v - 1] } else { 0 }),
+        };
+        if c.bit(labels[v] == guess, &mut hit[ctx])? {
+            labels[v] = guess;
+            continue;
+        }
+        let l = if clusters <= 256 {
+            c.symbol(labels[v] as usize, &mut small)? as u64
+        } else {
+            c.unsigned(labels[v] as u64, &mut large)?
+        };
+        if l >= clusters as u64 || l == guess as u64 {
+            return Err(Error::Stream(format!("partition: vertex {v} has an impossible label")));
+        }
+        labels[v] = l as u32;
+    }
+    Ok(())
+}
+
+/// Codes the cluster label of each vertex.
+pub fn encode_partition(labels: &[u32], clusters: usize, triangles: &[Triangle]) -> Result<Vec<u8>> {
+    let adj = VertexAdjacency::new(labels.len(), triangles);
+    let mut enc = Encoder::new();
+    code_partition(&mut enc, &mut labels.to_vec(), clusters, &adj)?;
+    enc.finish()
+}
+
+/// Decodes `vertices` cluster labels in `0..clusters`.
+pub fn decode_partition(bytes: &[u8], vertices: usize, clusters: usize, triangles: &[Triangle]) -> Result<Vec<u32>> {
+    check_capacity(vertices as u64, bytes.len(), "partition")?;
+    let adj = VertexAdjacency::new(vertices, triangles);
+    let mut dec = Decoder::new(bytes)?;
+    let mut labels = vec![0u32; vertices];
+    code_partition(&mut dec, &mut labels, clusters, &adj)?;
+    Ok(labels)
+}
+
+fn code_lattice<C: SymbolCoder>(c: &mut C, pixels: &mut [[u16; 2]], size: (u16, u16), adj: &VertexAdjacency) -> Result<()> {
+    let mut near = [IntModel::default(), IntModel::default()];
+    let mut far = [IntModel::default(), IntModel::default()];
+    let limits = [size.0 as i64, size.1 as i64];
+    for v in 0..pixels.len() {
+        let (mut sum, mut n) = ([0i64; 2], 0i64);
+        for &w in adj.neighbours(v).iter().filter(|&&w| (w as usize) < v) {
+            let p = pixels[w as usize];
+            sum[0] += p[0] as i64;
+            sum[1] += p[1] as i64;
+            n += 1;
+        }
+        let (guess, models) = if n > 0 {
+            ([(sum[0] + n / 2) / n, (sum[1] + n / 2) / n], &mut near)
+        } else if v > 0 {
+            ([pixels[v - 1][0] as i64, pixels[v - 1][1] as i64], &mut far)
+        } else {
+            ([0, 0], &mut far)
+        };
+        for a in 0..2 {
+            let d = c.signed(pixels[v][a] as i64 - guess[a], &mut models[a])?;
+            let value = guess[a] + d;
+            if !(0..limits[a]).contains(&value) {
+                return Err(Error::Stream(format!("lattice coordinate of vertex {v} is outside the lattice")));
+            }
+            pixels[v][a] = value as u16;
+        }
+    }
+    Ok(())
+}
+
+/// Codes the lattice pixel of each vertex.
+pub fn encode_lattice(pixels: &[[u16; 2]], size: (u16, u16), triangles: &[Triangle]) -> Result<Vec<u8>> {
+    let adj = VertexAdjacency::new(pixels.len(), triangles);
+    let mut enc = Encoder::new();
+    code_lattice(&mut enc, &mut pixels.to_vec(), size, &adj)?;
+    enc.finish()
+}
+
+/// Decodes `vertices` lattice pixels inside a `size` lattice.
+pub fn decode_lattice(bytes: &[u8], vertices: usize, size: (u16, u16), triangles: &[Triangle]) -> Result<Vec<[u16; 2]>> {
+    check_capacity(2 * vertices as u64, bytes.len(), "lattice coordinates")?;
+    let adj = VertexAdjacency::new(vertices, triangles);
+    let mut dec = Decoder::new(bytes)?;
+    let mut pixels = vec![[0u16; 2]; vertices];
+    code_lattice(&mut dec, &mut pixels, size, &adj)?;
+    Ok(pixels)
+}
+
+/// Frame-to-frame differences of each of the 12 coefficients, one adaptive model per coefficient
+/// index; the first frame's values as differences from mid-range.
+fn code_affine_values<C: SymbolCoder>(c: &mut C, q: &mut QuantisedAffine) -> Result<()> {
+    let mut first: Vec<IntModel> = vec![IntModel::default(); 12];
+    let mut delta: Vec<IntModel> = vec![IntModel::default(); 12];
+    let top = (1i64 << q.bits) - 1;
+    let per_frame = q.clusters * 12;
+    for i in 0..q.values.len() {
+        let (f, coeff) = (i / per_frame, i % 12);
+        let (base, model) = if f == 0 {
+            ((top + 1) / 2, &mut first[coeff])
+        } else {
+            (q.values[i - per_frame] as i64, &mut delta[coeff])
+        };
+        let value = base + c.signed(q.values[i] as i64 - base, model)?;
+        if !(0..=top).contains(&value) {
+            return Err(Error::Stream("affine coefficient outside its quantisation range".into()));
+        }
+        q.values[i] = value as u32;
+    }
+    Ok(())
+}
+
+/// Codes the quantised affine coefficients and their ranges.
+pub fn encode_affine(track: &AffineTrack) -> Result<Vec<u8>> {
+    let mut q = track.quantised().clone();
+    let mut w = ByteWriter::new();
+    w.u8(q.bits);
+    for (lo, hi) in q.ranges {
+        w.f32(lo).f32(hi);
+    }
+    let mut enc = Encoder::new();
+    code_affine_values(&mut enc, &mut q)?;
+    w.raw(&enc.finish()?);
+    Ok(w.into_bytes())
+}
+
+/// Decodes the affine track of `frames` frames and `clusters` clusters at `bits` bits.
+pub fn decode_affine(bytes: &[u8], frames: usize, clusters: usize, bits: u8) -> Result<AffineTrack> {
+    let mut r = ByteReader::new(bytes, "affine coefficients");
+    let stored_bits = r.u8()?;
+    if stored_bits != bits {
+        return Err(Error::Stream(format!(
+            "affine coefficients have {stored_bits} bits, header says {bits}"
+        )));
+    }
+    let mut ranges = [(0f32, 0f32); 12];
+    for range in ranges.iter_mut() {
+        *range = (r.f32()?, r.f32()?);
+    }
+    if !(1..=31).contains(&bits) {
+        return Err(Error::Stream(format!("affine coefficients: {bits} bits is out of range")));
+    }
+    let rest = r.take(r.remaining())?;
+    let count = (frames as u64).saturating_mul(clusters as u64).saturating_mul(12);
+    check_capacity(count, rest.len(), "affine coefficients")?;
+    let mut q = QuantisedAffine {
+        bits,
+        frames,
+        clusters,
+        ranges,
+        values: vec![0; count as usize],
+    };
+    let mut dec = Decoder::new(rest)?;
+    code_affine_values(&mut dec, &mut q)?;
+    AffineTrack::from_quantised(q)
+}
