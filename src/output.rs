@@ -9,7 +9,10 @@ use std::path::Path;
 /// (the temporary file is removed when dropped).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     if path.is_dir() {
-        return Err(Error::Usage(format!("{} is a folder, not a file", path.display())));
+        return Err(Error::Usage(format!(
+            "{} is a folder, not a file",
+            path.display()
+        )));
     }
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,

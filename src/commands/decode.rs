@@ -11,7 +11,8 @@ use std::time::Instant;
 
 /// Whether the output path names a PC2 point cache rather than an OBJ folder.
 fn is_pc2(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("pc2"))
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pc2"))
 }
 
 /// Runs `decode`.

@@ -13,10 +13,11 @@ use std::time::Instant;
 pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
     let lattice = parse_lattice(&args.lattice)?;
     let padding = match &args.padding {
-        Some(name) => name
-            .parse::<padding::Method>()
-            .map_err(|e| Error::Usage(format!("--padding {name}: {e}")))?,
-        None => padding::PaddingOptions::default().method,
+        Some(name) => Some(
+            name.parse::<padding::Method>()
+                .map_err(|e| Error::Usage(format!("--padding {name}: {e}")))?,
+        ),
+        None => None,
     };
     Ok(EncodeOptions {
         codec: match args.codec {
@@ -37,16 +38,26 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
 
 /// Parses `WIDTHxHEIGHT`.
 pub fn parse_lattice(s: &str) -> Result<(u16, u16)> {
-    let bad = || Error::Usage(format!("--lattice {s}: expected WIDTHxHEIGHT, e.g. 256x256"));
+    let bad = || {
+        Error::Usage(format!(
+            "--lattice {s}: expected WIDTHxHEIGHT, e.g. 256x256"
+        ))
+    };
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    Ok((w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?))
+    Ok((
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    ))
 }
 
 /// Refuses to write the output over the input.
 fn check_not_input(input: &str, output: &Path) -> Result<()> {
     if let (Ok(a), Ok(b)) = (Path::new(input).canonicalize(), output.canonicalize()) {
         if a == b {
-            return Err(Error::Usage(format!("refusing to overwrite the input {}", output.display())));
+            return Err(Error::Usage(format!(
+                "refusing to overwrite the input {}",
+                output.display()
+            )));
         }
     }
     Ok(())

@@ -2,10 +2,10 @@
 
 use crate::cli::EvalArgs;
 use crate::decoder::Decoder;
-use crate::progress;
 use crate::error::{Error, Result};
 use crate::mesh::{read_animation, ReadOptions};
 use crate::metrics::{compare, Measures};
+use crate::progress;
 use std::path::Path;
 
 /// Runs `eval`.
@@ -99,9 +99,9 @@ mod tests {
     }
 
     #[test]
-    fn a_mcgv_second_argument_is_a_clear_usage_error() {
-        assert!(reject_mcgv("frames/").is_ok());
-        let err = reject_mcgv("out.MCGV");
-        assert!(matches!(err, Err(Error::Usage(m)) if m.contains(".mcgv is not yet")));
+    fn mcgv_streams_are_recognised_by_extension() {
+        assert!(!is_mcgv("frames/"));
+        assert!(is_mcgv("out.MCGV"));
+        assert!(!is_mcgv("walk.glb"));
     }
 }

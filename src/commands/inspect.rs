@@ -55,7 +55,10 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
         return Ok(());
     }
     println!("{}", summary(&header, &args.input));
-    println!("{:<22} {:>12} {:>14} {:>7} {:>8}", "part", "bytes", "bits", "%", "bpvf");
+    println!(
+        "{:<22} {:>12} {:>14} {:>7} {:>8}",
+        "part", "bytes", "bits", "%", "bpvf"
+    );
     for (name, bytes) in &parts {
         println!(
             "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
@@ -66,7 +69,14 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             *bytes as f64 * 8.0 / vf
         );
     }
-    println!("{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}", "total", total, total * 8, 100.0, bpvf);
+    println!(
+        "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
+        "total",
+        total,
+        total * 8,
+        100.0,
+        bpvf
+    );
     Ok(())
 }
 
@@ -105,13 +115,18 @@ pub fn cluster_colour(k: u32) -> [u8; 3] {
         _ => (c, 0.0, x),
     };
     let m = v - c;
-    [((r + m) * 255.0) as u8, ((g + m) * 255.0) as u8, ((b + m) * 255.0) as u8]
+    [
+        ((r + m) * 255.0) as u8,
+        ((g + m) * 255.0) as u8,
+        ((b + m) * 255.0) as u8,
+    ]
 }
 
 fn save_gray(path: &Path, width: u32, height: u32, data: Vec<u8>) -> Result<()> {
     let img = image::GrayImage::from_raw(width, height, data)
         .ok_or_else(|| Error::Usage("image size mismatch".into()))?;
-    img.save(path).map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
+    img.save(path)
+        .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
 }
 
 fn save_levels(path: &Path, images: &[Vec<f32>; 3], w: usize, h: usize) -> Result<()> {
@@ -127,10 +142,20 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
 ) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let header = decoder.header().clone();
-    let (w, h) = (header.lattice_width as usize, header.lattice_height as usize);
-    let frames: Vec<usize> = if args.frames.is_empty() { vec![0] } else { args.frames.clone() };
+    let (w, h) = (
+        header.lattice_width as usize,
+        header.lattice_height as usize,
+    );
+    let frames: Vec<usize> = if args.frames.is_empty() {
+        vec![0]
+    } else {
+        args.frames.clone()
+    };
     if let Some(&bad) = frames.iter().find(|&&f| f >= header.frames as usize) {
-        return Err(Error::Usage(format!("--frames {bad}: the stream has frames 0 to {}", header.frames - 1)));
+        return Err(Error::Usage(format!(
+            "--frames {bad}: the stream has frames 0 to {}",
+            header.frames - 1
+        )));
     }
 
     // The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
@@ -161,12 +186,19 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
 
     for &f in &frames {
         let plane = decoder.decoded_plane(f)?;
-        save_gray(&dir.join(format!("frame_{f:04}_decoded.png")), plane.width, plane.height, plane.data)?;
+        save_gray(
+            &dir.join(format!("frame_{f:04}_decoded.png")),
+            plane.width,
+            plane.height,
+            plane.data,
+        )?;
     }
 
     if let Some(original) = &args.original {
         let mesh = read_animation(original, &(&args.input_args).into())?;
-        if mesh.vertex_count() != header.vertices as usize || mesh.frame_count() != header.frames as usize {
+        if mesh.vertex_count() != header.vertices as usize
+            || mesh.frame_count() != header.frames as usize
+        {
             return Err(Error::Usage(format!(
                 "{original} has {} vertices x {} frames; the stream has {} x {}",
                 mesh.vertex_count(),
@@ -183,10 +215,12 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             affine_bits: header.affine_bits,
             first_frame_bits: header.first_frame_bits,
             lattice: (header.lattice_width, header.lattice_height),
-            padding: header
-                .padding
-                .parse()
-                .map_err(|e| Error::Stream(format!("padding {}: {e}", header.padding)))?,
+            padding: Some(
+                header
+                    .padding
+                    .parse()
+                    .map_err(|e| Error::Stream(format!("padding {}: {e}", header.padding)))?,
+            ),
             gop: header.gop as usize,
             reorder: header.reorder,
         };

@@ -68,7 +68,10 @@ pub fn write_obj_sequence(mesh: &AnimatedMesh, dir: &Path) -> Result<()> {
 /// `frame_0057.obj`).
 pub fn write_obj_sequence_from(mesh: &AnimatedMesh, dir: &Path, first: usize) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let digits = (first + mesh.frame_count().saturating_sub(1)).to_string().len().max(4);
+    let digits = (first + mesh.frame_count().saturating_sub(1))
+        .to_string()
+        .len()
+        .max(4);
     for (f, frame) in mesh.frames().iter().enumerate() {
         let path = dir.join(format!("frame_{:0digits$}.obj", first + f));
         write_atomic(&path, obj::obj_text(mesh.triangles(), frame).as_bytes())?;
@@ -82,4 +85,3 @@ pub fn write_pc2(mesh: &AnimatedMesh, path: &Path) -> Result<()> {
         pc2::pc2_bytes(mesh).map_err(|e| Error::Usage(format!("{}: {e}", path.display())))?;
     write_atomic(path, &bytes)
 }
-

@@ -142,7 +142,6 @@ impl ContainerWriter {
     }
 }
 
-
 /// Where one part lies in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PartEntry {
