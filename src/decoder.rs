@@ -7,7 +7,7 @@ use crate::mesh::{AnimatedMesh, Point, Triangle};
 use crate::motion::{AffineTrack, Partition};
 use crate::stream::bytes::ByteReader;
 use crate::stream::container::{ContainerReader, Tag};
-use crate::stream::frame_index::FrameIndex;
+use crate::stream::frame_index::{ChunkEntry, FrameIndex};
 use crate::stream::header::{CodecKind, Header};
 use crate::stream::{first_frame, side_info};
 use indicatif::ProgressBar;
@@ -117,34 +117,27 @@ impl<R: Read + Seek> Decoder<R> {
         &self.reader
     }
 
+    /// Where frame `f`'s coded picture lies in the images part.
+    pub fn frame_entry(&self, f: usize) -> Result<ChunkEntry> {
+        self.index.entry(f)
+    }
+
     /// Decodes frame `f` alone: reads only its own chunk for intra streams, and the chunks from the
     /// last key frame for P-frame streams.
     pub fn decode_frame(&mut self, f: usize) -> Result<Vec<Point>> {
-        self.index.entry(f)?;
-        let plane = match self.header.codec {
-            CodecKind::Jpeg => self.jpeg_plane(f)?,
-            CodecKind::Mpeg4 => {
-                let start = self.index.key_before(f);
-                let mut dec = self.mpeg4_decoder()?;
-                let mut last = None;
-                for g in start..=f {
-                    last = Some(self.mpeg4_next(&mut dec, g)?);
-                }
-                last.ok_or_else(|| Error::Stream("no frame decoded".into()))?
-            }
-        };
+        let plane = self.decoded_plane(f)?;
         self.reconstruct(f, &plane)
     }
 
     /// The decoded picture (x | y | z residual images side by side) of frame `f`.
     pub fn decoded_plane(&mut self, f: usize) -> Result<Plane> {
+        self.index.entry(f)?;
         match self.header.codec {
             CodecKind::Jpeg => self.jpeg_plane(f),
             CodecKind::Mpeg4 => {
-                let start = self.index.key_before(f);
                 let mut dec = self.mpeg4_decoder()?;
                 let mut last = None;
-                for g in start..=f {
+                for g in self.index.key_before(f)..=f {
                     last = Some(self.mpeg4_next(&mut dec, g)?);
                 }
                 last.ok_or_else(|| Error::Stream("no frame decoded".into()))

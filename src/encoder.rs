@@ -75,7 +75,7 @@ pub struct EncodeReport {
     /// Vertices moved to resolve lattice collisions.
     pub moved_vertices: usize,
     /// Seconds per stage.
-    pub seconds: Vec<(String, f64)>,
+    pub stage_seconds: Vec<(String, f64)>,
     /// If the first-frame coder reordered vertices: new index → input index.
     #[serde(skip)]
     pub permutation: Option<Vec<u32>>,
@@ -213,7 +213,7 @@ pub fn encode(
         charts: stats.charts,
         packing_efficiency: stats.packing_efficiency,
         moved_vertices: stats.moved_vertices,
-        seconds,
+        stage_seconds: seconds,
         permutation: ff.permutation,
     };
     Ok(Encoded { container, report })
