@@ -145,7 +145,7 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
         return Partition::from_labels(vec![0; v_count], 1);
     }
     let sampled = SampledMotion::new(mesh, opts.feature_frames);
-    let adjacency = welded_adjacency(mesh);
+    let adjacency = welded_adjacency(mesh, &sampled);
     let (features, misfit) = motion_features(&adjacency, &sampled, opts.ring);
     let inliers = affine_rings(&misfit);
     let training = if inliers.len() >= k {
@@ -177,19 +177,39 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     compact(labels)
 }
 
-/// The mesh's vertex adjacency, plus an edge between vertices at the very same frame-0 position.
-/// Exporters split vertices along UV and normal seams (glTF meshes often fall into dozens of
-/// pieces, a triangle soup at worst); the copies move together, and without these edges their
-/// rings would stop at every seam, down to a lone flat triangle.
-fn welded_adjacency(mesh: &AnimatedMesh) -> VertexAdjacency {
-    let mut first_at = std::collections::HashMap::new();
-    let mut edges: Vec<Triangle> = mesh.triangles().to_vec();
+/// Most copies of one position that are welded: seams make a few; more is collapsed geometry
+/// (e.g. hidden parts parked at one point), and welding it would join unrelated parts through one hub.
+const MAX_WELD_GROUP: usize = 8;
+
+/// The mesh's vertex adjacency, plus an edge between vertices at the very same frame-0 position
+/// that stay together (within float noise) in every sampled frame. Exporters split vertices along
+/// UV and normal seams (glTF meshes often fall into dozens of pieces, a triangle soup at worst);
+/// without these edges the rings would stop at every seam, down to a lone flat triangle.
+fn welded_adjacency(mesh: &AnimatedMesh, motion: &SampledMotion) -> VertexAdjacency {
+    let mut groups: std::collections::HashMap<[u32; 3], Vec<u32>> =
+        std::collections::HashMap::new();
     for (v, p) in mesh.frame(0).iter().enumerate() {
-        let key = p.map(f32::to_bits);
-        let first = *first_at.entry(key).or_insert(v as u32);
-        if first != v as u32 {
-            // A degenerate triangle contributes just the edge (first, v).
-            edges.push([first, v as u32, v as u32]);
+        groups
+            .entry(p.map(f32::to_bits))
+            .or_default()
+            .push(v as u32);
+    }
+    let together = |a: u32, b: u32| {
+        motion.frames.iter().all(|f| {
+            let (p, q) = (f[a as usize], f[b as usize]);
+            (0..3).all(|i| (p[i] - q[i]).abs() <= 1e-6)
+        })
+    };
+    let mut edges: Vec<Triangle> = mesh.triangles().to_vec();
+    for group in groups
+        .values()
+        .filter(|g| (2..=MAX_WELD_GROUP).contains(&g.len()))
+    {
+        for &v in &group[1..] {
+            if together(group[0], v) {
+                // A degenerate triangle contributes just the edge.
+                edges.push([group[0], v, v]);
+            }
         }
     }
     VertexAdjacency::new(mesh.vertex_count(), &edges)
