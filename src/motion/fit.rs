@@ -70,6 +70,8 @@ pub struct AffineSolver {
     inverse: Matrix3<f64>,
     /// For a (nearly) flat source, two tangents and the normal `t1 × t2` of its plane.
     plane: Option<[Vector3<f64>; 3]>,
+    /// Whether some direction of the source is seen less than the regularisation weighs.
+    degenerate: bool,
 }
 
 /// Smallest regularisation per source point, in unit coordinates: keeps a single point invertible.
@@ -101,7 +103,14 @@ impl AffineSolver {
             lambda,
             inverse,
             plane: flat_plane(&scatter, lambda),
+            degenerate: scatter.symmetric_eigenvalues().min() < lambda,
         }
+    }
+
+    /// Whether the source leaves some direction of the map to the regularisation (flat, on a line,
+    /// a single point): the fitted map is then a guess in that direction.
+    pub fn is_degenerate(&self) -> bool {
+        self.degenerate
     }
 
     /// The best map from the source onto `target` (unit coordinates, same order and length as the source).

@@ -121,9 +121,10 @@ impl Partition {
 ///    linear part is weighted by the RMS radius of the shape so both parts measure displacement: a
 ///    change δ of a linear coefficient moves a typical vertex by about radius × δ.
 /// 2. k-means (k-means++ seeded by `opts.seed`, one run) is trained on the vertices whose ring moves
-///    affinely (ring misfit ≤ 4 × median); every vertex then takes its nearest centroid. Rings
-///    straddling differently moving parts give far-off descriptors that would otherwise draw
-///    centroids away from the parts; those vertices take the cluster whose affine maps predict their
+///    affinely (ring misfit ≤ 4 × median) and is not degenerate (flat, on a line); every vertex
+///    then takes its nearest centroid. Rings straddling differently moving parts give far-off
+///    descriptors that would otherwise draw centroids away from the parts, and degenerate rings
+///    give partly guessed ones; those vertices take the cluster whose affine maps predict their
 ///    trajectory best instead.
 /// 3. `opts.refine_passes` passes move cluster borders to lower the prediction error (see
 ///    [`SegmentOptions::refine_passes`]).
@@ -298,7 +299,13 @@ fn motion_features(
                     }
                 }
                 let samples = (ring.len() * motion.frames.len()).max(1);
-                *misfit = (error / samples as f64).sqrt() as f32;
+                // A degenerate ring's descriptor is partly the regulariser's guess: keep it out of
+                // k-means training like a torn ring, and let its trajectory decide its cluster.
+                *misfit = if solver.is_degenerate() {
+                    f32::INFINITY
+                } else {
+                    (error / samples as f64).sqrt() as f32
+                };
             },
         );
     // The shape is (V, dim) by construction.
