@@ -50,11 +50,22 @@ impl<R: Read + Seek> Decoder<R> {
                 header.triangles
             )));
         }
-        let labels = side_info::decode_partition(&reader.part(Tag::PARTITION)?, v, header.clusters as usize, &triangles)?;
+        let labels = side_info::decode_partition(
+            &reader.part(Tag::PARTITION)?,
+            v,
+            header.clusters as usize,
+            &triangles,
+        )?;
         let partition = Partition::from_labels(labels, header.clusters as usize)?;
         let lattice = (header.lattice_width, header.lattice_height);
-        let pixels = side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, &triangles)?;
-        let track = side_info::decode_affine(&reader.part(Tag::AFFINE)?, f, partition.clusters(), header.affine_bits)?;
+        let pixels =
+            side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, &triangles)?;
+        let track = side_info::decode_affine(
+            &reader.part(Tag::AFFINE)?,
+            f,
+            partition.clusters(),
+            header.affine_bits,
+        )?;
         let ranges_bytes = reader.part(Tag::RANGES)?;
         let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
         let ranges = quantise::read_ranges(&mut r, f)?;
@@ -162,7 +173,8 @@ impl<R: Read + Seek> Decoder<R> {
 
     fn frame_bytes(&mut self, f: usize) -> Result<Vec<u8>> {
         let e = self.index.entry(f)?;
-        self.reader.chunk(Tag::FRAMES, e.offset, e.len, e.crc, &format!("frame {f}"))
+        self.reader
+            .chunk(Tag::FRAMES, e.offset, e.len, e.crc, &format!("frame {f}"))
     }
 
     fn jpeg_plane(&mut self, f: usize) -> Result<Plane> {
@@ -184,13 +196,18 @@ impl<R: Read + Seek> Decoder<R> {
         if planes.is_empty() {
             planes = dec.flush()?;
         }
-        planes
-            .pop()
-            .ok_or_else(|| Error::Stream(format!("frame {f}: the MPEG-4 packet decoded to no picture")))
+        planes.pop().ok_or_else(|| {
+            Error::Stream(format!(
+                "frame {f}: the MPEG-4 packet decoded to no picture"
+            ))
+        })
     }
 
     fn picture_size(&self) -> (u32, u32) {
-        (3 * self.header.lattice_width as u32, self.header.lattice_height as u32)
+        (
+            3 * self.header.lattice_width as u32,
+            self.header.lattice_height as u32,
+        )
     }
 
     fn reconstruct(&self, f: usize, plane: &Plane) -> Result<Vec<Point>> {
@@ -202,7 +219,9 @@ impl<R: Read + Seek> Decoder<R> {
             )));
         }
         let lw = self.header.lattice_width as usize;
-        let mut out = self.track.predict(f, &self.reference, &self.partition);
+        let mut out = self
+            .track
+            .try_predict(f, &self.reference, &self.partition)?;
         for a in 0..3 {
             let levels = tile::sample(plane, a, lw, &self.pixels);
             let range = self.ranges[f][a];

@@ -29,8 +29,8 @@ pub struct EncodeOptions {
     pub first_frame_bits: u8,
     /// Lattice width and height.
     pub lattice: (u16, u16),
-    /// Padding of the free pixels.
-    pub padding: padding::Method,
+    /// Padding of the free pixels; `None` picks the codec's measured best (see [`padding_method`]).
+    pub padding: Option<padding::Method>,
     /// MPEG-4 group of pictures.
     pub gop: usize,
     /// Let the first-frame coder permute vertices.
@@ -47,7 +47,7 @@ impl Default for EncodeOptions {
             affine_bits: 17,
             first_frame_bits: 12,
             lattice: (256, 256),
-            padding: padding::Method::default(),
+            padding: None,
             gop: 50,
             reorder: false,
         }
@@ -106,7 +106,11 @@ pub struct Analysis {
 }
 
 /// Encodes an animation; `progress` is advanced once per frame coded.
-pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions, progress: &ProgressBar) -> Result<Encoded> {
+pub fn encode(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    progress: &ProgressBar,
+) -> Result<Encoded> {
     check_options(mesh, opts)?;
     let mut seconds = Vec::new();
     let mut clock = Instant::now();
@@ -158,22 +162,38 @@ pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions, progress: &ProgressBar)
         },
         affine_bits: opts.affine_bits,
         first_frame_bits: opts.first_frame_bits,
-        padding: opts.padding.to_string(),
+        padding: padding_method(opts).to_string(),
+        requested_clusters: opts.clusters as u32,
+        reorder: opts.reorder,
+        charts: analysis.atlas.stats().charts as u32,
+        chart_pixels: analysis.atlas.stats().chart_pixels as u32,
     };
     let mut container = ContainerWriter::new();
     container.add(Tag::HEADER, header.to_bytes(), Checksum::Whole);
     container.add(Tag::FIRST_FRAME, ff.bytes, Checksum::Whole);
     container.add(
         Tag::PARTITION,
-        side_info::encode_partition(analysis.partition.labels(), analysis.partition.clusters(), mesh.triangles())?,
+        side_info::encode_partition(
+            analysis.partition.labels(),
+            analysis.partition.clusters(),
+            mesh.triangles(),
+        )?,
         Checksum::Whole,
     );
     container.add(
         Tag::LATTICE,
-        side_info::encode_lattice(analysis.atlas.vertex_pixels(), opts.lattice, mesh.triangles())?,
+        side_info::encode_lattice(
+            analysis.atlas.vertex_pixels(),
+            opts.lattice,
+            mesh.triangles(),
+        )?,
         Checksum::Whole,
     );
-    container.add(Tag::AFFINE, side_info::encode_affine(&analysis.track)?, Checksum::Whole);
+    container.add(
+        Tag::AFFINE,
+        side_info::encode_affine(&analysis.track)?,
+        Checksum::Whole,
+    );
     let mut w = crate::stream::bytes::ByteWriter::new();
     quantise::write_ranges(&analysis.ranges, &mut w);
     container.add(Tag::RANGES, w.into_bytes(), Checksum::Whole);
@@ -204,7 +224,9 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
         return Err(Error::Usage("--clusters must be at least 1".into()));
     }
     if !(8..=32).contains(&opts.affine_bits) {
-        return Err(Error::Usage("--affine-bits must be between 8 and 32".into()));
+        return Err(Error::Usage(
+            "--affine-bits must be between 8 and 32".into(),
+        ));
     }
     let (w, h) = opts.lattice;
     if w == 0 || h == 0 || w % 16 != 0 || h % 16 != 0 || w > 4096 || h > 4096 {
@@ -216,21 +238,39 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
         return Err(Error::Usage("--gop must be at least 1".into()));
     }
     if mesh.triangles().is_empty() {
-        return Err(Error::Mesh("the mesh has no triangles: nothing to parameterize".into()));
+        return Err(Error::Mesh(
+            "the mesh has no triangles: nothing to parameterize".into(),
+        ));
     }
     Ok(())
+}
+
+/// The padding an encoding uses: the user's choice, else the measured winner for the codec —
+/// `snap` (tuned to JPEG's quantiser at the stream's quality) for JPEG, and for MPEG-4, whose
+/// quantiser differs, the quality-independent `biharmonic`.
+pub fn padding_method(opts: &EncodeOptions) -> padding::Method {
+    opts.padding.unwrap_or(match opts.codec {
+        CodecKind::Jpeg => padding::Method::Snap,
+        CodecKind::Mpeg4 => padding::Method::Biharmonic,
+    })
 }
 
 /// The MPEG-4 quantiser an encoding uses (0 for JPEG).
 pub fn qscale(opts: &EncodeOptions) -> u8 {
     match opts.codec {
         CodecKind::Jpeg => 0,
-        CodecKind::Mpeg4 => opts.qscale.unwrap_or_else(|| codec::quality_to_qscale(opts.quality)),
+        CodecKind::Mpeg4 => opts
+            .qscale
+            .unwrap_or_else(|| codec::quality_to_qscale(opts.quality)),
     }
 }
 
 /// Segmentation, prediction, atlas and residuals: everything before the images are coded.
-pub fn analyse(mesh: &AnimatedMesh, reference: Vec<Point>, opts: &EncodeOptions) -> Result<Analysis> {
+pub fn analyse(
+    mesh: &AnimatedMesh,
+    reference: Vec<Point>,
+    opts: &EncodeOptions,
+) -> Result<Analysis> {
     let partition = motion::segment(
         mesh,
         &SegmentOptions {
@@ -251,8 +291,13 @@ pub fn analyse(mesh: &AnimatedMesh, reference: Vec<Point>, opts: &EncodeOptions)
     )
     .map_err(|e| Error::Usage(format!("atlas: {e}")))?;
     let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
-        .map(|f| motion::residuals(mesh.frame(f), &track.predict(f, &reference, &partition)))
-        .collect();
+        .map(|f| {
+            Ok(motion::residuals(
+                mesh.frame(f),
+                &track.try_predict(f, &reference, &partition)?,
+            ))
+        })
+        .collect::<Result<_>>()?;
     let mode = match opts.codec {
         CodecKind::Jpeg => RangeMode::PerFrame,
         CodecKind::Mpeg4 => RangeMode::PerGroup(opts.gop),
@@ -268,6 +313,20 @@ pub fn analyse(mesh: &AnimatedMesh, reference: Vec<Point>, opts: &EncodeOptions)
     })
 }
 
+/// Frame `f`'s residuals of coordinate `axis` as levels in `0..=255` on the lattice, before padding
+/// (free pixels are 0).
+pub fn level_image(analysis: &Analysis, f: usize, axis: usize) -> Result<Vec<f32>> {
+    let range = analysis.ranges[f][axis];
+    let levels: Vec<f32> = analysis.residuals[f]
+        .iter()
+        .map(|r| range.quantise(r[axis]))
+        .collect();
+    analysis
+        .atlas
+        .try_splat(&levels)
+        .map_err(|e| Error::Codec(format!("atlas: {e}")))
+}
+
 /// The three padded residual images of frame `f` (levels in `0..=255`, before rounding).
 /// `previous` holds the previous frame's padded images for P-frame coding.
 pub fn residual_images(
@@ -280,9 +339,7 @@ pub fn residual_images(
     let fixed = analysis.atlas.fixed_mask();
     let mut out: [Vec<f32>; 3] = Default::default();
     for (a, img) in out.iter_mut().enumerate() {
-        let range = analysis.ranges[f][a];
-        let levels: Vec<f32> = analysis.residuals[f].iter().map(|r| range.quantise(r[a])).collect();
-        let mut image = analysis.atlas.splat(&levels);
+        let mut image = level_image(analysis, f, a)?;
         padding::pad(
             &mut image,
             w,
@@ -290,7 +347,8 @@ pub fn residual_images(
             &fixed,
             previous.map(|p| p[a].as_slice()),
             &padding::PaddingOptions {
-                method: opts.padding,
+                method: padding_method(opts),
+                jpeg_quality: opts.quality,
                 ..padding::PaddingOptions::default()
             },
         )
@@ -301,7 +359,11 @@ pub fn residual_images(
 }
 
 /// Codes every frame's images: returns the codec set-up part and one chunk per frame.
-fn code_images(analysis: &Analysis, opts: &EncodeOptions, progress: &ProgressBar) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
+fn code_images(
+    analysis: &Analysis,
+    opts: &EncodeOptions,
+    progress: &ProgressBar,
+) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
     let (w, h) = (opts.lattice.0 as usize, opts.lattice.1 as usize);
     let frames = analysis.residuals.len();
     let mut chunks = Vec::with_capacity(frames);
@@ -320,7 +382,10 @@ fn code_images(analysis: &Analysis, opts: &EncodeOptions, progress: &ProgressBar
                     }
                     Some(_) => {}
                 }
-                chunks.push(FrameChunk { data: scan.to_vec(), key: true });
+                chunks.push(FrameChunk {
+                    data: scan.to_vec(),
+                    key: true,
+                });
                 progress.inc(1);
             }
             Ok((shared_header.unwrap_or_default(), chunks))
@@ -338,7 +403,11 @@ fn code_images(analysis: &Analysis, opts: &EncodeOptions, progress: &ProgressBar
             let mut packets = Vec::with_capacity(frames);
             for f in 0..frames {
                 // A new group starts from an I-frame: its blocks without data need no temporal continuity.
-                let prev = if f % opts.gop == 0 { None } else { previous.as_ref() };
+                let prev = if f % opts.gop == 0 {
+                    None
+                } else {
+                    previous.as_ref()
+                };
                 let imgs = residual_images(analysis, f, opts, prev)?;
                 let plane: Plane = tile::compose([&imgs[0], &imgs[1], &imgs[2]], w, h);
                 packets.extend(enc.encode(&plane)?);
@@ -352,7 +421,10 @@ fn code_images(analysis: &Analysis, opts: &EncodeOptions, progress: &ProgressBar
                     packets.len()
                 )));
             }
-            chunks.extend(packets.into_iter().map(|p| FrameChunk { data: p.data, key: p.key }));
+            chunks.extend(packets.into_iter().map(|p| FrameChunk {
+                data: p.data,
+                key: p.key,
+            }));
             Ok((Vec::new(), chunks))
         }
     }

@@ -6,11 +6,15 @@
 pub mod cli;
 pub mod codec;
 pub mod commands;
+pub mod decoder;
+pub mod encoder;
 pub mod error;
 pub mod geometry_image;
 pub mod mesh;
 pub mod metrics;
 pub mod motion;
+pub mod output;
+pub mod progress;
 pub mod stream;
 
 pub use error::{Error, Result};

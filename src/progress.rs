@@ -8,9 +8,9 @@ pub fn bar(len: u64, what: &str, quiet: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if let Ok(style) =
-        ProgressStyle::with_template("{prefix:>8} [{bar:30}] {pos}/{len} frames {msg} ({elapsed}, eta {eta})")
-    {
+    if let Ok(style) = ProgressStyle::with_template(
+        "{prefix:>8} [{bar:30}] {pos}/{len} frames {msg} ({elapsed}, eta {eta})",
+    ) {
         pb.set_style(style.progress_chars("=> "));
     }
     pb.set_prefix(what.to_string());

@@ -1,1 +1,264 @@
-//! Smooth padding of the free pixels of geometry images (filled in by the padding issue).
+//! Padding of the free pixels of multi-chart geometry images before block-DCT coding.
+//!
+//! A geometry image holds a value at the pixels covered by charts ("fixed") and don't-care values
+//! elsewhere ("free"). The codec pays for every pixel, so free pixels are filled to cost it as little
+//! as possible: [`pad`] does this in place with one of several [`Method`]s, never touching a fixed
+//! pixel. The crate knows images and masks only.
+//!
+//! ```
+//! use padding::{pad, Method, PaddingOptions};
+//! let (w, h) = (16, 8);
+//! let mut image = vec![0.0f32; w * h];
+//! let mut fixed = vec![false; w * h];
+//! image[0] = 10.0;
+//! fixed[0] = true;
+//! pad(&mut image, w, h, &fixed, None, &PaddingOptions::with_method(Method::Cg)).unwrap();
+//! assert!(image.iter().all(|&v| v == 10.0));
+//! ```
+
+mod block_laplace;
+mod cg;
+mod dct_energy;
+mod empty_blocks;
+mod error;
+mod grid;
+mod image_laplace;
+mod options;
+mod push_pull;
+
+pub use error::PaddingError;
+pub use options::{EmptyBlocks, Method, PaddingOptions};
+
+use block_laplace::BlockLaplace;
+use dct_energy::{DctEnergy, Weighting};
+use grid::BlockGrid;
+
+/// What a call to [`pad`] did, for benches and diagnostics.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PadStats {
+    /// Linear systems solved by conjugate gradient.
+    pub systems: usize,
+    /// Conjugate gradient iterations, summed over systems.
+    pub cg_iterations: usize,
+    /// Systems stopped by `max_iterations` before reaching `tolerance` (their last iterate is used).
+    pub unconverged: usize,
+}
+
+impl PadStats {
+    fn record(&mut self, report: cg::CgReport) {
+        self.systems += 1;
+        self.cg_iterations += report.iterations;
+        if !report.converged {
+            self.unconverged += 1;
+        }
+    }
+}
+
+/// Fills the free pixels (`fixed[i] == false`) of a row-major `width × height` image in place;
+/// fixed pixels never change.
+///
+/// `previous` is the previous padded frame (same size) when coding P-frames: blocks without a fixed
+/// pixel copy it, so the codec can skip them. Without it (intra), such blocks are filled as the
+/// method says (block methods: flat, see [`EmptyBlocks`]). An image with no
+/// fixed pixel and no previous frame is filled with 0.
+///
+/// Errors (never panics) on an empty image, buffers whose length is not `width × height`, a zero
+/// block size (or not 8 for the DCT-based `dct`, `biharmonic` and `snap`), or a non-finite fixed or previous pixel.
+pub fn pad(
+    image: &mut [f32],
+    width: usize,
+    height: usize,
+    fixed: &[bool],
+    previous: Option<&[f32]>,
+    opts: &PaddingOptions,
+) -> Result<PadStats, PaddingError> {
+    validate(image, width, height, fixed, previous, opts)?;
+    let grid = BlockGrid::new(width, height, opts.block);
+    let limits = cg::CgLimits {
+        tolerance: f64::from(opts.tolerance.max(0.0)),
+        max_iterations: opts.max_iterations,
+    };
+    let mut stats = PadStats::default();
+    let mut filled = grid.any_set(fixed);
+    let mut held = fixed.to_vec();
+    if let Some(previous) = previous {
+        empty_blocks::copy_from_previous(&grid, image, previous, &mut filled, &mut held);
+    }
+    if !held.iter().any(|&h| h) {
+        image.fill(0.0);
+        return Ok(stats);
+    }
+    match opts.method {
+        Method::MidGrey => {
+            let (lo, hi) = fixed_range(image, fixed);
+            let mid = if lo <= hi { 0.5 * (lo + hi) } else { 0.0 };
+            image
+                .iter_mut()
+                .zip(&held)
+                .filter(|(_, &h)| !h)
+                .for_each(|(v, _)| *v = mid);
+        }
+        Method::PushPull => push_pull::fill(image, width, height, &held),
+        Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
+        Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic | Method::Snap => {
+            let mut block_solver = BlockSolver::new(opts);
+            let with_fixed = grid.any_set(fixed);
+            for b in (0..grid.len()).filter(|&b| with_fixed[b]) {
+                let rect = grid.rect(b);
+                match &mut block_solver {
+                    BlockSolver::Mean => fill_block_mean(&grid, rect, image, fixed),
+                    BlockSolver::Laplace(solver) => {
+                        solver.pad_block(&grid, rect, image, fixed, limits, &mut stats)
+                    }
+                    BlockSolver::Dct(solver) => {
+                        solver.pad_block(&grid, rect, image, fixed, limits, &mut stats)
+                    }
+                }
+            }
+            match opts.empty_blocks {
+                EmptyBlocks::NeighbourMean => {
+                    empty_blocks::fill_flat_from_neighbours(&grid, image, &mut filled, 0.0);
+                }
+                EmptyBlocks::FixedMean => {
+                    let mean = fixed_mean(image, fixed);
+                    empty_blocks::fill_flat(&grid, image, &mut filled, mean);
+                }
+                EmptyBlocks::RasterPrevious => {
+                    let mean = fixed_mean(image, fixed);
+                    empty_blocks::fill_from_raster_previous(&grid, image, &mut filled, mean);
+                }
+            }
+        }
+    }
+    Ok(stats)
+}
+
+enum BlockSolver {
+    Mean,
+    Laplace(Box<BlockLaplace>),
+    Dct(Box<DctEnergy>),
+}
+
+impl BlockSolver {
+    fn new(opts: &PaddingOptions) -> Self {
+        match opts.method {
+            Method::Cg => BlockSolver::Laplace(Box::default()),
+            Method::DctEnergy => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Quantiser))),
+            Method::Biharmonic => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Biharmonic))),
+            Method::Snap => BlockSolver::Dct(Box::new(
+                DctEnergy::new(Weighting::Biharmonic).with_snap(opts.jpeg_quality),
+            )),
+            _ => BlockSolver::Mean,
+        }
+    }
+}
+
+fn fill_block_mean(grid: &BlockGrid, rect: grid::BlockRect, image: &mut [f32], fixed: &[bool]) {
+    let (sum, count) = grid
+        .pixels(rect)
+        .filter(|&i| fixed[i])
+        .fold((0.0f64, 0usize), |(s, c), i| {
+            (s + f64::from(image[i]), c + 1)
+        });
+    if count == 0 {
+        return;
+    }
+    let mean = (sum / count as f64) as f32;
+    for i in grid.pixels(rect) {
+        if !fixed[i] {
+            image[i] = mean;
+        }
+    }
+}
+
+fn fixed_mean(image: &[f32], fixed: &[bool]) -> f32 {
+    let (sum, count) = image
+        .iter()
+        .zip(fixed)
+        .filter(|(_, &f)| f)
+        .fold((0.0f64, 0usize), |(s, c), (&v, _)| {
+            (s + f64::from(v), c + 1)
+        });
+    if count == 0 {
+        0.0
+    } else {
+        (sum / count as f64) as f32
+    }
+}
+
+fn fixed_range(image: &[f32], fixed: &[bool]) -> (f32, f32) {
+    image
+        .iter()
+        .zip(fixed)
+        .filter(|(_, &f)| f)
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), (&v, _)| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+fn validate(
+    image: &[f32],
+    width: usize,
+    height: usize,
+    fixed: &[bool],
+    previous: Option<&[f32]>,
+    opts: &PaddingOptions,
+) -> Result<(), PaddingError> {
+    if width == 0 || height == 0 {
+        return Err(PaddingError::EmptyImage { width, height });
+    }
+    let expected = width
+        .checked_mul(height)
+        .ok_or(PaddingError::EmptyImage { width, height })?;
+    let check = |what, got| {
+        if got == expected {
+            Ok(())
+        } else {
+            Err(PaddingError::SizeMismatch {
+                what,
+                got,
+                expected,
+            })
+        }
+    };
+    check("image", image.len())?;
+    check("mask", fixed.len())?;
+    if let Some(previous) = previous {
+        check("previous", previous.len())?;
+        if let Some(index) = previous.iter().position(|v| !v.is_finite()) {
+            return Err(PaddingError::NonFinite {
+                what: "previous",
+                index,
+            });
+        }
+    }
+    if let Some(index) = image
+        .iter()
+        .zip(fixed)
+        .position(|(v, &f)| f && !v.is_finite())
+    {
+        return Err(PaddingError::NonFinite {
+            what: "image",
+            index,
+        });
+    }
+    if opts.block == 0 {
+        return Err(PaddingError::BadBlock {
+            block: 0,
+            method: opts.method.to_string(),
+            why: "blocks must be at least one pixel wide",
+        });
+    }
+    if matches!(
+        opts.method,
+        Method::DctEnergy | Method::Biharmonic | Method::Snap
+    ) && opts.block != dct_energy::SIDE
+    {
+        return Err(PaddingError::BadBlock {
+            block: opts.block,
+            method: opts.method.to_string(),
+            why: "the quantiser-weighted DCT works on JPEG's 8x8 blocks",
+        });
+    }
+    Ok(())
+}

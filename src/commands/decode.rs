@@ -1,9 +1,59 @@
 //! `mcgv-video decode`.
 
 use crate::cli::DecodeArgs;
+use crate::decoder::Decoder;
 use crate::error::{Error, Result};
+use crate::mesh::io::write_obj_sequence_from;
+use crate::mesh::{write_pc2, AnimatedMesh};
+use crate::progress;
+use std::path::Path;
+use std::time::Instant;
+
+/// Whether the output path names a PC2 point cache rather than an OBJ folder.
+fn is_pc2(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pc2"))
+}
 
 /// Runs `decode`.
-pub fn run(_args: &DecodeArgs, _quiet: bool) -> Result<()> {
-    Err(Error::Usage("`decode` is not available yet".into()))
+pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
+    let start = Instant::now();
+    let mut decoder = Decoder::open(&args.input)?;
+    let frames = decoder.header().frames as usize;
+    let mesh = match args.frame {
+        Some(f) => {
+            if f >= frames {
+                return Err(Error::Usage(format!(
+                    "--frame {f}: the stream has frames 0 to {}",
+                    frames - 1
+                )));
+            }
+            let positions = decoder.decode_frame(f)?;
+            AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
+        }
+        None => {
+            let pb = progress::bar(frames as u64, "decode", quiet);
+            let mesh = decoder.decode_all(&pb)?;
+            pb.finish_and_clear();
+            mesh
+        }
+    };
+    if is_pc2(&args.output) {
+        write_pc2(&mesh, &args.output)?;
+    } else {
+        let first = args.frame.unwrap_or(0);
+        write_obj_sequence_from(&mesh, &args.output, first)?;
+    }
+    if !quiet {
+        let seconds = start.elapsed().as_secs_f64();
+        println!(
+            "{}: {} frame(s) of {} vertices written in {:.2} s ({:.1} frames/s)",
+            args.output.display(),
+            mesh.frame_count(),
+            mesh.vertex_count(),
+            seconds,
+            mesh.frame_count() as f64 / seconds.max(1e-9)
+        );
+    }
+    Ok(())
 }

@@ -1,9 +1,272 @@
 //! `mcgv-video inspect`.
 
 use crate::cli::InspectArgs;
+use crate::decoder::Decoder;
+use crate::encoder::{self, EncodeOptions};
 use crate::error::{Error, Result};
+use crate::geometry_image::tile;
+use crate::mesh::read_animation;
+use crate::stream::container::{FILE_HEADER_LEN, PART_HEADER_LEN};
+use crate::stream::first_frame;
+use crate::stream::header::{CodecKind, Header};
+use std::path::Path;
 
 /// Runs `inspect`.
-pub fn run(_args: &InspectArgs, _quiet: bool) -> Result<()> {
-    Err(Error::Usage("`inspect` is not available yet".into()))
+pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
+    let mut decoder = Decoder::open(&args.input)?;
+    let header = decoder.header().clone();
+    let total = decoder.container().file_len();
+    let mut parts: Vec<(String, u64)> = vec![("file header".into(), FILE_HEADER_LEN as u64)];
+    parts.extend(
+        decoder
+            .container()
+            .parts()
+            .iter()
+            .map(|p| (p.tag.name().to_string(), p.len + PART_HEADER_LEN as u64)),
+    );
+    let vf = header.vertices as f64 * header.frames as f64;
+    let bpvf = total as f64 * 8.0 / vf;
+    if let Some(dir) = &args.png {
+        write_pngs(&mut decoder, args, dir, quiet)?;
+    }
+    if args.json {
+        let parts_obj: serde_json::Map<String, serde_json::Value> = parts
+            .iter()
+            .map(|(n, b)| (n.clone(), serde_json::json!(b * 8)))
+            .collect();
+        let value = serde_json::json!({
+            "vertices": header.vertices,
+            "frames": header.frames,
+            "faces": header.triangles,
+            "codec": header.codec.name(),
+            "quality": header.quality,
+            "qscale": header.qscale,
+            "gop": header.gop,
+            "clusters": header.clusters,
+            "charts": header.charts,
+            "lattice": [header.lattice_width, header.lattice_height],
+            "packing_efficiency": header.packing_efficiency(),
+            "padding": header.padding,
+            "bytes": total,
+            "bpvf": bpvf,
+            "parts": parts_obj,
+        });
+        println!("{value}");
+        return Ok(());
+    }
+    println!("{}", summary(&header, &args.input));
+    println!(
+        "{:<22} {:>12} {:>14} {:>7} {:>8}",
+        "part", "bytes", "bits", "%", "bpvf"
+    );
+    for (name, bytes) in &parts {
+        println!(
+            "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
+            name,
+            bytes,
+            bytes * 8,
+            100.0 * *bytes as f64 / total as f64,
+            *bytes as f64 * 8.0 / vf
+        );
+    }
+    println!(
+        "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
+        "total",
+        total,
+        total * 8,
+        100.0,
+        bpvf
+    );
+    Ok(())
+}
+
+fn summary(h: &Header, path: &Path) -> String {
+    let codec = match h.codec {
+        CodecKind::Jpeg => format!("jpeg quality {}", h.quality),
+        CodecKind::Mpeg4 => format!("mpeg4 qscale {} gop {}", h.qscale, h.gop),
+    };
+    format!(
+        "{}: {} vertices x {} frames, {} faces; {codec}; {} clusters, {} charts in {}x{} (packing {:.1}%), padding {}",
+        path.display(),
+        h.vertices,
+        h.frames,
+        h.triangles,
+        h.clusters,
+        h.charts,
+        h.lattice_width,
+        h.lattice_height,
+        100.0 * h.packing_efficiency(),
+        h.padding
+    )
+}
+
+/// A distinct, saturated colour per cluster (golden-angle hues).
+pub fn cluster_colour(k: u32) -> [u8; 3] {
+    let h = (k as f32 * 137.507_77) % 360.0;
+    let (s, v) = (0.75f32, 0.95f32);
+    let c = v * s;
+    let x = c * (1.0 - ((h / 60.0) % 2.0 - 1.0).abs());
+    let (r, g, b) = match (h / 60.0) as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = v - c;
+    [
+        ((r + m) * 255.0) as u8,
+        ((g + m) * 255.0) as u8,
+        ((b + m) * 255.0) as u8,
+    ]
+}
+
+fn save_gray(path: &Path, width: u32, height: u32, data: Vec<u8>) -> Result<()> {
+    let img = image::GrayImage::from_raw(width, height, data)
+        .ok_or_else(|| Error::Usage("image size mismatch".into()))?;
+    img.save(path)
+        .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
+}
+
+fn save_levels(path: &Path, images: &[Vec<f32>; 3], w: usize, h: usize) -> Result<()> {
+    let plane = tile::compose([&images[0], &images[1], &images[2]], w, h);
+    save_gray(path, plane.width, plane.height, plane.data)
+}
+
+fn write_pngs<R: std::io::Read + std::io::Seek>(
+    decoder: &mut Decoder<R>,
+    args: &InspectArgs,
+    dir: &Path,
+    quiet: bool,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let header = decoder.header().clone();
+    let (w, h) = (
+        header.lattice_width as usize,
+        header.lattice_height as usize,
+    );
+    let frames: Vec<usize> = if args.frames.is_empty() {
+        vec![0]
+    } else {
+        args.frames.clone()
+    };
+    if let Some(&bad) = frames.iter().find(|&&f| f >= header.frames as usize) {
+        return Err(Error::Usage(format!(
+            "--frames {bad}: the stream has frames 0 to {}",
+            header.frames - 1
+        )));
+    }
+
+    // The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
+    let mut atlas_rgb = vec![0u8; w * h * 3];
+    for y in 0..h {
+        for x in 0..w {
+            if x % 8 == 0 || y % 8 == 0 {
+                atlas_rgb[(y * w + x) * 3..][..3].copy_from_slice(&[40, 40, 40]);
+            }
+        }
+    }
+    for (v, &[u, py]) in decoder.vertex_pixels().iter().enumerate() {
+        let c = cluster_colour(decoder.partition().labels()[v]);
+        atlas_rgb[(py as usize * w + u as usize) * 3..][..3].copy_from_slice(&c);
+    }
+    let atlas_path = dir.join("atlas.png");
+    image::RgbImage::from_raw(w as u32, h as u32, atlas_rgb)
+        .ok_or_else(|| Error::Usage("atlas image size".into()))?
+        .save(&atlas_path)
+        .map_err(|e| Error::Usage(format!("{}: {e}", atlas_path.display())))?;
+    crate::motion::render_partition_png(
+        decoder.reference(),
+        decoder.triangles(),
+        decoder.partition().labels(),
+        512,
+        &dir.join("segmentation.png"),
+    )?;
+
+    for &f in &frames {
+        let plane = decoder.decoded_plane(f)?;
+        save_gray(
+            &dir.join(format!("frame_{f:04}_decoded.png")),
+            plane.width,
+            plane.height,
+            plane.data,
+        )?;
+    }
+
+    if let Some(original) = &args.original {
+        let mesh = read_animation(original, &(&args.input_args).into())?;
+        if mesh.vertex_count() != header.vertices as usize
+            || mesh.frame_count() != header.frames as usize
+        {
+            return Err(Error::Usage(format!(
+                "{original} has {} vertices x {} frames; the stream has {} x {}",
+                mesh.vertex_count(),
+                mesh.frame_count(),
+                header.vertices,
+                header.frames
+            )));
+        }
+        let opts = EncodeOptions {
+            codec: header.codec,
+            quality: header.quality,
+            qscale: Some(header.qscale).filter(|&q| q > 0),
+            clusters: header.requested_clusters as usize,
+            affine_bits: header.affine_bits,
+            first_frame_bits: header.first_frame_bits,
+            lattice: (header.lattice_width, header.lattice_height),
+            padding: Some(
+                header
+                    .padding
+                    .parse()
+                    .map_err(|e| Error::Stream(format!("padding {}: {e}", header.padding)))?,
+            ),
+            gop: header.gop as usize,
+            reorder: header.reorder,
+        };
+        let ff = first_frame::encode(
+            mesh.frame(0),
+            mesh.triangles(),
+            &first_frame::FirstFrameOptions {
+                bits: opts.first_frame_bits,
+                reorder: opts.reorder,
+            },
+        )?;
+        let mesh = match &ff.permutation {
+            Some(p) => mesh.permuted(p)?,
+            None => mesh,
+        };
+        let analysis = encoder::analyse(&mesh, ff.decoded_positions, &opts)?;
+        let fixed = analysis.atlas.fixed_mask();
+        for &f in &frames {
+            // Raw: the quantised residuals on the pixels that carry data, free pixels black.
+            let mut raw: [Vec<f32>; 3] = Default::default();
+            for (a, img) in raw.iter_mut().enumerate() {
+                *img = encoder::level_image(&analysis, f, a)?;
+                for (p, &keep) in img.iter_mut().zip(&fixed) {
+                    if !keep {
+                        *p = 0.0;
+                    }
+                }
+            }
+            save_levels(&dir.join(format!("frame_{f:04}_raw.png")), &raw, w, h)?;
+            // P-frames pad against the previous frame; re-padding from the group start reproduces it.
+            let padded = match header.codec {
+                CodecKind::Jpeg => encoder::residual_images(&analysis, f, &opts, None)?,
+                CodecKind::Mpeg4 => {
+                    let start = f - f % opts.gop;
+                    let mut prev = encoder::residual_images(&analysis, start, &opts, None)?;
+                    for g in start + 1..=f {
+                        prev = encoder::residual_images(&analysis, g, &opts, Some(&prev))?;
+                    }
+                    prev
+                }
+            };
+            save_levels(&dir.join(format!("frame_{f:04}_padded.png")), &padded, w, h)?;
+        }
+    }
+    if !quiet {
+        eprintln!("images written to {}", dir.display());
+    }
+    Ok(())
 }

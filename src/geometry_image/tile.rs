@@ -54,9 +54,9 @@ mod tests {
             .collect();
         let plane = compose([&imgs[0], &imgs[1], &imgs[2]], w, h);
         assert_eq!((plane.width, plane.height), (24, 4));
-        for a in 0..3 {
+        for (a, img) in imgs.iter().enumerate() {
             let cut = axis_image(&plane, a, w, h);
-            let want: Vec<f32> = imgs[a].iter().map(|v| v.round().min(255.0)).collect();
+            let want: Vec<f32> = img.iter().map(|v| v.round().min(255.0)).collect();
             assert_eq!(cut, want);
             let s = sample(&plane, a, w, &[[3, 2], [7, 3]]);
             assert_eq!(s, vec![want[2 * w + 3], want[3 * w + 7]]);

@@ -1,7 +1,11 @@
 //! Reading and writing animations in every form the tool takes: OBJ sequences, PC2 + base OBJ, glTF.
+//!
+//! The formats themselves live in [`super::obj`], [`super::pc2`] and [`super::gltf_import`]; this
+//! module picks one from the input's name and writes files so that a failure never leaves half of one.
 
-use super::AnimatedMesh;
+use super::{gltf_import, obj, pc2, AnimatedMesh};
 use crate::error::{Error, Result};
+use crate::output::write_atomic;
 use std::path::{Path, PathBuf};
 
 /// Options that apply to reading any input form.
@@ -15,25 +19,69 @@ pub struct ReadOptions {
     pub base: Option<PathBuf>,
 }
 
+impl From<&crate::cli::InputArgs> for ReadOptions {
+    fn from(args: &crate::cli::InputArgs) -> Self {
+        Self {
+            fps: args.fps,
+            clip: args.clip.clone(),
+            base: args.base.clone(),
+        }
+    }
+}
+
 /// Reads an animation: a folder or glob of `.obj` files, a `.pc2` point cache, or a `.gltf`/`.glb`.
-pub fn read_animation(input: &str, _opts: &ReadOptions) -> Result<AnimatedMesh> {
-    Err(Error::Usage(format!(
-        "{input}: reading animations is not available yet"
-    )))
+///
+/// - OBJ: a folder's `.obj` files, a glob such as `dir/*.obj`, or one `.obj` (one frame). Frames are
+///   ordered by the last number in their file names; every frame must have the first one's vertex
+///   count and faces. Vertices keep the file's order, unused ones included.
+/// - PC2: the triangles come from [`ReadOptions::base`], by default the `.obj` of the same stem.
+/// - glTF: the clip [`ReadOptions::clip`] of the default scene, baked at [`ReadOptions::fps`]; a
+///   file without animations is an error (the tool compresses animations).
+pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
+    let path = Path::new(input);
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if let Some(fps) = opts.fps {
+        if !(fps.is_finite() && fps > 0.0) {
+            return Err(Error::Usage(format!(
+                "--fps {fps}: the frame rate must be a positive number"
+            )));
+        }
+    }
+    match extension.as_deref() {
+        Some("pc2") => pc2::read_pc2_animation(path, opts.base.as_deref()),
+        Some("gltf") | Some("glb") => gltf_import::read_gltf(path, opts.fps, opts.clip.as_deref()),
+        _ => obj::read_sequence(&obj::frame_files(input)?),
+    }
 }
 
 /// Writes one OBJ per frame into `dir` as `frame_0000.obj`, … (created if missing).
-pub fn write_obj_sequence(_mesh: &AnimatedMesh, dir: &Path) -> Result<()> {
-    Err(Error::Usage(format!(
-        "{}: writing OBJ is not available yet",
-        dir.display()
-    )))
+///
+/// Numbers have at least four digits, more when the frame count needs them, so the files sort by
+/// name too. Files of the same names are replaced; other files in `dir` are left alone.
+pub fn write_obj_sequence(mesh: &AnimatedMesh, dir: &Path) -> Result<()> {
+    write_obj_sequence_from(mesh, dir, 0)
 }
 
-/// Writes the animation's positions as a PC2 point cache.
-pub fn write_pc2(_mesh: &AnimatedMesh, path: &Path) -> Result<()> {
-    Err(Error::Usage(format!(
-        "{}: writing PC2 is not available yet",
-        path.display()
-    )))
+/// Like [`write_obj_sequence`], numbering the files from `first` (e.g. `decode --frame 57` writes
+/// `frame_0057.obj`).
+pub fn write_obj_sequence_from(mesh: &AnimatedMesh, dir: &Path, first: usize) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let digits = (first + mesh.frame_count().saturating_sub(1))
+        .to_string()
+        .len()
+        .max(4);
+    for (f, frame) in mesh.frames().iter().enumerate() {
+        let path = dir.join(format!("frame_{:0digits$}.obj", first + f));
+        write_atomic(&path, obj::obj_text(mesh.triangles(), frame).as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Writes the animation's positions as a PC2 point cache (start frame 0, one sample per frame).
+pub fn write_pc2(mesh: &AnimatedMesh, path: &Path) -> Result<()> {
+    let bytes =
+        pc2::pc2_bytes(mesh).map_err(|e| Error::Usage(format!("{}: {e}", path.display())))?;
+    write_atomic(path, &bytes)
 }

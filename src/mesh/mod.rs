@@ -6,6 +6,10 @@
 pub mod io;
 pub mod topology;
 
+mod gltf_import;
+mod obj;
+mod pc2;
+
 pub use io::{read_animation, write_obj_sequence, write_pc2, ReadOptions};
 
 use crate::error::{Error, Result};

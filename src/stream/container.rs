@@ -8,7 +8,7 @@
 use crate::error::{Error, Result};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom, Write};
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
@@ -137,22 +137,9 @@ impl ContainerWriter {
     /// never leaves a half-written file at `path`.
     pub fn write_atomic(&self, path: &Path) -> Result<u64> {
         let bytes = self.to_bytes();
-        write_file_atomic(path, &bytes)?;
+        crate::output::write_atomic(path, &bytes)?;
         Ok(bytes.len() as u64)
     }
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
-pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::io(path, e))?;
-    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
-    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
 }
 
 /// Where one part lies in the file.

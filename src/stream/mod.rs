@@ -2,5 +2,8 @@
 
 pub mod bytes;
 pub mod container;
+pub mod entropy;
+pub mod first_frame;
 pub mod frame_index;
 pub mod header;
+pub mod side_info;

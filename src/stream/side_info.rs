@@ -11,18 +11,27 @@ use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
 use crate::motion::{AffineTrack, QuantisedAffine};
 use crate::stream::bytes::{ByteReader, ByteWriter};
-use crate::stream::entropy::{self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel};
+use crate::stream::entropy::{
+    self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel,
+};
 
 /// Refuses a decode that would need more symbols than `bytes` can possibly hold, before allocating.
 fn check_capacity(symbols: u64, bytes: usize, what: &str) -> Result<()> {
     if symbols > entropy::max_symbols(bytes) {
-        return Err(Error::Stream(format!("{what}: {symbols} values cannot fit in {bytes} bytes")));
+        return Err(Error::Stream(format!(
+            "{what}: {symbols} values cannot fit in {bytes} bytes"
+        )));
     }
     Ok(())
 }
 
 /// The label most common among `v`'s already-coded neighbours (lowest on ties), if any.
-fn predicted_label(adj: &VertexAdjacency, labels: &[u32], v: usize, counts: &mut Vec<(u32, u32)>) -> Option<u32> {
+fn predicted_label(
+    adj: &VertexAdjacency,
+    labels: &[u32],
+    v: usize,
+    counts: &mut Vec<(u32, u32)>,
+) -> Option<u32> {
     counts.clear();
     for &w in adj.neighbours(v).iter().filter(|&&w| (w as usize) < v) {
         let l = labels[w as usize];
@@ -31,10 +40,18 @@ fn predicted_label(adj: &VertexAdjacency, labels: &[u32], v: usize, counts: &mut
             None => counts.push((l, 1)),
         }
     }
-    counts.iter().max_by_key(|&&(l, n)| (n, std::cmp::Reverse(l))).map(|&(l, _)| l)
+    counts
+        .iter()
+        .max_by_key(|&&(l, n)| (n, std::cmp::Reverse(l)))
+        .map(|&(l, _)| l)
 }
 
-fn code_partition<C: SymbolCoder>(c: &mut C, labels: &mut [u32], clusters: usize, adj: &VertexAdjacency) -> Result<()> {
+fn code_partition<C: SymbolCoder>(
+    c: &mut C,
+    labels: &mut [u32],
+    clusters: usize,
+    adj: &VertexAdjacency,
+) -> Result<()> {
     let mut hit = [BitModel::default(), BitModel::default()];
     let mut small = SymbolModel::new(clusters);
     let mut large = UIntModel::default();
@@ -54,7 +71,9 @@ fn code_partition<C: SymbolCoder>(c: &mut C, labels: &mut [u32], clusters: usize
             c.unsigned(labels[v] as u64, &mut large)?
         };
         if l >= clusters as u64 || l == guess as u64 {
-            return Err(Error::Stream(format!("partition: vertex {v} has an impossible label")));
+            return Err(Error::Stream(format!(
+                "partition: vertex {v} has an impossible label"
+            )));
         }
         labels[v] = l as u32;
     }
@@ -62,7 +81,11 @@ fn code_partition<C: SymbolCoder>(c: &mut C, labels: &mut [u32], clusters: usize
 }
 
 /// Codes the cluster label of each vertex.
-pub fn encode_partition(labels: &[u32], clusters: usize, triangles: &[Triangle]) -> Result<Vec<u8>> {
+pub fn encode_partition(
+    labels: &[u32],
+    clusters: usize,
+    triangles: &[Triangle],
+) -> Result<Vec<u8>> {
     let adj = VertexAdjacency::new(labels.len(), triangles);
     let mut enc = Encoder::new();
     code_partition(&mut enc, &mut labels.to_vec(), clusters, &adj)?;
@@ -70,7 +93,12 @@ pub fn encode_partition(labels: &[u32], clusters: usize, triangles: &[Triangle])
 }
 
 /// Decodes `vertices` cluster labels in `0..clusters`.
-pub fn decode_partition(bytes: &[u8], vertices: usize, clusters: usize, triangles: &[Triangle]) -> Result<Vec<u32>> {
+pub fn decode_partition(
+    bytes: &[u8],
+    vertices: usize,
+    clusters: usize,
+    triangles: &[Triangle],
+) -> Result<Vec<u32>> {
     check_capacity(vertices as u64, bytes.len(), "partition")?;
     let adj = VertexAdjacency::new(vertices, triangles);
     let mut dec = Decoder::new(bytes)?;
@@ -79,7 +107,12 @@ pub fn decode_partition(bytes: &[u8], vertices: usize, clusters: usize, triangle
     Ok(labels)
 }
 
-fn code_lattice<C: SymbolCoder>(c: &mut C, pixels: &mut [[u16; 2]], size: (u16, u16), adj: &VertexAdjacency) -> Result<()> {
+fn code_lattice<C: SymbolCoder>(
+    c: &mut C,
+    pixels: &mut [[u16; 2]],
+    size: (u16, u16),
+    adj: &VertexAdjacency,
+) -> Result<()> {
     let mut near = [IntModel::default(), IntModel::default()];
     let mut far = [IntModel::default(), IntModel::default()];
     let limits = [size.0 as i64, size.1 as i64];
@@ -102,7 +135,9 @@ fn code_lattice<C: SymbolCoder>(c: &mut C, pixels: &mut [[u16; 2]], size: (u16, 
             let d = c.signed(pixels[v][a] as i64 - guess[a], &mut models[a])?;
             let value = guess[a] + d;
             if !(0..limits[a]).contains(&value) {
-                return Err(Error::Stream(format!("lattice coordinate of vertex {v} is outside the lattice")));
+                return Err(Error::Stream(format!(
+                    "lattice coordinate of vertex {v} is outside the lattice"
+                )));
             }
             pixels[v][a] = value as u16;
         }
@@ -111,7 +146,11 @@ fn code_lattice<C: SymbolCoder>(c: &mut C, pixels: &mut [[u16; 2]], size: (u16, 
 }
 
 /// Codes the lattice pixel of each vertex.
-pub fn encode_lattice(pixels: &[[u16; 2]], size: (u16, u16), triangles: &[Triangle]) -> Result<Vec<u8>> {
+pub fn encode_lattice(
+    pixels: &[[u16; 2]],
+    size: (u16, u16),
+    triangles: &[Triangle],
+) -> Result<Vec<u8>> {
     let adj = VertexAdjacency::new(pixels.len(), triangles);
     let mut enc = Encoder::new();
     code_lattice(&mut enc, &mut pixels.to_vec(), size, &adj)?;
@@ -119,7 +158,12 @@ pub fn encode_lattice(pixels: &[[u16; 2]], size: (u16, u16), triangles: &[Triang
 }
 
 /// Decodes `vertices` lattice pixels inside a `size` lattice.
-pub fn decode_lattice(bytes: &[u8], vertices: usize, size: (u16, u16), triangles: &[Triangle]) -> Result<Vec<[u16; 2]>> {
+pub fn decode_lattice(
+    bytes: &[u8],
+    vertices: usize,
+    size: (u16, u16),
+    triangles: &[Triangle],
+) -> Result<Vec<[u16; 2]>> {
     check_capacity(2 * vertices as u64, bytes.len(), "lattice coordinates")?;
     let adj = VertexAdjacency::new(vertices, triangles);
     let mut dec = Decoder::new(bytes)?;
@@ -144,7 +188,9 @@ fn code_affine_values<C: SymbolCoder>(c: &mut C, q: &mut QuantisedAffine) -> Res
         };
         let value = base + c.signed(q.values[i] as i64 - base, model)?;
         if !(0..=top).contains(&value) {
-            return Err(Error::Stream("affine coefficient outside its quantisation range".into()));
+            return Err(Error::Stream(
+                "affine coefficient outside its quantisation range".into(),
+            ));
         }
         q.values[i] = value as u32;
     }
@@ -166,7 +212,12 @@ pub fn encode_affine(track: &AffineTrack) -> Result<Vec<u8>> {
 }
 
 /// Decodes the affine track of `frames` frames and `clusters` clusters at `bits` bits.
-pub fn decode_affine(bytes: &[u8], frames: usize, clusters: usize, bits: u8) -> Result<AffineTrack> {
+pub fn decode_affine(
+    bytes: &[u8],
+    frames: usize,
+    clusters: usize,
+    bits: u8,
+) -> Result<AffineTrack> {
     let mut r = ByteReader::new(bytes, "affine coefficients");
     let stored_bits = r.u8()?;
     if stored_bits != bits {
@@ -179,10 +230,14 @@ pub fn decode_affine(bytes: &[u8], frames: usize, clusters: usize, bits: u8) -> 
         *range = (r.f32()?, r.f32()?);
     }
     if !(1..=31).contains(&bits) {
-        return Err(Error::Stream(format!("affine coefficients: {bits} bits is out of range")));
+        return Err(Error::Stream(format!(
+            "affine coefficients: {bits} bits is out of range"
+        )));
     }
     let rest = r.take(r.remaining())?;
-    let count = (frames as u64).saturating_mul(clusters as u64).saturating_mul(12);
+    let count = (frames as u64)
+        .saturating_mul(clusters as u64)
+        .saturating_mul(12);
     check_capacity(count, rest.len(), "affine coefficients")?;
     let mut q = QuantisedAffine {
         bits,

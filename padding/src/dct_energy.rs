@@ -1,0 +1,275 @@
+//! Per-block padding as a weighted energy of the block's 2-D DCT coefficients c = D·b:
+//! E = Σ_{k≠0} w_k c_k², fixed pixels held. Two weightings (see [`Weighting`]):
+//!
+//! - quantiser: w_k = 1/Q_k² with JPEG's Annex K table, i.e. the energy of what the codec rounds.
+//!   JPEG's quality scales the table uniformly (up to rounding), which leaves the minimiser unchanged.
+//!   It loses (measured): high frequencies weigh little, so the padding fills them, JPEG drops them,
+//!   and what is dropped lands as error on the fixed pixels too.
+//! - biharmonic: w_k = λ_k², λ_k the eigenvalues of the block's 4-connected Neumann Laplacian,
+//!   which the DCT-II diagonalises, so E = ‖Δb‖². Where the paper's ψ (≈ Σ λ_k c_k²) gives a
+//!   harmonic fill with kinks at the chart border, this continues the chart's gradient, and JPEG
+//!   spends fewer high-frequency coefficients on it (the measured winner).
+//!
+//! `snap` follows the biharmonic solve with 30 rounds of: DCT, zero the AC coefficients JPEG's
+//! quantiser at the target quality would round to 0 (|c_k| < Q_k/2), inverse DCT, put the fixed pixels
+//! back. The coefficients JPEG will drop are then ~0 already, so dropping them moves little error onto
+//! the fixed pixels (alternating projections; 100 rounds measured only 0.2 % better than 30).
+//!
+//! With b = P·x + f (x the free pixels, f the fixed ones), E is minimised by
+//! Pᵀ DᵀWD P x = −Pᵀ DᵀWD f, an SPD system solved by CG: W ≥ 0 with only DC unweighted and D
+//! orthogonal, so a null vector would be a constant block that is 0 on the fixed pixels. Pixels of a
+//! block lying outside the image are treated as free.
+
+use crate::cg::{self, CgLimits, CgScratch};
+use crate::grid::{BlockGrid, BlockRect};
+use crate::PadStats;
+
+/// The block side this method works on (JPEG's DCT size).
+pub(crate) const SIDE: usize = 8;
+const N: usize = SIDE * SIDE;
+
+/// ITU-T T.81 Annex K luminance quantisation table, row-major.
+const ANNEX_K_LUMA: [f64; N] = [
+    16., 11., 10., 16., 24., 40., 51., 61., 12., 12., 14., 19., 26., 58., 60., 55., 14., 13., 16.,
+    24., 40., 57., 69., 56., 14., 17., 22., 29., 51., 87., 80., 62., 18., 22., 37., 56., 68., 109.,
+    103., 77., 24., 35., 55., 64., 81., 104., 113., 92., 49., 64., 78., 87., 103., 121., 120.,
+    101., 72., 92., 95., 98., 112., 100., 103., 99.,
+];
+
+/// Orthonormal DCT-II basis and weights, plus per-block work space.
+#[derive(Debug)]
+pub(crate) struct DctEnergy {
+    /// basis[k * SIDE + n] = α_k cos(π (2n+1) k / 16).
+    basis: [f64; N],
+    weight: [f64; N],
+    /// JPEG quantiser steps (orthonormal-DCT units, equal to JPEG's table entries) at the target
+    /// quality, when the solve is followed by snapping to what the quantiser keeps.
+    snap_steps: Option<[f64; N]>,
+    unknowns: Vec<usize>,
+    rhs: Vec<f64>,
+    x: Vec<f64>,
+    scratch: CgScratch,
+}
+
+/// Which weights w_k the block energy Σ w_k c_k² uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Weighting {
+    /// w_k = 1 / Q_k² (Annex K luminance table): the energy of what the codec quantises.
+    Quantiser,
+    /// w_k = λ_k², λ_k the eigenvalue of the block's 4-connected Neumann Laplacian that the DCT
+    /// basis function k diagonalises: ‖Δb‖², a thin-plate (biharmonic) smoothness in the block.
+    Biharmonic,
+}
+
+impl DctEnergy {
+    pub fn new(weighting: Weighting) -> Self {
+        let mut basis = [0.0; N];
+        for k in 0..SIDE {
+            let alpha = if k == 0 {
+                (1.0 / SIDE as f64).sqrt()
+            } else {
+                (2.0 / SIDE as f64).sqrt()
+            };
+            for n in 0..SIDE {
+                basis[k * SIDE + n] = alpha
+                    * (std::f64::consts::PI * (2 * n + 1) as f64 * k as f64 / (2 * SIDE) as f64)
+                        .cos();
+            }
+        }
+        let mut weight: [f64; N] = std::array::from_fn(|k| match weighting {
+            Weighting::Quantiser => 1.0 / (ANNEX_K_LUMA[k] * ANNEX_K_LUMA[k]),
+            Weighting::Biharmonic => {
+                let step = std::f64::consts::PI / SIDE as f64;
+                let (u, v) = ((k / SIDE) as f64, (k % SIDE) as f64);
+                let lambda = (2.0 - 2.0 * (step * u).cos()) + (2.0 - 2.0 * (step * v).cos());
+                lambda * lambda
+            }
+        });
+        // DC is coded as a difference from the previous block's DC, so its size is not its cost;
+        // weighting it would drag padded values towards 0. With DC free, a single fixed pixel still
+        // pins the system: a nonzero free-pixel vector with only a DC component would be a constant
+        // block that is 0 on the fixed pixels.
+        weight[0] = 0.0;
+        DctEnergy {
+            basis,
+            weight,
+            snap_steps: None,
+            unknowns: Vec::new(),
+            rhs: Vec::new(),
+            x: Vec::new(),
+            scratch: CgScratch::default(),
+        }
+    }
+}
+
+impl DctEnergy {
+    /// After each solve, alternate (SNAP_ROUNDS times) between the JPEG quantiser at `quality`
+    /// (Annex K table scaled as libjpeg does) and putting the fixed pixels back.
+    pub fn with_snap(mut self, quality: u8) -> Self {
+        let quality = u32::from(quality.clamp(1, 100));
+        let scale = if quality < 50 {
+            5000 / quality
+        } else {
+            200 - quality * 2
+        };
+        self.snap_steps = Some(ANNEX_K_LUMA.map(|t| {
+            ((t * scale as f64 + 50.0) / 100.0)
+                .floor()
+                .clamp(1.0, 255.0)
+        }));
+        self
+    }
+
+    /// Pads the free pixels of one block that holds at least one fixed pixel.
+    pub fn pad_block(
+        &mut self,
+        grid: &BlockGrid,
+        rect: BlockRect,
+        image: &mut [f32],
+        fixed: &[bool],
+        limits: CgLimits,
+        stats: &mut PadStats,
+    ) {
+        let width = grid.width;
+        let mut known = [0.0f64; N];
+        let mut is_fixed = [false; N];
+        let mut fixed_sum = 0.0;
+        let mut fixed_count = 0usize;
+        self.unknowns.clear();
+        for y in 0..SIDE {
+            for x in 0..SIDE {
+                let local = y * SIDE + x;
+                let inside = x < rect.w && y < rect.h;
+                let pixel = (rect.y0 + y) * width + rect.x0 + x;
+                if inside && fixed[pixel] {
+                    is_fixed[local] = true;
+                    known[local] = f64::from(image[pixel]);
+                    fixed_sum += known[local];
+                    fixed_count += 1;
+                } else {
+                    self.unknowns.push(local);
+                }
+            }
+        }
+        if fixed_count == 0 || self.unknowns.is_empty() {
+            return;
+        }
+        let (basis, weight) = (&self.basis, &self.weight);
+        let operator = |block: &[f64; N], out: &mut [f64; N]| {
+            let mut coefficients = [0.0; N];
+            transform(basis, block, &mut coefficients, false);
+            coefficients
+                .iter_mut()
+                .zip(weight)
+                .for_each(|(c, w)| *c *= w);
+            transform(basis, &coefficients, out, true);
+        };
+        let mut image_of_known = [0.0; N];
+        operator(&known, &mut image_of_known);
+        self.rhs.clear();
+        self.rhs
+            .extend(self.unknowns.iter().map(|&u| -image_of_known[u]));
+        self.x.clear();
+        self.x
+            .resize(self.unknowns.len(), fixed_sum / fixed_count as f64);
+        let unknowns = &self.unknowns;
+        let report = cg::solve(
+            |v, out| {
+                let mut block = [0.0; N];
+                for (&u, &value) in unknowns.iter().zip(v) {
+                    block[u] = value;
+                }
+                let mut result = [0.0; N];
+                operator(&block, &mut result);
+                for (o, &u) in out.iter_mut().zip(unknowns) {
+                    *o = result[u];
+                }
+            },
+            &self.rhs,
+            &mut self.x,
+            limits,
+            &mut self.scratch,
+        );
+        stats.record(report);
+        if let Some(steps) = &self.snap_steps {
+            let mut block = known;
+            for (&u, &value) in self.unknowns.iter().zip(&self.x) {
+                block[u] = value;
+            }
+            for _ in 0..SNAP_ROUNDS {
+                let mut c = [0.0; N];
+                transform(basis, &block, &mut c, false);
+                for (ck, q) in c.iter_mut().zip(steps).skip(1) {
+                    if ck.abs() < 0.5 * q {
+                        *ck = 0.0;
+                    }
+                }
+                let mut back = [0.0; N];
+                transform(basis, &c, &mut back, true);
+                for &u in &self.unknowns {
+                    block[u] = back[u];
+                }
+            }
+            for (x, &u) in self.x.iter_mut().zip(&self.unknowns) {
+                *x = block[u];
+            }
+        }
+        for (&u, &value) in self.unknowns.iter().zip(&self.x) {
+            let (x, y) = (u % SIDE, u / SIDE);
+            if x < rect.w && y < rect.h && !is_fixed[u] {
+                image[(rect.y0 + y) * width + rect.x0 + x] = value as f32;
+            }
+        }
+    }
+}
+
+/// Projection rounds of `snap` (see the module doc).
+const SNAP_ROUNDS: usize = 30;
+
+/// Separable 2-D DCT (`inverse == false`: c = D b Dᵀ) or its transpose (b = Dᵀ c D).
+fn transform(basis: &[f64; N], input: &[f64; N], output: &mut [f64; N], inverse: bool) {
+    let entry = |k: usize, n: usize| {
+        if inverse {
+            basis[n * SIDE + k]
+        } else {
+            basis[k * SIDE + n]
+        }
+    };
+    let mut rows = [0.0; N];
+    for y in 0..SIDE {
+        for k in 0..SIDE {
+            rows[y * SIDE + k] = (0..SIDE).map(|n| entry(k, n) * input[y * SIDE + n]).sum();
+        }
+    }
+    for k in 0..SIDE {
+        for x in 0..SIDE {
+            output[k * SIDE + x] = (0..SIDE).map(|n| entry(k, n) * rows[n * SIDE + x]).sum();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transform_is_orthonormal() {
+        let dct = DctEnergy::new(Weighting::Quantiser);
+        let block: [f64; N] = std::array::from_fn(|i| ((i * 37) % 11) as f64 - 5.0);
+        let mut c = [0.0; N];
+        let mut back = [0.0; N];
+        transform(&dct.basis, &block, &mut c, false);
+        transform(&dct.basis, &c, &mut back, true);
+        let energy_b: f64 = block.iter().map(|v| v * v).sum();
+        let energy_c: f64 = c.iter().map(|v| v * v).sum();
+        assert!((energy_b - energy_c).abs() < 1e-9 * energy_b);
+        for (a, b) in block.iter().zip(&back) {
+            assert!((a - b).abs() < 1e-9);
+        }
+        // A flat block has only a DC coefficient, 8× its value.
+        let flat = [3.0; N];
+        transform(&dct.basis, &flat, &mut c, false);
+        assert!((c[0] - 24.0).abs() < 1e-9);
+        assert!(c[1..].iter().all(|v| v.abs() < 1e-9));
+    }
+}

@@ -1,0 +1,329 @@
+//! MPEG-4 Part 2 (FFmpeg's native `mpeg4` encoder and decoder through `ffmpeg-next`).
+//!
+//! The plane goes in the luma of a YUV 4:2:0 picture with flat chroma (128), which costs a few bits per
+//! macroblock. The quantiser is fixed: FFmpeg only honours it when the context has the QSCALE flag and
+//! `global_quality`, *and* every input frame carries the same value in its `quality` field — without
+//! the latter the encoder silently runs at `qmin`. No B-frames, one thread and no scene-cut detection,
+//! so each frame yields exactly one packet, in order, and I-frames fall exactly every `gop` frames.
+//! Headers are in-band (no global header): each I-frame packet repeats the VOL header, so decoding can
+//! start at any I-frame.
+
+use super::Plane;
+use crate::{Error, Result};
+use ffmpeg_next as ffmpeg;
+use ffmpeg_next::util::{error::EAGAIN, picture};
+use ffmpeg_next::{codec, decoder, encoder, format::Pixel, frame, Dictionary};
+use std::sync::OnceLock;
+
+/// Chroma value of a neutral (grey) picture: the planes carry no information.
+const NEUTRAL_CHROMA: u8 = 128;
+/// MPEG-4 video object layer width and height are 13-bit fields.
+const MAX_SIDE: u32 = 8191;
+/// The time base only labels frames; 1/25 keeps `vop_time_increment` short.
+const TIME_BASE: (i32, i32) = (1, 25);
+/// `sc_threshold` at this value switches scene-cut detection off (FFmpeg's own "never").
+const NO_SCENE_CUT: &str = "1000000000";
+
+/// Encoder settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Mpeg4Options {
+    /// Fixed quantiser, 1 (best) ..= 31 (coarsest); see [`super::quality_to_qscale`].
+    pub qscale: u8,
+    /// Frames per group of pictures: an I-frame, then `gop − 1` P-frames.
+    pub gop: usize,
+}
+
+impl Default for Mpeg4Options {
+    fn default() -> Self {
+        Mpeg4Options { qscale: 4, gop: 30 }
+    }
+}
+
+/// One coded frame.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Packet {
+    /// The MPEG-4 bitstream of the frame (with VOS/VOL headers on I-frames).
+    pub data: Vec<u8>,
+    /// Index of the frame in the sequence given to [`Encoder::encode`], from 0.
+    pub pts: i64,
+    /// True for an I-frame: decoding may start here.
+    pub key: bool,
+}
+
+fn ff_error(context: &str, e: ffmpeg::Error) -> Error {
+    Error::Codec(format!("mpeg4 {context}: {e}"))
+}
+
+/// Initialises FFmpeg once per process and quiets its logging to errors only.
+fn init() -> Result<()> {
+    static INIT: OnceLock<std::result::Result<(), String>> = OnceLock::new();
+    INIT.get_or_init(|| {
+        ffmpeg::init().map_err(|e| e.to_string())?;
+        ffmpeg::util::log::set_level(ffmpeg::util::log::Level::Error);
+        Ok(())
+    })
+    .clone()
+    .map_err(|e| Error::Codec(format!("ffmpeg init: {e}")))
+}
+
+/// The sizes the encoder takes: 4:2:0 chroma needs even sides, the VOL header 13 bits.
+fn check_size(width: u32, height: u32) -> Result<()> {
+    let ok = |side: u32| (2..=MAX_SIDE).contains(&side) && side % 2 == 0;
+    if ok(width) && ok(height) {
+        Ok(())
+    } else {
+        Err(Error::Codec(format!(
+            "mpeg4 size {width}×{height}: sides must be even and within 2..={MAX_SIDE}"
+        )))
+    }
+}
+
+/// A fixed-quantiser MPEG-4 Part 2 encoder for a sequence of same-size planes.
+pub struct Encoder {
+    inner: encoder::Video,
+    width: u32,
+    height: u32,
+    /// Lambda of the fixed quantiser, set on every frame.
+    lambda: i32,
+    next_pts: i64,
+}
+
+impl Encoder {
+    /// Opens an encoder for `width × height` planes (sides even, at most 8191).
+    pub fn new(width: u32, height: u32, options: &Mpeg4Options) -> Result<Self> {
+        init()?;
+        check_size(width, height)?;
+        if !(1..=31).contains(&options.qscale) {
+            return Err(Error::Codec(format!(
+                "mpeg4 qscale {} outside 1..=31",
+                options.qscale
+            )));
+        }
+        let gop = u32::try_from(options.gop)
+            .ok()
+            .filter(|g| (1..=i32::MAX as u32).contains(g))
+            .ok_or_else(|| Error::Codec(format!("mpeg4 gop {} must be ≥ 1", options.gop)))?;
+        let codec = encoder::find(codec::Id::MPEG4)
+            .ok_or_else(|| Error::Codec("mpeg4 encoder missing from libavcodec".into()))?;
+        let mut video = codec::Context::new_with_codec(codec)
+            .encoder()
+            .video()
+            .map_err(|e| ff_error("encoder context", e))?;
+        let lambda = i32::from(options.qscale) * ffmpeg::ffi::FF_QP2LAMBDA;
+        video.set_width(width);
+        video.set_height(height);
+        video.set_format(Pixel::YUV420P);
+        video.set_time_base(TIME_BASE);
+        video.set_gop(gop);
+        video.set_max_b_frames(0);
+        video.set_qmin(1);
+        video.set_qmax(31);
+        video.set_global_quality(lambda);
+        // BITEXACT drops the "Lavc…" user-data string from every I-frame and pins the output across
+        // FFmpeg builds.
+        video.set_flags(codec::Flags::QSCALE | codec::Flags::BITEXACT);
+        video.set_threading(codec::threading::Config {
+            count: 1,
+            ..Default::default()
+        });
+        let mut dict = Dictionary::new();
+        dict.set("sc_threshold", NO_SCENE_CUT);
+        // Trellis quantisation: measured +0.7..1.1 dB at qscale 2..8 for 1..2 % more bytes, at a third
+        // of the encoding speed (still > 1000 frames/s at 256×256).
+        dict.set("trellis", "1");
+        let inner = video
+            .open_as_with(codec, dict)
+            .map_err(|e| ff_error(&format!("open encoder {width}×{height}"), e))?;
+        Ok(Encoder {
+            inner,
+            width,
+            height,
+            lambda,
+            next_pts: 0,
+        })
+    }
+
+    /// Codes the next plane; returns the packets ready so far (one per frame with these settings).
+    pub fn encode(&mut self, plane: &Plane) -> Result<Vec<Packet>> {
+        plane.check()?;
+        if (plane.width, plane.height) != (self.width, self.height) {
+            return Err(Error::Codec(format!(
+                "mpeg4 plane {}×{} given to a {}×{} encoder",
+                plane.width, plane.height, self.width, self.height
+            )));
+        }
+        let mut picture = frame::Video::new(Pixel::YUV420P, self.width, self.height);
+        fill_luma(&mut picture, plane)?;
+        picture.data_mut(1).fill(NEUTRAL_CHROMA);
+        picture.data_mut(2).fill(NEUTRAL_CHROMA);
+        picture.set_pts(Some(self.next_pts));
+        // SAFETY: `picture` owns a valid AVFrame; `quality` is a plain int field that ffmpeg-next
+        // exposes only for reading.
+        unsafe {
+            (*picture.as_mut_ptr()).quality = self.lambda;
+        }
+        self.inner
+            .send_frame(&picture)
+            .map_err(|e| ff_error(&format!("encode frame {}", self.next_pts), e))?;
+        self.next_pts += 1;
+        self.receive()
+    }
+
+    /// Ends the sequence and returns the packets still held by the encoder.
+    pub fn finish(mut self) -> Result<Vec<Packet>> {
+        self.inner
+            .send_eof()
+            .map_err(|e| ff_error("flush encoder", e))?;
+        self.receive()
+    }
+
+    fn receive(&mut self) -> Result<Vec<Packet>> {
+        let mut packets = Vec::new();
+        loop {
+            let mut packet = ffmpeg::Packet::empty();
+            match self.inner.receive_packet(&mut packet) {
+                Ok(()) => packets.push(Packet {
+                    data: packet.data().unwrap_or_default().to_vec(),
+                    pts: packet.pts().unwrap_or(self.next_pts - 1),
+                    key: packet.is_key(),
+                }),
+                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
+                    return Ok(packets)
+                }
+                Err(e) => return Err(ff_error("receive packet", e)),
+            }
+        }
+    }
+}
+
+/// Copies the plane into the luma of `picture`, row by row (FFmpeg pads rows to its own stride).
+fn fill_luma(picture: &mut frame::Video, plane: &Plane) -> Result<()> {
+    let stride = picture.stride(0);
+    let width = plane.width as usize;
+    let luma = picture.data_mut(0);
+    for (y, src) in plane.data.chunks_exact(width).enumerate() {
+        let start = y * stride;
+        let dst = luma
+            .get_mut(start..start + width)
+            .ok_or_else(|| Error::Codec("mpeg4 frame buffer smaller than the plane".into()))?;
+        dst.copy_from_slice(src);
+    }
+    Ok(())
+}
+
+/// An MPEG-4 Part 2 decoder giving back the luma planes of a stream made by [`Encoder`].
+pub struct Decoder {
+    inner: decoder::Video,
+    width: u32,
+    height: u32,
+    /// Whether an I-frame has been decoded since the last reset: FFmpeg would otherwise predict a
+    /// leading P-frame from nothing and return a plausible but wrong picture.
+    has_reference: bool,
+}
+
+impl Decoder {
+    /// Opens a decoder that expects `width × height` pictures.
+    pub fn new(width: u32, height: u32) -> Result<Self> {
+        init()?;
+        check_size(width, height)?;
+        let codec = decoder::find(codec::Id::MPEG4)
+            .ok_or_else(|| Error::Codec("mpeg4 decoder missing from libavcodec".into()))?;
+        let mut context = codec::Context::new_with_codec(codec);
+        // One thread: frame threading would delay output by a frame per thread.
+        context.set_threading(codec::threading::Config {
+            count: 1,
+            ..Default::default()
+        });
+        let inner = context
+            .decoder()
+            .video()
+            .map_err(|e| ff_error("open decoder", e))?;
+        Ok(Decoder {
+            inner,
+            width,
+            height,
+            has_reference: false,
+        })
+    }
+
+    /// Decodes one packet; returns the pictures it completes (one per packet for our streams).
+    ///
+    /// The first packet after [`Decoder::new`] or [`Decoder::reset`] must be an I-frame.
+    pub fn decode(&mut self, packet: &[u8]) -> Result<Vec<Plane>> {
+        if packet.is_empty() {
+            // An empty packet would tell FFmpeg to drain; that is `flush`'s job.
+            return Err(Error::Codec("mpeg4 empty packet".into()));
+        }
+        self.inner
+            .send_packet(&ffmpeg::Packet::copy(packet))
+            .map_err(|e| ff_error(&format!("decode packet of {} bytes", packet.len()), e))?;
+        self.receive()
+    }
+
+    /// Signals the end of the stream and returns the pictures still held by the decoder.
+    pub fn flush(&mut self) -> Result<Vec<Plane>> {
+        self.inner
+            .send_eof()
+            .map_err(|e| ff_error("flush decoder", e))?;
+        let planes = self.receive()?;
+        self.reset();
+        Ok(planes)
+    }
+
+    /// Forgets all reference pictures, so decoding can restart at another I-frame.
+    pub fn reset(&mut self) {
+        self.inner.flush();
+        self.has_reference = false;
+    }
+
+    fn receive(&mut self) -> Result<Vec<Plane>> {
+        let mut planes = Vec::new();
+        loop {
+            let mut picture = frame::Video::empty();
+            match self.inner.receive_frame(&mut picture) {
+                Ok(()) => planes.push(self.luma(&picture)?),
+                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
+                    return Ok(planes)
+                }
+                Err(e) => return Err(ff_error("receive picture", e)),
+            }
+        }
+    }
+
+    fn luma(&mut self, picture: &frame::Video) -> Result<Plane> {
+        if picture.is_corrupt() || picture.has_decode_errors() {
+            return Err(Error::Codec("mpeg4 picture decoded with errors".into()));
+        }
+        if picture.kind() == picture::Type::I {
+            self.has_reference = true;
+        } else if !self.has_reference {
+            return Err(Error::Codec(format!(
+                "mpeg4 {:?}-frame before any I-frame: decoding must start at an I-frame",
+                picture.kind()
+            )));
+        }
+        if picture.format() != Pixel::YUV420P
+            || (picture.width(), picture.height()) != (self.width, self.height)
+        {
+            return Err(Error::Codec(format!(
+                "mpeg4 picture is {:?} {}×{}, expected YUV420P {}×{}",
+                picture.format(),
+                picture.width(),
+                picture.height(),
+                self.width,
+                self.height
+            )));
+        }
+        let (width, height) = (self.width as usize, self.height as usize);
+        let stride = picture.stride(0);
+        let luma = picture.data(0);
+        let mut data = Vec::with_capacity(width * height);
+        for y in 0..height {
+            let row = luma
+                .get(y * stride..y * stride + width)
+                .ok_or_else(|| Error::Codec("mpeg4 picture buffer shorter than its size".into()))?;
+            data.extend_from_slice(row);
+        }
+        Plane::new(self.width, self.height, data)
+    }
+}

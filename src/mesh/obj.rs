@@ -1,0 +1,390 @@
+//! Wavefront OBJ: one frame per file, frames ordered by the number in their file names.
+//!
+//! The parser is written here rather than taken from `tobj` because the transcoder must keep the
+//! file's global vertex order and every vertex, referenced or not (the stream, the PC2 caches and the
+//! error measures all rely on vertex `i` of one frame being vertex `i` of the next). `tobj` splits the
+//! file into models at every `o`/`g`/`usemtl`, renumbers each model's vertices in order of first use
+//! and drops unused ones, and does not expose the original indices, so that order cannot be recovered
+//! from its output. Only `v` and `f` lines matter here; everything else (normals, texture
+//! coordinates, groups, materials, lines, points) is skipped. Polygons become triangle fans around
+//! their first corner, as `tobj` triangulates them; `tests/mesh_io.rs` checks the two agree.
+
+use super::{AnimatedMesh, Point, Triangle};
+use crate::error::{Error, Result};
+use std::borrow::Cow;
+use std::cmp::Ordering;
+use std::path::{Path, PathBuf};
+
+/// The geometry of one OBJ file: positions in the file's `v` order and its faces as triangles.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ObjFrame {
+    /// Positions in the order of the file's `v` lines.
+    pub positions: Vec<Point>,
+    /// Faces triangulated as fans, indices into `positions`.
+    pub triangles: Vec<Triangle>,
+}
+
+/// Reads and parses one OBJ file.
+pub(crate) fn read_obj(path: &Path) -> Result<ObjFrame> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    parse_obj(&String::from_utf8_lossy(&bytes), path)
+}
+
+/// Parses OBJ text; `path` only names the file in error messages.
+pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
+    let at =
+        |line: usize, what: String| Error::Mesh(format!("{}: line {line}: {what}", path.display()));
+    let mut positions: Vec<Point> = Vec::new();
+    // Corners keep the 1-based or negative OBJ index until all positions are known, because a face
+    // may name a vertex defined further down.
+    let mut triangles: Vec<[(i64, usize); 3]> = Vec::new();
+    let mut corners: Vec<i64> = Vec::new();
+    for (line_no, line) in logical_lines(text) {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let mut p = [0f32; 3];
+                for c in &mut p {
+                    let word = words
+                        .next()
+                        .ok_or_else(|| at(line_no, "a vertex needs three coordinates".into()))?;
+                    *c = word
+                        .parse()
+                        .map_err(|_| at(line_no, format!("`{word}` is not a number")))?;
+                }
+                // An optional fourth value is the homogeneous w (three more would be a colour).
+                let rest: Vec<&str> = words.collect();
+                if rest.len() == 1 {
+                    let w: f32 = rest[0]
+                        .parse()
+                        .map_err(|_| at(line_no, format!("`{}` is not a number", rest[0])))?;
+                    if w == 0.0 {
+                        return Err(at(line_no, "vertex has w = 0".into()));
+                    }
+                    p.iter_mut().for_each(|c| *c /= w);
+                }
+                if p.iter().any(|c| !c.is_finite()) {
+                    return Err(at(
+                        line_no,
+                        format!(
+                            "vertex {} has a coordinate that is not a finite number ({} {} {})",
+                            positions.len() + 1,
+                            p[0],
+                            p[1],
+                            p[2]
+                        ),
+                    ));
+                }
+                positions.push(p);
+            }
+            Some("f") => {
+                corners.clear();
+                for word in words {
+                    let index = word.split('/').next().unwrap_or("");
+                    let index: i64 = index
+                        .parse()
+                        .map_err(|_| at(line_no, format!("`{word}` is not a vertex reference")))?;
+                    if index == 0 {
+                        return Err(at(line_no, "vertex index 0 (OBJ counts from 1)".into()));
+                    }
+                    // A negative index counts back from the last vertex read so far.
+                    corners.push(if index < 0 {
+                        positions.len() as i64 + index + 1
+                    } else {
+                        index
+                    });
+                }
+                if corners.len() < 3 {
+                    return Err(at(
+                        line_no,
+                        format!(
+                            "a face needs at least 3 vertices, this one has {}",
+                            corners.len()
+                        ),
+                    ));
+                }
+                for k in 1..corners.len() - 1 {
+                    triangles.push([
+                        (corners[0], line_no),
+                        (corners[k], line_no),
+                        (corners[k + 1], line_no),
+                    ]);
+                }
+            }
+            _ => {}
+        }
+    }
+    if positions.is_empty() {
+        return Err(Error::Mesh(format!("{}: no vertices", path.display())));
+    }
+    if triangles.is_empty() {
+        return Err(Error::Mesh(format!(
+            "{}: {} vertices but no faces (a triangle mesh is needed)",
+            path.display(),
+            positions.len()
+        )));
+    }
+    let v = positions.len() as i64;
+    let triangles = triangles
+        .into_iter()
+        .map(|tri| {
+            let mut out = [0u32; 3];
+            for (o, (index, line_no)) in out.iter_mut().zip(tri) {
+                if index < 1 || index > v {
+                    return Err(at(
+                        line_no,
+                        format!("face refers to vertex {index}, but the file has {v} vertices"),
+                    ));
+                }
+                *o = (index - 1) as u32;
+            }
+            Ok(out)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(ObjFrame {
+        positions,
+        triangles,
+    })
+}
+
+/// Lines with their 1-based numbers, a trailing `\` joining a line to the next, comments removed.
+fn logical_lines(text: &str) -> impl Iterator<Item = (usize, Cow<'_, str>)> + '_ {
+    let mut lines = text.lines().enumerate();
+    std::iter::from_fn(move || {
+        let (i, first) = lines.next()?;
+        let mut line = Cow::Borrowed(first);
+        while line.ends_with('\\') {
+            let joined = line.to_mut();
+            joined.pop();
+            joined.push(' ');
+            match lines.next() {
+                Some((_, next)) => joined.push_str(next),
+                None => break,
+            }
+        }
+        if let Some(hash) = line.find('#') {
+            line.to_mut().truncate(hash);
+        }
+        Some((i + 1, line))
+    })
+}
+
+/// Reads OBJ files as the frames of one animation; all must share vertex count and faces.
+pub(crate) fn read_sequence(files: &[PathBuf]) -> Result<AnimatedMesh> {
+    let (first_path, rest) = files
+        .split_first()
+        .ok_or_else(|| Error::Usage("no .obj files to read".into()))?;
+    let first = read_obj(first_path)?;
+    let mut frames = Vec::with_capacity(files.len());
+    frames.push(first.positions);
+    for path in rest {
+        let frame = read_obj(path)?;
+        check_same_mesh(&first.triangles, frames[0].len(), first_path, &frame, path)?;
+        frames.push(frame.positions);
+    }
+    AnimatedMesh::new(first.triangles, frames)
+}
+
+/// The error naming `path` and the first way its mesh differs from the first frame's.
+fn check_same_mesh(
+    triangles: &[Triangle],
+    vertex_count: usize,
+    first_path: &Path,
+    frame: &ObjFrame,
+    path: &Path,
+) -> Result<()> {
+    let differs = |what: String| {
+        Error::Mesh(format!(
+            "frame file {}: {what} (every frame must have the connectivity of the first, {})",
+            path.display(),
+            first_path.display()
+        ))
+    };
+    if frame.positions.len() != vertex_count {
+        return Err(differs(format!(
+            "{} vertices, the first frame has {vertex_count}",
+            frame.positions.len()
+        )));
+    }
+    if frame.triangles.len() != triangles.len() {
+        return Err(differs(format!(
+            "{} triangles, the first frame has {}",
+            frame.triangles.len(),
+            triangles.len()
+        )));
+    }
+    if let Some(t) = (0..triangles.len()).find(|&t| triangles[t] != frame.triangles[t]) {
+        let one_based = |tri: Triangle| format!("{} {} {}", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+        return Err(differs(format!(
+            "triangle {t} is `f {}`, in the first frame it is `f {}`",
+            one_based(frame.triangles[t]),
+            one_based(triangles[t])
+        )));
+    }
+    Ok(())
+}
+
+/// The frame files named by `input`: a folder's `.obj` files, the `.obj` files a glob pattern
+/// matches, or one `.obj` file; several files are ordered by the last number in their names.
+pub(crate) fn frame_files(input: &str) -> Result<Vec<PathBuf>> {
+    let path = Path::new(input);
+    let files: Vec<PathBuf> = if path.is_dir() {
+        let entries = std::fs::read_dir(path).map_err(|e| Error::io(path, e))?;
+        let mut files = Vec::new();
+        for entry in entries {
+            let entry = entry.map_err(|e| Error::io(path, e))?;
+            let p = entry.path();
+            if p.is_file() && has_obj_extension(&p) {
+                files.push(p);
+            }
+        }
+        if files.is_empty() {
+            return Err(Error::Usage(format!("{input}: folder holds no .obj files")));
+        }
+        files
+    } else if path.is_file() {
+        if !has_obj_extension(path) {
+            return Err(Error::Usage(format!(
+                "{input}: not a form this tool reads (a folder or glob of .obj files, .obj, .pc2, .gltf, .glb)"
+            )));
+        }
+        vec![path.to_path_buf()]
+    } else if input.contains(['*', '?', '[']) {
+        let pattern =
+            glob::glob(input).map_err(|e| Error::Usage(format!("{input}: bad pattern: {e}")))?;
+        let mut files = Vec::new();
+        for p in pattern {
+            let p = p.map_err(|e| Error::io(e.path().to_path_buf(), e.into()))?;
+            if p.is_file() && has_obj_extension(&p) {
+                files.push(p);
+            }
+        }
+        if files.is_empty() {
+            return Err(Error::Usage(format!("{input}: no .obj files match")));
+        }
+        files
+    } else {
+        return Err(Error::Usage(format!("{input}: no such file or folder")));
+    };
+    order_by_number(files)
+}
+
+fn has_obj_extension(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+}
+
+/// Sorts frame files by the last run of digits in their file stems (`frame_2` before `frame_10`).
+/// Two files with the same number, or a file without one, make the order ambiguous: an error.
+pub(crate) fn order_by_number(files: Vec<PathBuf>) -> Result<Vec<PathBuf>> {
+    if files.len() < 2 {
+        return Ok(files);
+    }
+    let mut keyed = files
+        .into_iter()
+        .map(|p| {
+            let number = frame_number(&p).ok_or_else(|| {
+                Error::Usage(format!(
+                    "{}: no number in the file name to order the frames by",
+                    p.display()
+                ))
+            })?;
+            Ok((number, p))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    keyed.sort_by(|a, b| compare_numbers(&a.0, &b.0).then_with(|| a.1.cmp(&b.1)));
+    if let Some(pair) = keyed
+        .windows(2)
+        .find(|w| compare_numbers(&w[0].0, &w[1].0) == Ordering::Equal)
+    {
+        return Err(Error::Usage(format!(
+            "{} and {} have the same frame number",
+            pair[0].1.display(),
+            pair[1].1.display()
+        )));
+    }
+    Ok(keyed.into_iter().map(|(_, p)| p).collect())
+}
+
+/// The last run of ASCII digits in the file stem, leading zeros removed (`"0"` for all zeros).
+fn frame_number(path: &Path) -> Option<String> {
+    let stem = path.file_stem()?.to_string_lossy();
+    let end = stem.rfind(|c: char| c.is_ascii_digit())? + 1;
+    let start = stem[..end]
+        .rfind(|c: char| !c.is_ascii_digit())
+        .map_or(0, |i| i + 1);
+    let trimmed = stem[start..end].trim_start_matches('0');
+    Some(if trimmed.is_empty() { "0" } else { trimmed }.to_owned())
+}
+
+/// Compares digit strings without leading zeros as numbers of any length.
+fn compare_numbers(a: &str, b: &str) -> Ordering {
+    a.len().cmp(&b.len()).then_with(|| a.cmp(b))
+}
+
+/// One frame as OBJ text: `v` lines in vertex order (shortest text that reads back to the same
+/// `f32`), then `f` lines.
+pub(crate) fn obj_text(triangles: &[Triangle], positions: &[Point]) -> String {
+    use std::fmt::Write;
+    let mut out = String::with_capacity(positions.len() * 40 + triangles.len() * 24);
+    for p in positions {
+        // Writing to a String cannot fail.
+        let _ = writeln!(out, "v {} {} {}", p[0], p[1], p[2]);
+    }
+    for t in triangles {
+        let _ = writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_order_like_numbers() {
+        let names = ["frame_10.obj", "frame_2.obj", "frame_1.obj", "frame_0.obj"];
+        let files = names.iter().map(PathBuf::from).collect();
+        let ordered = order_by_number(files).unwrap();
+        let got: Vec<_> = ordered
+            .iter()
+            .map(|p| p.to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(
+            got,
+            ["frame_0.obj", "frame_1.obj", "frame_2.obj", "frame_10.obj"]
+        );
+    }
+
+    #[test]
+    fn last_number_counts_and_zeros_do_not() {
+        assert_eq!(
+            frame_number(Path::new("take3/mesh.007.obj")).as_deref(),
+            Some("7")
+        );
+        assert_eq!(
+            frame_number(Path::new("v2_frame_0000.obj")).as_deref(),
+            Some("0")
+        );
+        assert_eq!(frame_number(Path::new("mesh.obj")), None);
+        let dup = vec![PathBuf::from("a_01.obj"), PathBuf::from("b_1.obj")];
+        assert!(order_by_number(dup).is_err());
+    }
+
+    #[test]
+    fn polygons_fan_and_unused_vertices_stay() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\ng a\nf 1/1/1 2/2 3//3 4\n";
+        let frame = parse_obj(text, Path::new("t.obj")).unwrap();
+        assert_eq!(frame.positions.len(), 5);
+        assert_eq!(frame.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn negative_and_forward_references() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf -3 -2 -1\nf 1 3 4\nv 2 2 2\n";
+        let frame = parse_obj(text, Path::new("t.obj")).unwrap();
+        assert_eq!(frame.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        let bad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 7\n";
+        let err = parse_obj(bad, Path::new("t.obj")).unwrap_err().to_string();
+        assert!(err.contains("line 4") && err.contains("vertex 7"), "{err}");
+    }
+}

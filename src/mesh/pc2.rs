@@ -1,0 +1,166 @@
+//! PC2 point caches (Blender, 3ds Max): positions only, so the connectivity comes from a base OBJ.
+//!
+//! Layout, all little-endian: `"POINTCACHE2\0"`, i32 version (1), i32 point count, f32 start frame,
+//! f32 sample rate, i32 sample count, then sample count × point count × 3 f32. So small and fixed a
+//! format needs no crate; none of the PC2 crates on crates.io is kept up.
+
+use super::obj::read_obj;
+use super::{AnimatedMesh, Point};
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+
+const MAGIC: &[u8; 12] = b"POINTCACHE2\0";
+const HEADER_LEN: usize = 32;
+
+/// The frames stored in a PC2 file.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PointCache {
+    /// Sample count × point count positions.
+    pub frames: Vec<Vec<Point>>,
+}
+
+/// Reads a PC2 file and takes the triangles from `base` (default: the `.obj` with the same stem
+/// beside it); the base's vertex count must equal the cache's point count.
+pub(crate) fn read_pc2_animation(path: &Path, base: Option<&Path>) -> Result<AnimatedMesh> {
+    let cache = read_pc2(path)?;
+    let base: PathBuf = match base {
+        Some(b) => b.to_path_buf(),
+        None => {
+            let beside = path.with_extension("obj");
+            if !beside.is_file() {
+                return Err(Error::Usage(format!(
+                    "{}: a PC2 cache holds no faces; give the base mesh with --base (looked for {})",
+                    path.display(),
+                    beside.display()
+                )));
+            }
+            beside
+        }
+    };
+    let mesh = read_obj(&base)?;
+    let points = cache.frames.first().map_or(0, Vec::len);
+    if mesh.positions.len() != points {
+        return Err(Error::Mesh(format!(
+            "{} has {points} points per frame but its base mesh {} has {} vertices",
+            path.display(),
+            base.display(),
+            mesh.positions.len()
+        )));
+    }
+    AnimatedMesh::new(mesh.triangles, cache.frames).map_err(|e| match e {
+        Error::Mesh(m) => Error::Mesh(format!("{}: {m}", path.display())),
+        other => other,
+    })
+}
+
+/// Reads and checks a PC2 file: magic, version, counts and exact length.
+pub(crate) fn read_pc2(path: &Path) -> Result<PointCache> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    parse_pc2(&bytes).map_err(|what| Error::Mesh(format!("{}: {what}", path.display())))
+}
+
+/// Parses PC2 bytes; the error says what is wrong.
+fn parse_pc2(bytes: &[u8]) -> std::result::Result<PointCache, String> {
+    let header = bytes.get(..HEADER_LEN).ok_or_else(|| {
+        format!(
+            "{} bytes is too short for a PC2 header ({HEADER_LEN} bytes)",
+            bytes.len()
+        )
+    })?;
+    if &header[..12] != MAGIC {
+        return Err("not a PC2 point cache (no POINTCACHE2 signature)".into());
+    }
+    let word = |at: usize| [header[at], header[at + 1], header[at + 2], header[at + 3]];
+    let version = i32::from_le_bytes(word(12));
+    let points = i32::from_le_bytes(word(16));
+    let samples = i32::from_le_bytes(word(28));
+    if version != 1 {
+        return Err(format!("PC2 version {version}, only version 1 is known"));
+    }
+    if points <= 0 || samples <= 0 {
+        return Err(format!(
+            "header says {points} points and {samples} samples; both must be positive"
+        ));
+    }
+    let (points, samples) = (points as usize, samples as usize);
+    let expected = points
+        .checked_mul(samples)
+        .and_then(|n| n.checked_mul(12))
+        .and_then(|n| n.checked_add(HEADER_LEN))
+        .ok_or_else(|| format!("header counts {points} × {samples} are too large"))?;
+    if bytes.len() != expected {
+        let state = if bytes.len() < expected {
+            "truncated"
+        } else {
+            "inconsistent"
+        };
+        return Err(format!(
+            "{state}: {points} points × {samples} samples need {expected} bytes, the file has {}",
+            bytes.len()
+        ));
+    }
+    let frames = bytes[HEADER_LEN..]
+        .chunks_exact(points * 12)
+        .map(|frame| {
+            frame
+                .chunks_exact(12)
+                .map(|p| {
+                    let f = |k: usize| f32::from_le_bytes([p[k], p[k + 1], p[k + 2], p[k + 3]]);
+                    [f(0), f(4), f(8)]
+                })
+                .collect()
+        })
+        .collect();
+    Ok(PointCache { frames })
+}
+
+/// The PC2 bytes of an animation: start frame 0, one sample per frame.
+pub(crate) fn pc2_bytes(mesh: &AnimatedMesh) -> Result<Vec<u8>> {
+    let too_many =
+        |what: &str, n: usize| Error::Usage(format!("{n} {what} do not fit in a PC2 file"));
+    let points = i32::try_from(mesh.vertex_count())
+        .map_err(|_| too_many("vertices", mesh.vertex_count()))?;
+    let samples =
+        i32::try_from(mesh.frame_count()).map_err(|_| too_many("frames", mesh.frame_count()))?;
+    let mut out = Vec::with_capacity(HEADER_LEN + mesh.frame_count() * mesh.vertex_count() * 12);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&1i32.to_le_bytes());
+    out.extend_from_slice(&points.to_le_bytes());
+    out.extend_from_slice(&0f32.to_le_bytes());
+    out.extend_from_slice(&1f32.to_le_bytes());
+    out.extend_from_slice(&samples.to_le_bytes());
+    for frame in mesh.frames() {
+        for p in frame {
+            for c in p {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bytes_round_trip_and_every_cut_is_refused() {
+        let mesh = AnimatedMesh::new(
+            vec![[0, 1, 2]],
+            vec![
+                vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0], [0.5, 1.0, -2.25]],
+            ],
+        )
+        .unwrap();
+        let bytes = pc2_bytes(&mesh).unwrap();
+        assert_eq!(bytes.len(), 32 + 2 * 3 * 12);
+        assert_eq!(parse_pc2(&bytes).unwrap().frames, mesh.frames());
+        for cut in 0..bytes.len() {
+            assert!(parse_pc2(&bytes[..cut]).is_err(), "cut at {cut} accepted");
+        }
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(parse_pc2(&longer).unwrap_err().contains("inconsistent"));
+    }
+}

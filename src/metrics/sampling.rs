@@ -1,0 +1,258 @@
+//! Deterministic area-weighted samples of a triangle surface, for integrating a distance over it.
+//!
+//! Each face is cut into `n²` similar sub-triangles (`n` from the face's longest edge and a spacing
+//! relative to the bounding-box diagonal, see [`sample_spacing`]); each sub-triangle is integrated
+//! with the classic 7-point rule (corners 1/20, edge midpoints 2/15, centroid 9/20 of its area),
+//! exact for cubics. A squared distance to a nearby surface is close to a low-degree polynomial
+//! across a small triangle, so the RMS converges far faster than with random samples, and no seed
+//! is needed. Points shared by neighbouring faces (mesh vertices, points on shared edges) are one
+//! sample carrying all their weights; the vertices, where a displaced surface's distance often
+//! peaks, are thereby always sampled for the maximum.
+
+use super::triangle::{triangle_area, Vec3};
+use crate::mesh::{Point, Triangle};
+use rustc_hash::FxHashMap;
+
+/// Samples per bounding-box diagonal: faces longer than `diagonal / SAMPLES_PER_DIAGONAL` are
+/// subdivided. At 50 the papers' 7k-vertex Dance stays mostly at level 1 (about 3.4 samples per
+/// face, vertices included) and its one-sided RMS against a copy moved by a smooth wave agrees with
+/// Metro's million-sample figure within 0.3 %; 100 and 200 came within 0.1 % for 3 and 8 times the
+/// work. The coarser CesiumMan with per-vertex jitter is the hard case (1.3 %, see
+/// tests/metrics_reference.rs).
+pub const SAMPLES_PER_DIAGONAL: f64 = 50.0;
+
+/// Finest subdivision of one face: caps the work a single huge triangle can cause (16² sub-triangles).
+pub const MAX_LEVEL: usize = 16;
+
+/// Sample spacing for a surface whose reference bounding-box diagonal is `diagonal`.
+pub fn sample_spacing(diagonal: f64) -> f64 {
+    diagonal / SAMPLES_PER_DIAGONAL
+}
+
+/// A sample point: where, how much surface it stands for, and a face it lies on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Position.
+    pub point: Vec3,
+    /// Area it stands for.
+    pub weight: f64,
+    /// A face it lies on (the first one that produced it).
+    pub face: u32,
+}
+
+fn position(positions: &[Point], i: u32) -> Vec3 {
+    positions
+        .get(i as usize)
+        .map_or([0.0; 3], |p| [p[0] as f64, p[1] as f64, p[2] as f64])
+}
+
+fn longest_edge(c: &[Vec3; 3]) -> f64 {
+    let len = |a: Vec3, b: Vec3| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    len(c[0], c[1]).max(len(c[1], c[2])).max(len(c[2], c[0]))
+}
+
+/// Subdivision level for a face whose longest edge is `edge`.
+fn level(edge: f64, spacing: f64) -> usize {
+    if spacing > 0.0 && edge.is_finite() {
+        ((edge / spacing).ceil() as usize).clamp(1, MAX_LEVEL)
+    } else {
+        1
+    }
+}
+
+/// Where a lattice point of a face lies, as a key shared with the neighbouring faces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Shared {
+    /// A mesh vertex.
+    Vertex(u32),
+    /// A point on the edge (lower vertex, higher vertex) of a face cut `2n` times, at lattice
+    /// weight `k` of the lower vertex.
+    Edge(u32, u32, usize, usize),
+}
+
+/// Accumulates samples, merging those at shared points.
+struct Samples {
+    list: Vec<Sample>,
+    shared: FxHashMap<Shared, usize>,
+}
+
+impl Samples {
+    fn add(&mut self, key: Option<Shared>, sample: Sample) {
+        if let Some(&i) = key.as_ref().and_then(|k| self.shared.get(k)) {
+            if let Some(s) = self.list.get_mut(i) {
+                s.weight += sample.weight;
+                return;
+            }
+        }
+        if let Some(k) = key {
+            self.shared.insert(k, self.list.len());
+        }
+        self.list.push(sample);
+    }
+}
+
+/// 7-point rule weights, as fractions of a sub-triangle's area.
+const CORNER: f64 = 1.0 / 20.0;
+const MIDPOINT: f64 = 2.0 / 15.0;
+const CENTROID: f64 = 9.0 / 20.0;
+
+/// Samples the surface of `triangles` at `positions` with the given `spacing`; the weights sum to
+/// the total area.
+pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64) -> Vec<Sample> {
+    let mut out = Samples {
+        list: Vec::with_capacity(3 * triangles.len() + positions.len()),
+        shared: FxHashMap::default(),
+    };
+    out.shared.reserve(2 * triangles.len() + positions.len());
+    for (f, t) in triangles.iter().enumerate() {
+        let c = [
+            position(positions, t[0]),
+            position(positions, t[1]),
+            position(positions, t[2]),
+        ];
+        let area = triangle_area(c[0], c[1], c[2]);
+        let n = level(longest_edge(&c), spacing);
+        let m = 2 * n;
+        let sub_area = area / (n * n) as f64;
+        let at = |u: f64, v: f64, w: f64| -> Vec3 {
+            let mut p = [0.0; 3];
+            for (a, x) in p.iter_mut().enumerate() {
+                *x = u * c[0][a] + v * c[1][a] + w * c[2][a];
+            }
+            p
+        };
+        // Corners and edge midpoints of the sub-triangles: the lattice of step 1/(2n).
+        for i in 0..=m {
+            for j in 0..=(m - i) {
+                let k = m - i - j;
+                let zeros = [i, j, k].iter().filter(|&&x| x == 0).count();
+                let corner = i % 2 == 0 && j % 2 == 0 && k % 2 == 0;
+                // Sub-triangles meeting at a corner: 1 at a face corner, 3 on a face edge, 6 inside;
+                // sharing a midpoint: 1 on a face edge, 2 inside.
+                let weight = match (corner, zeros) {
+                    (true, 2) => CORNER,
+                    (true, 1) => 3.0 * CORNER,
+                    (true, _) => 6.0 * CORNER,
+                    (false, 1) => MIDPOINT,
+                    (false, _) => 2.0 * MIDPOINT,
+                } * sub_area;
+                let key = match (i, j, k) {
+                    (_, 0, 0) => Some(Shared::Vertex(t[0])),
+                    (0, _, 0) => Some(Shared::Vertex(t[1])),
+                    (0, 0, _) => Some(Shared::Vertex(t[2])),
+                    (0, _, _) => Some(edge_key(t[1], j, t[2], k, m)),
+                    (_, 0, _) => Some(edge_key(t[0], i, t[2], k, m)),
+                    (_, _, 0) => Some(edge_key(t[0], i, t[1], j, m)),
+                    _ => None,
+                };
+                let (u, v, w) = (
+                    i as f64 / m as f64,
+                    j as f64 / m as f64,
+                    k as f64 / m as f64,
+                );
+                out.add(
+                    key,
+                    Sample {
+                        point: at(u, v, w),
+                        weight,
+                        face: f as u32,
+                    },
+                );
+            }
+        }
+        // Centroids of the upward (corner sum n − 1) and downward (n − 2) sub-triangles.
+        let nf = n as f64;
+        let upward = (n - 1, 1.0 / 3.0);
+        let downward = n.checked_sub(2).map(|sum| (sum, 2.0 / 3.0));
+        for (sum, shift) in std::iter::once(upward).chain(downward) {
+            for i in 0..=sum {
+                for j in 0..=(sum - i) {
+                    let k = sum - i - j;
+                    let b = [i, j, k].map(|x| (x as f64 + shift) / nf);
+                    out.list.push(Sample {
+                        point: at(b[0], b[1], b[2]),
+                        weight: CENTROID * sub_area,
+                        face: f as u32,
+                    });
+                }
+            }
+        }
+    }
+    out.list
+}
+
+/// The key of a lattice point on the edge between vertices `a` (lattice weight `wa`) and `b`.
+fn edge_key(a: u32, wa: usize, b: u32, wb: usize, m: usize) -> Shared {
+    if a <= b {
+        Shared::Edge(a, b, m, wa)
+    } else {
+        Shared::Edge(b, a, m, wb)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_sum_to_the_area_at_every_level() {
+        let positions = [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+        for spacing in [10.0, 2.0, 0.7, 0.3, 0.01] {
+            let s = sample_surface(&[[0, 1, 2]], &positions, spacing);
+            let total: f64 = s.iter().map(|s| s.weight).sum();
+            assert!((total - 6.0).abs() < 1e-12, "spacing {spacing}: {total}");
+            assert!(s.iter().all(|s| s.weight > 0.0));
+        }
+    }
+
+    #[test]
+    fn integrates_a_cubic_exactly() {
+        // Over the triangle (0,0),(1,0),(0,1): ∫ x² = 1/12, ∫ x³ = 1/20, ∫ x²y = 1/60.
+        let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        type Integrand = fn(Vec3) -> f64;
+        let cases: [(Integrand, f64); 3] = [
+            (|p| p[0].powi(2), 1.0 / 12.0),
+            (|p| p[0].powi(3), 1.0 / 20.0),
+            (|p| p[0].powi(2) * p[1], 1.0 / 60.0),
+        ];
+        for spacing in [2.0, 0.4, 0.1] {
+            let s = sample_surface(&[[0, 1, 2]], &positions, spacing);
+            for (f, want) in cases {
+                let integral: f64 = s.iter().map(|s| s.weight * f(s.point)).sum();
+                assert!((integral - want).abs() < 1e-12, "{integral} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn points_on_a_shared_edge_are_one_sample() {
+        // Two triangles sharing edge 1–2, walked in opposite directions.
+        let positions = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        let tris = [[0, 1, 2], [3, 2, 1]];
+        for (spacing, level) in [(2.0, 1usize), (0.5, 3)] {
+            let s = sample_surface(&tris, &positions, spacing);
+            // Per face: the (2L+1)(2L+2)/2 lattice points and L² centroids; the shared edge
+            // holds 2L+1 of them.
+            let per_face = (level + 1) * (2 * level + 1) + level * level;
+            assert_eq!(s.len(), 2 * per_face - (2 * level + 1), "level {level}");
+            let total: f64 = s.iter().map(|s| s.weight).sum();
+            assert!((total - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn finer_spacing_gives_more_samples() {
+        let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let coarse = sample_surface(&[[0, 1, 2]], &positions, 2.0).len();
+        let fine = sample_surface(&[[0, 1, 2]], &positions, 0.1).len();
+        assert_eq!(coarse, 3 + 3 + 1);
+        assert!(fine > 10 * coarse);
+    }
+}

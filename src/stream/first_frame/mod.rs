@@ -1,0 +1,356 @@
+//! The static mesh coder for frame 0: connectivity and quantised positions.
+//!
+//! Layout of [`EncodedFirstFrame::bytes`] (little endian):
+//! `version u8, bits u8, flags u8, 0u8, vertices u32, traversed triangles u32,
+//! degenerate triangles u32, bbox lo 3×f32, bbox hi 3×f32, connectivity length u32,
+//! geometry length u32, order length u32, crc32 u32` then the three range-coded streams:
+//! - connectivity: the [`traversal`] symbols, then the degenerate triangles (a repeated index),
+//!   which no traversal can reach, as plain adaptive-coded indices;
+//! - geometry: the quantised positions in traversal order (vertices in no triangle appended in
+//!   input order), coded after the connectivity by [`geometry`]: multi-parallelogram prediction,
+//!   else the mean of coded neighbours, else the previous vertex;
+//! - order: the traversal → input vertex permutation, absent with `reorder`.
+//!
+//! Triangles come back in traversal order (face order is not kept: coding it would cost
+//! log2(F!) bits) with the input's vertex indices and orientation, possibly rotated.
+
+mod geometry;
+mod order;
+mod quantise;
+mod traversal;
+
+pub use quantise::{Cell, Grid};
+
+use crate::error::{Error, Result};
+use crate::mesh::topology::VertexAdjacency;
+use crate::mesh::{Point, Triangle};
+use crate::stream::entropy::{max_symbols, Decoder, Encoder, SymbolCoder, UIntModel};
+use traversal::{Models, Oracle, UNASSIGNED};
+
+const VERSION: u8 = 1;
+const HEADER_LEN: usize = 56;
+const FLAG_ORDER: u8 = 1;
+/// Refuses headers past this many vertices or triangles whatever the input length.
+const MAX_ELEMENTS: u64 = 1 << 28;
+
+/// How to code the first frame.
+#[derive(Clone, Debug)]
+pub struct FirstFrameOptions {
+    /// Bits per coordinate over the bounding box (1..=24).
+    pub bits: u8,
+    /// Let the coder number vertices in traversal order (fewer bits; see [`EncodedFirstFrame::permutation`]).
+    pub reorder: bool,
+}
+
+impl Default for FirstFrameOptions {
+    fn default() -> Self {
+        Self {
+            bits: 12,
+            reorder: false,
+        }
+    }
+}
+
+/// The coded first frame and what the decoder will make of it.
+#[derive(Clone, Debug)]
+pub struct EncodedFirstFrame {
+    /// The coded bytes.
+    pub bytes: Vec<u8>,
+    /// Exactly what [`decode`] will return as positions (in the decoder's vertex order).
+    pub decoded_positions: Vec<Point>,
+    /// With `reorder`: `permutation[new] = old` vertex index; `None` when the order is kept.
+    pub permutation: Option<Vec<u32>>,
+    /// Bytes of each stream, for reports.
+    pub sizes: StreamSizes,
+}
+
+/// Sizes in bytes of the parts of a coded first frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StreamSizes {
+    /// Fixed header.
+    pub header: usize,
+    /// Connectivity stream.
+    pub connectivity: usize,
+    /// Geometry stream.
+    pub geometry: usize,
+    /// Vertex order stream.
+    pub order: usize,
+}
+
+/// Codes the triangles with a repeated vertex index.
+fn code_degenerate<C: SymbolCoder>(
+    coder: &mut C,
+    triangles: &mut [Triangle],
+    vertex_count: usize,
+) -> Result<()> {
+    let mut model = UIntModel::default();
+    for tri in triangles.iter_mut() {
+        for v in tri.iter_mut() {
+            let index = coder.unsigned(u64::from(*v), &mut model)?;
+            *v = u32::try_from(index)
+                .ok()
+                .filter(|&i| (i as usize) < vertex_count)
+                .ok_or_else(|| {
+                    Error::Stream("first frame: degenerate triangle index out of range".into())
+                })?;
+        }
+    }
+    Ok(())
+}
+
+/// Encodes frame 0: `triangles` index `positions`.
+pub fn encode(
+    positions: &[Point],
+    triangles: &[Triangle],
+    opts: &FirstFrameOptions,
+) -> Result<EncodedFirstFrame> {
+    let vertex_count = positions.len();
+    if vertex_count as u64 > MAX_ELEMENTS || triangles.len() as u64 > MAX_ELEMENTS {
+        return Err(Error::Usage(format!(
+            "first frame too large: {vertex_count} vertices"
+        )));
+    }
+    if let Some((t, _)) = triangles
+        .iter()
+        .enumerate()
+        .find(|(_, tri)| tri.iter().any(|&v| v as usize >= vertex_count))
+    {
+        return Err(Error::Mesh(format!(
+            "triangle {t} indexes a vertex past {vertex_count}"
+        )));
+    }
+    let grid = Grid::fit(positions, opts.bits)?;
+    let cells: Vec<Cell> = positions.iter().map(|&p| grid.quantise(p)).collect();
+    let (traversable, mut degenerate): (Vec<Triangle>, Vec<Triangle>) = triangles
+        .iter()
+        .partition(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+
+    let mut connectivity = Encoder::new();
+    let mut geometry = Encoder::new();
+    let mut models = Models::default();
+    let mut oracle = Oracle::new(&traversable, vertex_count);
+    let state = traversal::run(
+        &mut connectivity,
+        Some(&mut oracle),
+        traversable.len(),
+        vertex_count,
+        &mut models,
+    )?;
+    // Vertices in no traversed triangle follow, in input order.
+    for v in 0..vertex_count as u32 {
+        if oracle.to_traversal.get(v as usize) == Some(&UNASSIGNED) {
+            oracle.assign(v);
+        }
+    }
+    let traversal_cells: Vec<Cell> = oracle
+        .from_traversal
+        .iter()
+        .map(|&v| cells[v as usize])
+        .collect();
+    let decoded_cells = geometry::code_positions(
+        &mut geometry,
+        &grid,
+        &state.triangles,
+        vertex_count,
+        &traversal_cells,
+    )?;
+    for tri in degenerate.iter_mut() {
+        for v in tri.iter_mut() {
+            *v = oracle.to_traversal.get(*v as usize).copied().unwrap_or(0);
+        }
+    }
+    code_degenerate(&mut connectivity, &mut degenerate, vertex_count)?;
+
+    let mut order_stream = Vec::new();
+    if !opts.reorder {
+        let mut order_coder = Encoder::new();
+        let all: Vec<Triangle> = state.triangles.iter().chain(&degenerate).copied().collect();
+        let adjacency = VertexAdjacency::new(vertex_count, &all);
+        order::code_order(
+            &mut order_coder,
+            &mut oracle.from_traversal.clone(),
+            &adjacency,
+        )?;
+        order_stream = order_coder.finish()?;
+    }
+    let traversal_positions: Vec<Point> =
+        decoded_cells.iter().map(|&c| grid.dequantise(c)).collect();
+    let (decoded_positions, permutation) = if opts.reorder {
+        (traversal_positions, Some(oracle.from_traversal.clone()))
+    } else {
+        let mut out = vec![[0.0; 3]; vertex_count];
+        for (t, &input) in oracle.from_traversal.iter().enumerate() {
+            out[input as usize] = traversal_positions[t];
+        }
+        (out, None)
+    };
+
+    let connectivity = connectivity.finish()?;
+    let geometry = geometry.finish()?;
+    let header = Header {
+        bits: opts.bits,
+        has_order: !opts.reorder,
+        vertex_count: vertex_count as u32,
+        traversed: traversable.len() as u32,
+        degenerate: degenerate.len() as u32,
+        grid,
+        lengths: [
+            connectivity.len() as u32,
+            geometry.len() as u32,
+            order_stream.len() as u32,
+        ],
+    };
+    let mut bytes = header.to_bytes();
+    bytes.extend_from_slice(&connectivity);
+    bytes.extend_from_slice(&geometry);
+    bytes.extend_from_slice(&order_stream);
+    let crc = crc32fast::hash(&bytes);
+    bytes.splice(HEADER_LEN - 4..HEADER_LEN - 4, crc.to_le_bytes());
+    Ok(EncodedFirstFrame {
+        bytes,
+        decoded_positions,
+        permutation,
+        sizes: StreamSizes {
+            header: HEADER_LEN,
+            connectivity: connectivity.len(),
+            geometry: geometry.len(),
+            order: order_stream.len(),
+        },
+    })
+}
+
+/// Decodes a first frame: its triangles and positions.
+pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
+    let header = Header::parse(bytes)?;
+    let payload = bytes.get(HEADER_LEN..).unwrap_or_default();
+    let [lc, lg, lo] = header.lengths.map(|l| l as usize);
+    let (connectivity, rest) = payload.split_at_checked(lc).ok_or_else(truncated)?;
+    let (geometry, order) = rest.split_at_checked(lg).ok_or_else(truncated)?;
+    if order.len() != lo {
+        return Err(truncated());
+    }
+    let vertex_count = header.vertex_count as usize;
+    let mut connectivity = Decoder::new(connectivity)?;
+    let mut geometry = Decoder::new(geometry)?;
+    let mut models = Models::default();
+    let grid = header.grid;
+    let state = traversal::run(
+        &mut connectivity,
+        None,
+        header.traversed as usize,
+        vertex_count,
+        &mut models,
+    )?;
+    let cells =
+        geometry::code_positions(&mut geometry, &grid, &state.triangles, vertex_count, &[])?;
+    let mut degenerate = vec![[0u32; 3]; header.degenerate as usize];
+    code_degenerate(&mut connectivity, &mut degenerate, vertex_count)?;
+    let mut triangles = state.triangles;
+    triangles.extend(degenerate);
+    let mut positions: Vec<Point> = cells.iter().map(|&c| grid.dequantise(c)).collect();
+    if header.has_order {
+        let mut order_indices = vec![0u32; vertex_count];
+        let adjacency = VertexAdjacency::new(vertex_count, &triangles);
+        order::code_order(&mut Decoder::new(order)?, &mut order_indices, &adjacency)?;
+        let mut reordered = vec![[0.0; 3]; vertex_count];
+        for (t, &input) in order_indices.iter().enumerate() {
+            reordered[input as usize] = positions[t];
+        }
+        positions = reordered;
+        for tri in triangles.iter_mut() {
+            for v in tri.iter_mut() {
+                *v = order_indices[*v as usize];
+            }
+        }
+    }
+    Ok((triangles, positions))
+}
+
+fn truncated() -> Error {
+    Error::Stream("first frame: truncated".into())
+}
+
+/// The fixed-size header in front of the streams.
+struct Header {
+    bits: u8,
+    has_order: bool,
+    vertex_count: u32,
+    traversed: u32,
+    degenerate: u32,
+    grid: Grid,
+    lengths: [u32; 3],
+}
+
+impl Header {
+    /// The header with a zero checksum, which `encode` fills in.
+    fn to_bytes(&self) -> Vec<u8> {
+        let mut out = vec![
+            VERSION,
+            self.bits,
+            if self.has_order { FLAG_ORDER } else { 0 },
+            0,
+        ];
+        for v in [self.vertex_count, self.traversed, self.degenerate] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        for c in self.grid.lo.iter().chain(&self.grid.hi) {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+        for l in self.lengths {
+            out.extend_from_slice(&l.to_le_bytes());
+        }
+        out
+    }
+
+    fn parse(bytes: &[u8]) -> Result<Self> {
+        let head = bytes.get(..HEADER_LEN).ok_or_else(truncated)?;
+        let word = |k: usize| u32::from_le_bytes([head[k], head[k + 1], head[k + 2], head[k + 3]]);
+        let float = |k: usize| f32::from_bits(word(k));
+        let crc = word(HEADER_LEN - 4);
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(&head[..HEADER_LEN - 4]);
+        hasher.update(&bytes[HEADER_LEN..]);
+        if hasher.finalize() != crc {
+            return Err(Error::Stream("first frame: checksum mismatch".into()));
+        }
+        if head[0] != VERSION {
+            return Err(Error::Stream(format!(
+                "first frame: unknown version {}",
+                head[0]
+            )));
+        }
+        let bits = head[1];
+        if !(1..=Grid::MAX_BITS).contains(&bits) {
+            return Err(Error::Stream(format!("first frame: {bits} position bits")));
+        }
+        let lo = [float(16), float(20), float(24)];
+        let hi = [float(28), float(32), float(36)];
+        if lo.iter().chain(&hi).any(|c| !c.is_finite()) {
+            return Err(Error::Stream("first frame: non-finite bounding box".into()));
+        }
+        let header = Self {
+            bits,
+            has_order: head[2] & FLAG_ORDER != 0,
+            vertex_count: word(4),
+            traversed: word(8),
+            degenerate: word(12),
+            grid: Grid { bits, lo, hi },
+            lengths: [word(40), word(44), word(48)],
+        };
+        // Each vertex and triangle costs at least one coded symbol.
+        let limit = max_symbols(bytes.len() - HEADER_LEN).min(MAX_ELEMENTS);
+        for (what, n) in [
+            ("vertices", header.vertex_count),
+            ("triangles", header.traversed),
+            ("degenerate triangles", header.degenerate),
+        ] {
+            if u64::from(n) > limit {
+                return Err(Error::Stream(format!(
+                    "first frame: {n} {what} cannot fit in {} bytes",
+                    bytes.len()
+                )));
+            }
+        }
+        Ok(header)
+    }
+}

@@ -1,0 +1,118 @@
+//! `mcgv-video eval` end to end: the binary on files, its JSON and human output, its errors.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn eval(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
+        .arg("eval")
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
+}
+
+fn media(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("media")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "eval failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "not one JSON object ({e}): {}",
+            String::from_utf8_lossy(&out.stdout)
+        )
+    })
+}
+
+fn number(v: &serde_json::Value, key: &str) -> f64 {
+    v.get(key)
+        .and_then(|x| x.as_f64())
+        .unwrap_or_else(|| panic!("no number {key} in {v}"))
+}
+
+/// A 6×6 grid sheet in the z = `z` plane, `frames` frames swaying in x, as an OBJ sequence.
+fn write_sheet(dir: &Path, frames: usize, z: f32) {
+    std::fs::create_dir_all(dir).unwrap_or_else(|e| panic!("{e}"));
+    for f in 0..frames {
+        let mut s = String::new();
+        for v in 0..36 {
+            let (x, y) = ((v % 6) as f32, (v / 6) as f32);
+            let _ = writeln!(s, "v {} {y} {z}", x + 0.1 * f as f32 * y);
+        }
+        for i in 0..5 {
+            for j in 0..5 {
+                let v = i * 6 + j + 1;
+                let _ = writeln!(s, "f {} {} {}", v, v + 1, v + 6);
+                let _ = writeln!(s, "f {} {} {}", v + 1, v + 7, v + 6);
+            }
+        }
+        std::fs::write(dir.join(format!("frame_{f}.obj")), s).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+#[test]
+fn a_sample_against_itself_has_zero_error() {
+    let sample = media("RiggedSimple.glb");
+    let v = json(&eval(&[&sample, &sample, "--json"]));
+    for key in ["rmse", "hausdorff", "vertex_rmse", "kg_error"] {
+        assert_eq!(number(&v, key), 0.0, "{key} in {v}");
+    }
+    assert!(number(&v, "vertices") > 0.0 && number(&v, "frames") > 1.0);
+    assert!(v.get("bpvf").is_none(), "no file, so no bpvf: {v}");
+}
+
+#[test]
+fn a_lifted_copy_is_off_by_the_lift_in_both_outputs() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    write_sheet(&a, 3, 0.0);
+    write_sheet(&b, 3, 0.05);
+    let (a, b) = (a.to_string_lossy(), b.to_string_lossy());
+    let v = json(&eval(&[&a, &b, "--json"]));
+    // Frame 0 spans 5 × 5 in x, y: diagonal 5√2; a sheet lifted along its normal is 0.05 away.
+    let want = 0.05 / (50f64).sqrt();
+    for key in ["rmse", "hausdorff", "vertex_rmse"] {
+        let got = number(&v, key);
+        assert!(
+            (got - want).abs() < 1e-6 * want.max(got),
+            "{key}: {got} vs {want}"
+        );
+    }
+    assert_eq!((number(&v, "frames"), number(&v, "vertices")), (3.0, 36.0));
+    let out = eval(&[&a, &b]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains(&format!("{:.4} ×10⁻⁴", want * 1e4)) && text.contains("RMSE"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_missing_mcgv_fails_naming_it() {
+    let out = eval(&[&media("Fox.glb"), "no/such/decoded.mcgv"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no/such/decoded.mcgv"), "{err}");
+}
+
+#[test]
+fn a_missing_input_fails_naming_it() {
+    let out = eval(&["no/such/animation.glb", &media("Fox.glb")]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/animation.glb"));
+}

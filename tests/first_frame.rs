@@ -1,0 +1,370 @@
+//! Round trips of the first-frame mesh coder on meshes built in code, random soups and damage.
+
+use mcgv_video::mesh::{Point, Triangle};
+use mcgv_video::stream::first_frame::{decode, encode, FirstFrameOptions};
+use mcgv_video::Error;
+use proptest::prelude::*;
+
+/// Triangles as a sorted list with each rotated to start at its smallest index.
+fn canonical(triangles: &[Triangle]) -> Vec<Triangle> {
+    let mut out: Vec<Triangle> = triangles
+        .iter()
+        .map(|t| {
+            let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+/// Encodes and decodes with and without `reorder`; checks connectivity, positions and closed loop.
+fn round_trip(positions: &[Point], triangles: &[Triangle]) -> usize {
+    let mut size = 0;
+    for reorder in [false, true] {
+        let opts = FirstFrameOptions { bits: 12, reorder };
+        let coded = encode(positions, triangles, &opts).unwrap();
+        let (tris, pos) = decode(&coded.bytes).unwrap();
+        assert_eq!(pos.len(), positions.len());
+        let bits_eq = |a: &[Point], b: &[Point]| {
+            a.iter()
+                .zip(b)
+                .all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()))
+        };
+        assert!(
+            bits_eq(&pos, &coded.decoded_positions),
+            "decoder differs from encoder's prediction"
+        );
+        let (tris, pos) = match &coded.permutation {
+            None => (tris, pos),
+            Some(perm) => {
+                assert!(reorder);
+                let mut back = vec![[0.0; 3]; pos.len()];
+                for (new, &old) in perm.iter().enumerate() {
+                    back[old as usize] = pos[new];
+                }
+                let tris: Vec<Triangle> =
+                    tris.iter().map(|t| t.map(|v| perm[v as usize])).collect();
+                (tris, back)
+            }
+        };
+        assert_eq!(
+            canonical(&tris),
+            canonical(triangles),
+            "reorder = {reorder}"
+        );
+        // Quantisation error is at most half a step per axis.
+        let (lo, hi) = mcgv_video::mesh::bounding_box(positions);
+        let extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0f32, f32::max);
+        let step = extent / 4095.0;
+        for (p, q) in positions.iter().zip(&pos) {
+            for k in 0..3 {
+                assert!(
+                    (p[k] - q[k]).abs() <= step * 0.5 + 1e-5 * (1.0 + p[k].abs()),
+                    "{p:?} vs {q:?}"
+                );
+            }
+        }
+        size = coded.bytes.len();
+    }
+    size
+}
+
+fn grid(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
+    let mut pos = Vec::new();
+    for j in 0..=m {
+        for i in 0..=n {
+            pos.push([i as f32, j as f32, ((i * j) as f32 * 0.1).sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut tris = Vec::new();
+    for j in 0..m {
+        for i in 0..n {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    (pos, tris)
+}
+
+/// A torus: a grid whose both directions wrap around.
+fn torus(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
+    let mut pos = Vec::new();
+    for j in 0..m {
+        for i in 0..n {
+            let (u, v) = (
+                i as f32 / n as f32 * std::f32::consts::TAU,
+                j as f32 / m as f32 * std::f32::consts::TAU,
+            );
+            let r = 3.0 + v.cos();
+            pos.push([r * u.cos(), r * u.sin(), v.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((j % m) * n + (i % n)) as u32;
+    let mut tris = Vec::new();
+    for j in 0..m {
+        for i in 0..n {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    (pos, tris)
+}
+
+/// A closed latitude-longitude sphere with two poles.
+fn sphere(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
+    let mut pos = vec![[0.0, 0.0, 1.0]];
+    for j in 1..m {
+        let theta = j as f32 / m as f32 * std::f32::consts::PI;
+        for i in 0..n {
+            let phi = i as f32 / n as f32 * std::f32::consts::TAU;
+            pos.push([
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ]);
+        }
+    }
+    pos.push([0.0, 0.0, -1.0]);
+    let south = (pos.len() - 1) as u32;
+    let ring = |j: usize, i: usize| (1 + (j - 1) * n + i % n) as u32;
+    let mut tris = Vec::new();
+    for i in 0..n {
+        tris.push([0, ring(1, i), ring(1, i + 1)]);
+        tris.push([south, ring(m - 1, i + 1), ring(m - 1, i)]);
+    }
+    for j in 1..m - 1 {
+        for i in 0..n {
+            tris.push([ring(j, i), ring(j + 1, i), ring(j + 1, i + 1)]);
+            tris.push([ring(j, i), ring(j + 1, i + 1), ring(j, i + 1)]);
+        }
+    }
+    (pos, tris)
+}
+
+#[test]
+fn grid_with_boundary() {
+    let (p, t) = grid(12, 9);
+    round_trip(&p, &t);
+}
+
+#[test]
+fn closed_sphere_codes_compactly() {
+    let (p, t) = sphere(24, 16);
+    let opts = FirstFrameOptions {
+        bits: 12,
+        reorder: true,
+    };
+    let coded = encode(&p, &t, &opts).unwrap();
+    // Connectivity of a regular closed mesh should cost a few bits per vertex, not an index each.
+    let bpv = coded.sizes.connectivity as f64 * 8.0 / p.len() as f64;
+    assert!(bpv < 4.0, "connectivity {bpv} bits per vertex");
+    round_trip(&p, &t);
+}
+
+#[test]
+fn torus_with_handle() {
+    let (p, t) = torus(16, 10);
+    round_trip(&p, &t);
+}
+
+#[test]
+fn forty_one_components_and_isolated_vertices() {
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    for c in 0..41u32 {
+        let (gp, gt) = grid(2 + (c as usize % 3), 2);
+        let base = p.len() as u32;
+        p.extend(gp.iter().map(|q| [q[0] + 10.0 * c as f32, q[1], q[2]]));
+        t.extend(gt.iter().map(|tri| tri.map(|v| v + base)));
+        p.push([c as f32, -5.0, 0.5]); // isolated
+    }
+    round_trip(&p, &t);
+}
+
+#[test]
+fn non_manifold_fin_bow_tie_and_flips() {
+    let p: Vec<Point> = (0..9)
+        .map(|k| [k as f32, (k * k % 5) as f32, (k % 3) as f32])
+        .collect();
+    let t = vec![
+        [0, 1, 2],
+        [1, 0, 3], // shares edge 0-1
+        [0, 1, 4], // fin: a third triangle on edge 0-1, same orientation as the first
+        [2, 5, 6], // bow-tie at vertex 2
+        [6, 5, 7],
+        [7, 8, 6],
+        [8, 7, 6], // the same triangle both ways
+        [0, 1, 2], // duplicate triangle
+    ];
+    round_trip(&p, &t);
+}
+
+#[test]
+fn degenerate_and_duplicate_vertices() {
+    let p: Vec<Point> = vec![
+        [0.0; 3],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 2.0, 2.0],
+    ];
+    let t = vec![[0, 1, 2], [1, 1, 2], [3, 1, 2], [4, 4, 4], [2, 1, 0]];
+    round_trip(&p, &t);
+}
+
+#[test]
+fn tiny_meshes() {
+    round_trip(
+        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[[0, 1, 2]],
+    );
+    round_trip(&[], &[]);
+    round_trip(&[[1.0, 2.0, 3.0]], &[]);
+}
+
+#[test]
+fn bad_input_is_refused() {
+    let p = [[0.0f32; 3]; 3];
+    assert!(matches!(
+        encode(&p, &[[0, 1, 3]], &FirstFrameOptions::default()),
+        Err(Error::Mesh(_))
+    ));
+    let nan = [[f32::NAN, 0.0, 0.0], [0.0; 3], [1.0; 3]];
+    assert!(encode(&nan, &[[0, 1, 2]], &FirstFrameOptions::default()).is_err());
+    let opts = FirstFrameOptions {
+        bits: 0,
+        reorder: false,
+    };
+    assert!(encode(&p, &[[0, 1, 2]], &opts).is_err());
+}
+
+#[test]
+fn every_truncation_and_corruption_fails_cleanly() {
+    let (p, t) = grid(4, 3);
+    let bytes = encode(&p, &t, &FirstFrameOptions::default()).unwrap().bytes;
+    for cut in 0..bytes.len() {
+        assert!(
+            matches!(decode(&bytes[..cut]), Err(Error::Stream(_))),
+            "cut at {cut}"
+        );
+    }
+    for k in 0..bytes.len() {
+        let mut bad = bytes.clone();
+        bad[k] ^= 0x10;
+        assert!(matches!(decode(&bad), Err(Error::Stream(_))), "flip at {k}");
+    }
+}
+
+#[test]
+fn huge_vertex_count_is_refused_before_allocating() {
+    let (p, t) = grid(2, 2);
+    let mut bytes = encode(&p, &t, &FirstFrameOptions::default()).unwrap().bytes;
+    bytes[4..8].copy_from_slice(&1_000_000_000u32.to_le_bytes());
+    // Fix the checksum so that only the count check can refuse it.
+    let mut h = crc32fast::Hasher::new();
+    h.update(&bytes[..52]);
+    h.update(&bytes[56..]);
+    let crc = h.finalize();
+    bytes[52..56].copy_from_slice(&crc.to_le_bytes());
+    let err = decode(&bytes).unwrap_err();
+    assert!(err.to_string().contains("cannot fit"), "{err}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    #[test]
+    fn random_soups_round_trip(
+        n in 1usize..30,
+        raw in proptest::collection::vec((0u32..30, 0u32..30, 0u32..30), 0..60),
+        seed in 0u32..1000,
+    ) {
+        let p: Vec<Point> = (0..n)
+            .map(|k| {
+                let h = (k as u32).wrapping_mul(2_654_435_761).wrapping_add(seed);
+                [(h % 97) as f32, (h / 97 % 89) as f32 * 0.5, (h / 8633 % 83) as f32]
+            })
+            .collect();
+        let t: Vec<Triangle> = raw.iter().map(|&(a, b, c)| [a % n as u32, b % n as u32, c % n as u32]).collect();
+        round_trip(&p, &t);
+    }
+}
+
+/// Recomputes the checksum so that damage reaches the entropy decoders.
+fn with_valid_checksum(mut bytes: Vec<u8>) -> Vec<u8> {
+    if bytes.len() >= 56 {
+        let mut h = crc32fast::Hasher::new();
+        h.update(&bytes[..52]);
+        h.update(&bytes[56..]);
+        let crc = h.finalize();
+        bytes[52..56].copy_from_slice(&crc.to_le_bytes());
+    }
+    bytes
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    #[test]
+    fn garbage_behind_a_valid_checksum_never_panics(
+        flips in proptest::collection::vec((0usize..10_000, 1u8..=255), 1..6),
+    ) {
+        let (p, t) = torus(8, 6);
+        let bytes = encode(&p, &t, &FirstFrameOptions::default()).unwrap().bytes;
+        let mut bad = bytes.clone();
+        for (at, mask) in flips {
+            let k = 56 + at % (bad.len() - 56);
+            bad[k] ^= mask;
+        }
+        let bad = with_valid_checksum(bad);
+        if let Err(e) = decode(&bad) {
+            prop_assert!(matches!(e, Error::Stream(_)));
+        }
+    }
+}
+
+/// Bind-pose positions and triangles of every triangle primitive of a glTF sample, concatenated
+/// (read with `gltf` directly until the project's reader is used here).
+fn gltf_mesh(path: &str) -> (Vec<Point>, Vec<Triangle>) {
+    let (doc, buffers, _) = gltf::import(path).unwrap();
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for prim in doc
+        .meshes()
+        .flat_map(|m| m.primitives().collect::<Vec<_>>())
+    {
+        if prim.mode() != gltf::mesh::Mode::Triangles {
+            continue;
+        }
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let Some(pos) = reader.read_positions() else {
+            continue;
+        };
+        let base = positions.len() as u32;
+        positions.extend(pos);
+        let count = positions.len() as u32 - base;
+        let idx: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..count).collect(),
+        };
+        triangles.extend(
+            idx.chunks_exact(3)
+                .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
+        );
+    }
+    (positions, triangles)
+}
+
+#[test]
+fn media_samples_round_trip() {
+    for name in ["CesiumMan", "Fox", "RiggedFigure", "RiggedSimple"] {
+        let path = format!("{}/media/{name}.glb", env!("CARGO_MANIFEST_DIR"));
+        let (p, t) = gltf_mesh(&path);
+        assert!(!t.is_empty(), "{name} has no triangles");
+        let bytes = round_trip(&p, &t);
+        // A raw dump needs 96 bits per vertex for the positions alone.
+        assert!(
+            bytes * 8 < 64 * p.len(),
+            "{name}: {bytes} bytes for {} vertices",
+            p.len()
+        );
+    }
+}
