@@ -1,12 +1,13 @@
 //! Segmentation and piecewise affine prediction on real sequences: K, residual energy against raw
 //! motion energy, largest residual, and the time of each stage.
 //!
-//! `cargo bench --bench motion [-- DIR_OR_FILE ...]`; with no arguments, every sequence found under
+//! `cargo bench --bench motion [-- INPUT ...]` (any input `read_animation` takes); with no arguments,
+//! every sequence found under
 //! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
 //! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`;
 //! `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
 
-use mcgv_video::mesh::Point;
+use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
     energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions,
     DEFAULT_AFFINE_BITS,
@@ -38,7 +39,13 @@ fn main() {
         "predict s"
     );
     for input in inputs {
-        let name = input.file_name().map_or_else(
+        // Sequences are named by their folder: `pdance`, `walking_cat/OBJ` → walking_cat, `…/Fox/headA.glb` → the folder.
+        let folder = if input.is_file() || input.ends_with("OBJ") {
+            input.parent().unwrap_or(&input)
+        } else {
+            &input
+        };
+        let name = folder.file_name().map_or_else(
             || input.display().to_string(),
             |n| n.to_string_lossy().into(),
         );
@@ -61,7 +68,21 @@ fn default_inputs() -> Vec<PathBuf> {
     .iter()
     .map(|n| unpacked.join(n))
     .collect();
-    inputs.push(PathBuf::from("/work/shared/media/walking_cat/OBJ"));
+    let shared = Path::new("/work/shared/media");
+    inputs.push(shared.join("walking_cat/OBJ"));
+    for glb in [
+        "khronos_RiggedSimple/robeA.glb",
+        "khronos_RiggedFigure/bodyC.glb",
+        "khronos_Fox/headA.glb",
+        "khronos_CesiumMan/bodyA.glb",
+        "khronos_BrainStem/BrainStem.glb",
+        "threejs_Horse/Horse.glb",
+        "threejs_Flamingo/Flamingo.glb",
+        "threejs_Parrot/Parrot.glb",
+        "threejs_Stork/Stork.glb",
+    ] {
+        inputs.push(shared.join(glb));
+    }
     inputs.into_iter().filter(|p| p.exists()).collect()
 }
 
@@ -139,54 +160,6 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
     );
 }
 
-// TEMPORARY: a minimal OBJ-sequence loader until the project's readers land on main; delete it then
-// and call `mcgv_video::mesh::read_animation` instead (the project keeps one OBJ reader).
-fn load(dir: &Path) -> Result<AnimatedMesh, String> {
-    let mut files: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
-        .map_err(|e| e.to_string())?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
-        .map(|p| {
-            let digits: String = p
-                .file_stem()
-                .map(|s| {
-                    s.to_string_lossy()
-                        .chars()
-                        .filter(char::is_ascii_digit)
-                        .collect()
-                })
-                .unwrap_or_default();
-            (digits.parse().unwrap_or(0), p)
-        })
-        .collect();
-    files.sort();
-    let mut triangles = Vec::new();
-    let mut frames: Vec<Vec<Point>> = Vec::new();
-    for (_, path) in &files {
-        let (models, _) = tobj::load_obj(
-            path,
-            &tobj::LoadOptions {
-                triangulate: true,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-        let mut points = Vec::new();
-        let mut tris = Vec::new();
-        for m in &models {
-            let base = points.len() as u32;
-            points.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
-            tris.extend(
-                m.mesh
-                    .indices
-                    .chunks_exact(3)
-                    .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
-            );
-        }
-        if frames.is_empty() {
-            triangles = tris;
-        }
-        frames.push(points);
-    }
-    AnimatedMesh::new(triangles, frames).map_err(|e| e.to_string())
+fn load(input: &Path) -> mcgv_video::Result<AnimatedMesh> {
+    read_animation(&input.to_string_lossy(), &ReadOptions::default())
 }

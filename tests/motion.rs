@@ -380,3 +380,31 @@ fn partition_picture_shows_every_cluster() {
         render_partition_png(mesh.frame(0), mesh.triangles(), &labels[1..], 96, &path).is_err()
     );
 }
+
+/// Frame 0 of a real mesh shipped with the project (CesiumMan: 138 pieces, flat patches), cut into
+/// four slabs along its longest side, each moved by its own map.
+#[test]
+fn parts_of_a_real_mesh_are_recovered_and_predicted() {
+    let figure = mcgv_video::mesh::read_animation(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/media/CesiumMan.glb"),
+        &mcgv_video::mesh::ReadOptions::default(),
+    )
+    .unwrap();
+    let rest = figure.frame(0).to_vec();
+    let (lo, hi) = mcgv_video::mesh::bounding_box(&rest);
+    let axis = (0..3)
+        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
+        .unwrap();
+    let part: Vec<usize> = rest
+        .iter()
+        .map(|p| (((p[axis] - lo[axis]) / (hi[axis] - lo[axis]) * 4.0) as usize).min(3))
+        .collect();
+    let mesh = piecewise_affine(rest, figure.triangles().to_vec(), &part);
+    let partition = segment(&mesh, &options(4)).unwrap();
+    let score = rand_index(partition.labels(), &part);
+    assert!(score > 0.9, "Rand index {score}");
+    let labels: Vec<u32> = part.iter().map(|&k| k as u32).collect();
+    let exact = Partition::from_labels(labels, 4).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, 17).unwrap();
+    assert!(max_residual(&mesh, &track, &exact) < 2e-5 * mesh.bbox_diagonal());
+}

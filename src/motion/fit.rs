@@ -68,6 +68,10 @@ pub struct AffineSolver {
     centred: Vec<Vector3<f64>>,
     lambda: f64,
     inverse: Matrix3<f64>,
+    /// For a (nearly) flat source, two tangents and the normal `t1 × t2` of its plane.
+    plane: Option<[Vector3<f64>; 3]>,
+    /// Whether some direction of the source is seen less than the regularisation weighs.
+    degenerate: bool,
 }
 
 /// Smallest regularisation per source point, in unit coordinates: keeps a single point invertible.
@@ -98,7 +102,15 @@ impl AffineSolver {
             centred,
             lambda,
             inverse,
+            plane: flat_plane(&scatter, lambda),
+            degenerate: scatter.symmetric_eigenvalues().min() < lambda,
         }
+    }
+
+    /// Whether the source leaves some direction of the map to the regularisation (flat, on a line,
+    /// a single point): the fitted map is then a guess in that direction.
+    pub fn is_degenerate(&self) -> bool {
+        self.degenerate
     }
 
     /// The best map from the source onto `target` (unit coordinates, same order and length as the source).
@@ -115,7 +127,18 @@ impl AffineSolver {
         if count == 0 {
             return IDENTITY;
         }
-        let a = cross * self.inverse;
+        let mut a = cross * self.inverse;
+        if let Some([t1, t2, n]) = self.plane {
+            // The data do not see the normal direction; instead of leaving it at the identity (which
+            // makes a rotated flat patch look unlike the rest of its rigid part), send the normal
+            // where a similarity would: onto the cross product of the mapped tangents.
+            let mapped = (a * t1).cross(&(a * t2));
+            let size = mapped.norm();
+            if size > 0.0 && size.is_finite() {
+                let target = mapped / size.sqrt();
+                a += (target - a * n) * n.transpose();
+            }
+        }
         let b = sum / count as f64 - a * self.mean;
         let mut h = [0.0; 12];
         for r in 0..3 {
@@ -126,6 +149,20 @@ impl AffineSolver {
         }
         h
     }
+}
+
+/// The plane of a source whose scatter has exactly one direction the regularisation dominates.
+fn flat_plane(scatter: &Matrix3<f64>, lambda: f64) -> Option<[Vector3<f64>; 3]> {
+    let eigen = scatter.symmetric_eigen();
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| eigen.eigenvalues[i].total_cmp(&eigen.eigenvalues[j]));
+    let flat = eigen.eigenvalues[order[0]] < lambda && eigen.eigenvalues[order[1]] >= lambda;
+    if !flat {
+        return None;
+    }
+    let t1 = eigen.eigenvectors.column(order[2]).into_owned();
+    let t2 = eigen.eigenvectors.column(order[1]).into_owned();
+    Some([t1, t2, t1.cross(&t2)])
 }
 
 #[cfg(test)]
@@ -173,5 +210,22 @@ mod tests {
             }
         }
         assert_eq!(AffineSolver::new(&[], 0.0).solve([]), IDENTITY);
+    }
+
+    #[test]
+    fn a_rotated_flat_patch_gets_the_whole_rotation() {
+        let plane = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.5, 0.2, 0.0],
+        ];
+        let (c, s) = (0.6f64.cos(), 0.6f64.sin());
+        let h = [1.0, 0.0, 0.0, 0.3, 0.0, c, -s, 0.1, 0.0, s, c, -0.2];
+        let got = AffineSolver::new(&plane, 1e-3).solve(plane.iter().map(|&p| apply(&h, p)));
+        for (g, w) in got.iter().zip(&h) {
+            assert!((g - w).abs() < 1e-2, "{got:?}");
+        }
     }
 }

@@ -8,6 +8,7 @@
 mod affine;
 mod fit;
 mod predict;
+mod refine;
 mod render;
 mod segment;
 

@@ -1,6 +1,7 @@
 //! Motion-based segmentation (MCGV §3.1): per-vertex affine motion of its k-ring, clustered by k-means.
 
-use super::fit::{apply, AffineCoefficients, AffineSolver, UnitFrame};
+use super::fit::{apply, AffineSolver, UnitFrame};
+use super::refine::{assign_by_trajectory, refine_borders};
 use crate::error::{Error, Result};
 use crate::mesh::topology::{KRingScratch, VertexAdjacency};
 use crate::mesh::{AnimatedMesh, Triangle};
@@ -17,7 +18,7 @@ pub const MIN_CLUSTER_SIZE: usize = 4;
 
 /// Regularisation of the per-vertex fits, relative to the ring's spread: large enough that nearly
 /// flat rings do not turn noise into wild out-of-plane coefficients, small enough not to bias real motion.
-const RING_LAMBDA: f64 = 1e-3;
+pub(super) const RING_LAMBDA: f64 = 1e-3;
 
 /// How to segment.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -120,9 +121,10 @@ impl Partition {
 ///    linear part is weighted by the RMS radius of the shape so both parts measure displacement: a
 ///    change δ of a linear coefficient moves a typical vertex by about radius × δ.
 /// 2. k-means (k-means++ seeded by `opts.seed`, one run) is trained on the vertices whose ring moves
-///    affinely (ring misfit ≤ 4 × median); every vertex then takes its nearest centroid. Rings
-///    straddling differently moving parts give far-off descriptors that would otherwise draw
-///    centroids away from the parts; those vertices take the cluster whose affine maps predict their
+///    affinely (ring misfit ≤ 4 × median) and is not degenerate (flat, on a line); every vertex
+///    then takes its nearest centroid. Rings straddling differently moving parts give far-off
+///    descriptors that would otherwise draw centroids away from the parts, and degenerate rings
+///    give partly guessed ones; those vertices take the cluster whose affine maps predict their
 ///    trajectory best instead.
 /// 3. `opts.refine_passes` passes move cluster borders to lower the prediction error (see
 ///    [`SegmentOptions::refine_passes`]).
@@ -145,7 +147,7 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
         return Partition::from_labels(vec![0; v_count], 1);
     }
     let sampled = SampledMotion::new(mesh, opts.feature_frames);
-    let adjacency = welded_adjacency(mesh);
+    let adjacency = welded_adjacency(mesh, &sampled);
     let (features, misfit) = motion_features(&adjacency, &sampled, opts.ring);
     let inliers = affine_rings(&misfit);
     let training = if inliers.len() >= k {
@@ -177,28 +179,50 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     compact(labels)
 }
 
-/// The mesh's vertex adjacency, plus an edge between vertices at the very same frame-0 position.
-/// Exporters split vertices along UV and normal seams (glTF meshes often fall into dozens of
-/// pieces, a triangle soup at worst); the copies move together, and without these edges their
-/// rings would stop at every seam, down to a lone flat triangle.
-fn welded_adjacency(mesh: &AnimatedMesh) -> VertexAdjacency {
-    let mut first_at = std::collections::HashMap::new();
-    let mut edges: Vec<Triangle> = mesh.triangles().to_vec();
+/// Most copies of one position that are welded: seams make a few; more is collapsed geometry
+/// (e.g. hidden parts parked at one point), and welding it would join unrelated parts through one hub.
+const MAX_WELD_GROUP: usize = 8;
+
+/// The mesh's vertex adjacency, plus an edge between vertices at the very same frame-0 position
+/// that stay together (within float noise) in every sampled frame. Exporters split vertices along
+/// UV and normal seams (glTF meshes often fall into dozens of pieces, a triangle soup at worst);
+/// without these edges the rings would stop at every seam, down to a lone flat triangle.
+fn welded_adjacency(mesh: &AnimatedMesh, motion: &SampledMotion) -> VertexAdjacency {
+    let mut groups: std::collections::HashMap<[u32; 3], Vec<u32>> =
+        std::collections::HashMap::new();
     for (v, p) in mesh.frame(0).iter().enumerate() {
-        let key = p.map(f32::to_bits);
-        let first = *first_at.entry(key).or_insert(v as u32);
-        if first != v as u32 {
-            // A degenerate triangle contributes just the edge (first, v).
-            edges.push([first, v as u32, v as u32]);
+        groups
+            .entry(p.map(f32::to_bits))
+            .or_default()
+            .push(v as u32);
+    }
+    let together = |a: u32, b: u32| {
+        motion.frames.iter().all(|f| {
+            let (p, q) = (f[a as usize], f[b as usize]);
+            (0..3).all(|i| (p[i] - q[i]).abs() <= 1e-6)
+        })
+    };
+    let mut edges: Vec<Triangle> = mesh.triangles().to_vec();
+    for group in groups
+        .values()
+        .filter(|g| (2..=MAX_WELD_GROUP).contains(&g.len()))
+    {
+        for &v in &group[1..] {
+            if together(group[0], v) {
+                // A degenerate triangle contributes just the edge.
+                edges.push([group[0], v, v]);
+            }
         }
     }
     VertexAdjacency::new(mesh.vertex_count(), &edges)
 }
 
 /// Frame 0 and the sampled frames of an animation, in the unit frame of frame 0.
-struct SampledMotion {
-    rest: Vec<[f64; 3]>,
-    frames: Vec<Vec<[f64; 3]>>,
+pub(super) struct SampledMotion {
+    /// Frame 0.
+    pub(super) rest: Vec<[f64; 3]>,
+    /// The sampled frames.
+    pub(super) frames: Vec<Vec<[f64; 3]>>,
 }
 
 impl SampledMotion {
@@ -227,148 +251,6 @@ fn affine_rings(misfit: &[f32]) -> Vec<usize> {
     (0..misfit.len())
         .filter(|&v| misfit[v] <= threshold)
         .collect()
-}
-
-/// Per cluster, the affine maps (eq. 2) of its `members` over the sampled frames; `None` when empty.
-fn cluster_tracks(
-    members: &[Vec<usize>],
-    motion: &SampledMotion,
-) -> Vec<Option<Vec<AffineCoefficients>>> {
-    members
-        .par_iter()
-        .map(|m| {
-            if m.is_empty() {
-                return None;
-            }
-            let source: Vec<[f64; 3]> = m.iter().map(|&v| motion.rest[v]).collect();
-            let solver = AffineSolver::new(&source, RING_LAMBDA);
-            Some(
-                motion
-                    .frames
-                    .iter()
-                    .map(|f| solver.solve(m.iter().map(|&v| f[v])))
-                    .collect(),
-            )
-        })
-        .collect()
-}
-
-/// Squared error of predicting vertex `v`'s sampled trajectory with `track`; infinite for no track.
-fn trajectory_cost(
-    track: Option<&Vec<AffineCoefficients>>,
-    motion: &SampledMotion,
-    v: usize,
-) -> f64 {
-    let Some(track) = track else {
-        return f64::INFINITY;
-    };
-    track
-        .iter()
-        .zip(&motion.frames)
-        .map(|(h, f)| {
-            let q = apply(h, motion.rest[v]);
-            (0..3).map(|a| (q[a] - f[v][a]).powi(2)).sum::<f64>()
-        })
-        .sum()
-}
-
-fn group(labels: &[usize], vertices: impl Iterator<Item = usize>, k: usize) -> Vec<Vec<usize>> {
-    let mut members = vec![Vec::new(); k];
-    for v in vertices {
-        if let Some(m) = members.get_mut(labels[v]) {
-            m.push(v);
-        }
-    }
-    members
-}
-
-/// Gives each vertex outside `inliers` the cluster whose affine maps (fitted on that cluster's
-/// inliers, eq. 2) predict its sampled trajectory best: the criterion the predictor will be judged by.
-fn assign_by_trajectory(labels: &mut [usize], inliers: &[usize], motion: &SampledMotion, k: usize) {
-    let tracks = cluster_tracks(&group(labels, inliers.iter().copied(), k), motion);
-    let mut is_inlier = vec![false; labels.len()];
-    inliers.iter().for_each(|&v| is_inlier[v] = true);
-    labels
-        .par_iter_mut()
-        .enumerate()
-        .filter(|(v, _)| !is_inlier[*v])
-        .for_each(|(v, label)| {
-            if let Some((best, _)) = (0..k)
-                .map(|c| (c, trajectory_cost(tracks[c].as_ref(), motion, v)))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-            {
-                *label = best;
-            }
-        });
-}
-
-/// Moves cluster borders to lower the prediction error, keeping clusters spatially coherent: a
-/// vertex may only join a cluster one of its neighbours is in, and a connected component lying
-/// wholly in one cluster may move as a whole to any cluster.
-fn refine_borders(
-    labels: &mut Vec<usize>,
-    adjacency: &VertexAdjacency,
-    motion: &SampledMotion,
-    k: usize,
-    passes: usize,
-) {
-    let (component, component_count) = adjacency.components();
-    for _ in 0..passes {
-        let tracks = cluster_tracks(&group(labels, 0..labels.len(), k), motion);
-        let current: &[usize] = labels;
-        let mut next: Vec<usize> = (0..current.len())
-            .into_par_iter()
-            .map(|v| {
-                let own = current[v];
-                let mut best = (own, trajectory_cost(tracks[own].as_ref(), motion, v));
-                for &u in adjacency.neighbours(v) {
-                    let c = current[u as usize];
-                    if c != best.0 {
-                        let cost = trajectory_cost(tracks[c].as_ref(), motion, v);
-                        if cost < best.1 {
-                            best = (c, cost);
-                        }
-                    }
-                }
-                best.0
-            })
-            .collect();
-        let mut single = vec![Some(usize::MAX); component_count];
-        for (v, &c) in component.iter().enumerate() {
-            let s = &mut single[c as usize];
-            *s = match *s {
-                Some(usize::MAX) => Some(next[v]),
-                Some(l) if l == next[v] => Some(l),
-                _ => None,
-            };
-        }
-        let members = group(
-            &component.iter().map(|&c| c as usize).collect::<Vec<_>>(),
-            0..labels.len(),
-            component_count,
-        );
-        for (c, vertices) in members.iter().enumerate() {
-            if single[c].is_none() || vertices.is_empty() {
-                continue;
-            }
-            let best = (0..k)
-                .map(|l| {
-                    let cost: f64 = vertices
-                        .iter()
-                        .map(|&v| trajectory_cost(tracks[l].as_ref(), motion, v))
-                        .sum();
-                    (l, cost)
-                })
-                .min_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some((l, _)) = best {
-                vertices.iter().for_each(|&v| next[v] = l);
-            }
-        }
-        if next == *labels {
-            break;
-        }
-        *labels = next;
-    }
 }
 
 /// The per-vertex motion descriptors α^v (one row per vertex, 12 per sampled frame) and how far each
@@ -417,7 +299,13 @@ fn motion_features(
                     }
                 }
                 let samples = (ring.len() * motion.frames.len()).max(1);
-                *misfit = (error / samples as f64).sqrt() as f32;
+                // A degenerate ring's descriptor is partly the regulariser's guess: keep it out of
+                // k-means training like a torn ring, and let its trajectory decide its cluster.
+                *misfit = if solver.is_degenerate() {
+                    f32::INFINITY
+                } else {
+                    (error / samples as f64).sqrt() as f32
+                };
             },
         );
     // The shape is (V, dim) by construction.
