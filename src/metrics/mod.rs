@@ -11,7 +11,8 @@ pub mod surface;
 pub mod triangle;
 
 pub use surface::{
-    frame_distance, frame_distance_cached, FrameDistance, IndexCache, OneSided, Surface,
+    frame_distance, frame_distance_planned, FrameDistance, IndexCache, OneSided, Surface,
+    SurfacePlans,
 };
 
 use crate::error::{Error, Result};
@@ -84,10 +85,22 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
         ));
     }
     let spacing = sampling::sample_spacing(diagonal);
+    // Sampled where each mesh's first frame says, so that every frame is measured alike.
+    let plans = SurfacePlans::new(
+        Surface {
+            triangles: original.triangles(),
+            positions: original.frame(0),
+        },
+        Surface {
+            triangles: decoded.triangles(),
+            positions: decoded.frame(0),
+        },
+        spacing,
+    );
     let per_frame: Vec<FrameDistance> = (0..frames)
         .into_par_iter()
         .map_init(IndexCache::default, |cache, f| {
-            frame_distance_cached(
+            frame_distance_planned(
                 Surface {
                     triangles: original.triangles(),
                     positions: original.frame(f),
@@ -96,7 +109,7 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
                     triangles: decoded.triangles(),
                     positions: decoded.frame(f),
                 },
-                spacing,
+                &plans,
                 cache,
             )
             .map_err(|e| match e {

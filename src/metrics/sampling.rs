@@ -72,25 +72,24 @@ enum Shared {
     Edge(u32, u32, usize, usize),
 }
 
-/// Accumulates samples, merging those at shared points.
-struct Samples {
-    list: Vec<Sample>,
-    shared: FxHashMap<Shared, usize>,
+/// One planned sample: where on which face, and which faces' areas make up its weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Planned {
+    face: u32,
+    bary: [f64; 3],
+    /// Range in [`SamplingPlan::shares`].
+    shares: (u32, u32),
 }
 
-impl Samples {
-    fn add(&mut self, key: Option<Shared>, sample: Sample) {
-        if let Some(&i) = key.as_ref().and_then(|k| self.shared.get(k)) {
-            if let Some(s) = self.list.get_mut(i) {
-                s.weight += sample.weight;
-                return;
-            }
-        }
-        if let Some(k) = key {
-            self.shared.insert(k, self.list.len());
-        }
-        self.list.push(sample);
-    }
+/// Where a surface is sampled, fixed once for every frame of an animation: per sample a face,
+/// barycentric coordinates, and the fractions of the faces' areas it stands for. Making the plan
+/// (the subdivision levels, the merging of shared points) is the costly part of sampling; applying
+/// it to a frame is a few multiply-adds per sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SamplingPlan {
+    samples: Vec<Planned>,
+    /// (face, fraction of its area).
+    shares: Vec<(u32, f64)>,
 }
 
 /// 7-point rule weights, as fractions of a sub-triangle's area.
@@ -98,89 +97,156 @@ const CORNER: f64 = 1.0 / 20.0;
 const MIDPOINT: f64 = 2.0 / 15.0;
 const CENTROID: f64 = 9.0 / 20.0;
 
-/// Samples the surface of `triangles` at `positions` with the given `spacing`; the weights sum to
-/// the total area.
-pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64) -> Vec<Sample> {
-    let mut out = Samples {
-        list: Vec::with_capacity(3 * triangles.len() + positions.len()),
-        shared: FxHashMap::default(),
-    };
-    out.shared.reserve(2 * triangles.len() + positions.len());
-    for (f, t) in triangles.iter().enumerate() {
-        let c = [
-            position(positions, t[0]),
-            position(positions, t[1]),
-            position(positions, t[2]),
-        ];
-        let area = triangle_area(c[0], c[1], c[2]);
-        let n = level(longest_edge(&c), spacing);
-        let m = 2 * n;
-        let sub_area = area / (n * n) as f64;
-        let at = |u: f64, v: f64, w: f64| -> Vec3 {
-            let mut p = [0.0; 3];
-            for (a, x) in p.iter_mut().enumerate() {
-                *x = u * c[0][a] + v * c[1][a] + w * c[2][a];
-            }
-            p
-        };
-        // Corners and edge midpoints of the sub-triangles: the lattice of step 1/(2n).
-        for i in 0..=m {
-            for j in 0..=(m - i) {
-                let k = m - i - j;
-                let zeros = [i, j, k].iter().filter(|&&x| x == 0).count();
-                let corner = i % 2 == 0 && j % 2 == 0 && k % 2 == 0;
-                // Sub-triangles meeting at a corner: 1 at a face corner, 3 on a face edge, 6 inside;
-                // sharing a midpoint: 1 on a face edge, 2 inside.
-                let weight = match (corner, zeros) {
-                    (true, 2) => CORNER,
-                    (true, 1) => 3.0 * CORNER,
-                    (true, _) => 6.0 * CORNER,
-                    (false, 1) => MIDPOINT,
-                    (false, _) => 2.0 * MIDPOINT,
-                } * sub_area;
-                let key = match (i, j, k) {
-                    (_, 0, 0) => Some(Shared::Vertex(t[0])),
-                    (0, _, 0) => Some(Shared::Vertex(t[1])),
-                    (0, 0, _) => Some(Shared::Vertex(t[2])),
-                    (0, _, _) => Some(edge_key(t[1], j, t[2], k, m)),
-                    (_, 0, _) => Some(edge_key(t[0], i, t[2], k, m)),
-                    (_, _, 0) => Some(edge_key(t[0], i, t[1], j, m)),
-                    _ => None,
-                };
-                let (u, v, w) = (
-                    i as f64 / m as f64,
-                    j as f64 / m as f64,
-                    k as f64 / m as f64,
-                );
-                out.add(
-                    key,
-                    Sample {
-                        point: at(u, v, w),
-                        weight,
-                        face: f as u32,
-                    },
-                );
-            }
-        }
-        // Centroids of the upward (corner sum n − 1) and downward (n − 2) sub-triangles.
-        let nf = n as f64;
-        let upward = (n - 1, 1.0 / 3.0);
-        let downward = n.checked_sub(2).map(|sum| (sum, 2.0 / 3.0));
-        for (sum, shift) in std::iter::once(upward).chain(downward) {
-            for i in 0..=sum {
-                for j in 0..=(sum - i) {
-                    let k = sum - i - j;
-                    let b = [i, j, k].map(|x| (x as f64 + shift) / nf);
-                    out.list.push(Sample {
-                        point: at(b[0], b[1], b[2]),
-                        weight: CENTROID * sub_area,
-                        face: f as u32,
+impl SamplingPlan {
+    /// Plans the samples of `triangles`, choosing each face's subdivision from its size at
+    /// `positions` (the reference frame) and the `spacing`.
+    pub fn new(triangles: &[Triangle], positions: &[Point], spacing: f64) -> Self {
+        let mut samples: Vec<Planned> = Vec::with_capacity(4 * triangles.len());
+        let mut shares: Vec<Vec<(u32, f64)>> = Vec::with_capacity(4 * triangles.len());
+        let mut shared: FxHashMap<Shared, usize> = FxHashMap::default();
+        shared.reserve(2 * triangles.len() + positions.len());
+        for (f, t) in triangles.iter().enumerate() {
+            let c = [
+                position(positions, t[0]),
+                position(positions, t[1]),
+                position(positions, t[2]),
+            ];
+            let n = level(longest_edge(&c), spacing);
+            let m = 2 * n;
+            let sub = 1.0 / (n * n) as f64;
+            let face = f as u32;
+            // Corners and edge midpoints of the sub-triangles: the lattice of step 1/(2n).
+            for i in 0..=m {
+                for j in 0..=(m - i) {
+                    let k = m - i - j;
+                    let zeros = [i, j, k].iter().filter(|&&x| x == 0).count();
+                    let corner = i % 2 == 0 && j % 2 == 0 && k % 2 == 0;
+                    // Sub-triangles meeting at a corner: 1 at a face corner, 3 on a face edge,
+                    // 6 inside; sharing a midpoint: 1 on a face edge, 2 inside.
+                    let fraction = match (corner, zeros) {
+                        (true, 2) => CORNER,
+                        (true, 1) => 3.0 * CORNER,
+                        (true, _) => 6.0 * CORNER,
+                        (false, 1) => MIDPOINT,
+                        (false, _) => 2.0 * MIDPOINT,
+                    } * sub;
+                    let key = match (i, j, k) {
+                        (_, 0, 0) => Some(Shared::Vertex(t[0])),
+                        (0, _, 0) => Some(Shared::Vertex(t[1])),
+                        (0, 0, _) => Some(Shared::Vertex(t[2])),
+                        (0, _, _) => Some(edge_key(t[1], j, t[2], k, m)),
+                        (_, 0, _) => Some(edge_key(t[0], i, t[2], k, m)),
+                        (_, _, 0) => Some(edge_key(t[0], i, t[1], j, m)),
+                        _ => None,
+                    };
+                    if let Some(list) = key
+                        .as_ref()
+                        .and_then(|k| shared.get(k))
+                        .and_then(|&s| shares.get_mut(s))
+                    {
+                        list.push((face, fraction));
+                        continue;
+                    }
+                    if let Some(key) = key {
+                        shared.insert(key, samples.len());
+                    }
+                    let bary = [i, j, k].map(|x| x as f64 / m as f64);
+                    samples.push(Planned {
+                        face,
+                        bary,
+                        shares: (0, 0),
                     });
+                    shares.push(vec![(face, fraction)]);
+                }
+            }
+            // Centroids of the upward (corner sum n − 1) and downward (n − 2) sub-triangles.
+            let nf = n as f64;
+            let upward = (n - 1, 1.0 / 3.0);
+            let downward = n.checked_sub(2).map(|sum| (sum, 2.0 / 3.0));
+            for (sum, shift) in std::iter::once(upward).chain(downward) {
+                for i in 0..=sum {
+                    for j in 0..=(sum - i) {
+                        let k = sum - i - j;
+                        samples.push(Planned {
+                            face,
+                            bary: [i, j, k].map(|x| (x as f64 + shift) / nf),
+                            shares: (0, 0),
+                        });
+                        shares.push(vec![(face, CENTROID * sub)]);
+                    }
                 }
             }
         }
+        let mut flat = Vec::with_capacity(shares.iter().map(Vec::len).sum());
+        for (s, list) in samples.iter_mut().zip(&shares) {
+            let start = flat.len() as u32;
+            flat.extend_from_slice(list);
+            s.shares = (start, flat.len() as u32);
+        }
+        Self {
+            samples,
+            shares: flat,
+        }
     }
-    out.list
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// True when the surface has no faces.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// The samples of `triangles` (those the plan was made for) at `positions`, into `out`;
+    /// the weights sum to the frame's total area.
+    pub fn apply(&self, triangles: &[Triangle], positions: &[Point], out: &mut Vec<Sample>) {
+        let corners = |f: u32| -> [Vec3; 3] {
+            triangles.get(f as usize).map_or([[0.0; 3]; 3], |t| {
+                [
+                    position(positions, t[0]),
+                    position(positions, t[1]),
+                    position(positions, t[2]),
+                ]
+            })
+        };
+        let areas: Vec<f64> = (0..triangles.len() as u32)
+            .map(|f| {
+                let c = corners(f);
+                triangle_area(c[0], c[1], c[2])
+            })
+            .collect();
+        out.clear();
+        out.extend(self.samples.iter().map(|s| {
+            let c = corners(s.face);
+            let mut point = [0.0; 3];
+            for (a, x) in point.iter_mut().enumerate() {
+                *x = s.bary[0] * c[0][a] + s.bary[1] * c[1][a] + s.bary[2] * c[2][a];
+            }
+            let shares = self
+                .shares
+                .get(s.shares.0 as usize..s.shares.1 as usize)
+                .unwrap_or(&[]);
+            let weight = shares
+                .iter()
+                .map(|&(f, fraction)| fraction * areas.get(f as usize).copied().unwrap_or(0.0))
+                .sum();
+            Sample {
+                point,
+                weight,
+                face: s.face,
+            }
+        }));
+    }
+}
+
+/// Samples the surface of `triangles` at `positions` with the given `spacing`; the weights sum to
+/// the total area. (A plan made and applied at once; see [`SamplingPlan`] to reuse one.)
+pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64) -> Vec<Sample> {
+    let mut out = Vec::new();
+    SamplingPlan::new(triangles, positions, spacing).apply(triangles, positions, &mut out);
+    out
 }
 
 /// The key of a lattice point on the edge between vertices `a` (lattice weight `wa`) and `b`.

@@ -2,7 +2,7 @@
 //! each sample's exact distance to the other surface, take the area-weighted RMS and the maximum.
 
 use super::bvh::{Nearest, TriangleBvh};
-use super::sampling::sample_surface;
+use super::sampling::{Sample, SamplingPlan};
 use super::triangle::Vec3;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
@@ -53,20 +53,19 @@ pub struct Surface<'a> {
     pub positions: &'a [Point],
 }
 
-/// Distance from surface `a` to the surface indexed by `b`, sampling `a` with `spacing`
-/// (see [`super::sampling::sample_spacing`]). `same_triangles` says that `a`'s face `i` corresponds
-/// to `b`'s face `i` (shared connectivity), which makes it the first candidate for samples on face `i`.
+/// Distance from surface `a`, sampled at `samples` (see [`SamplingPlan::apply`]), to the surface
+/// indexed by `b`. `same_triangles` says that `a`'s face `i` corresponds to `b`'s face `i` (shared
+/// connectivity), which makes it the first candidate for samples on face `i`.
 pub fn one_sided(
+    samples: &[Sample],
     a: Surface<'_>,
     b: &TriangleBvh,
-    spacing: f64,
     same_triangles: bool,
 ) -> Result<OneSided> {
-    let samples = sample_surface(a.triangles, a.positions, spacing);
     let (mut area, mut sum, mut sum_sq, mut max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut last = None;
     let mut stack = Vec::new();
-    for s in &samples {
+    for s in samples {
         // The same-numbered face is right when the surfaces barely differ; the previous sample's
         // answer when they differ a lot (a neighbouring sample has a neighbouring answer).
         let same_face = if same_triangles { Some(s.face) } else { None };
@@ -122,13 +121,15 @@ pub fn index_surface(s: Surface<'_>, which: &str) -> Result<TriangleBvh> {
     })
 }
 
-/// Nearest-triangle indexes kept from one frame to the next: a later frame refits the trees
-/// instead of building them anew. Any surfaces may be passed (a tree is rebuilt when the triangle
-/// count changes); answers stay exact, only speed depends on the frames sharing triangles.
+/// Nearest-triangle indexes and a sample buffer kept from one frame to the next: a later frame
+/// refits the trees instead of building them anew. Any surfaces may be passed (a tree is rebuilt
+/// when the triangle count changes); answers stay exact, only speed depends on the frames sharing
+/// triangles.
 #[derive(Debug, Clone, Default)]
 pub struct IndexCache {
     first: Option<TriangleBvh>,
     second: Option<TriangleBvh>,
+    samples: Vec<Sample>,
 }
 
 fn refit_or_build<'c>(
@@ -146,25 +147,52 @@ fn refit_or_build<'c>(
         .ok_or_else(|| Error::Mesh(format!("the {which} mesh could not be indexed")))
 }
 
-/// Both one-sided distances between surfaces `a` and `b` of one frame, each sampled with `spacing`.
-pub fn frame_distance(a: Surface<'_>, b: Surface<'_>, spacing: f64) -> Result<FrameDistance> {
-    frame_distance_cached(a, b, spacing, &mut IndexCache::default())
+/// Where both surfaces of a comparison are sampled, fixed for all frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfacePlans {
+    /// The first (original) surface's plan.
+    pub first: SamplingPlan,
+    /// The second surface's plan.
+    pub second: SamplingPlan,
 }
 
-/// [`frame_distance`], reusing (and updating) the trees in `cache` from an earlier frame.
-pub fn frame_distance_cached(
+impl SurfacePlans {
+    /// Plans both surfaces from their reference frames `a` and `b` with the sample `spacing`
+    /// (see [`super::sampling::sample_spacing`]).
+    pub fn new(a: Surface<'_>, b: Surface<'_>, spacing: f64) -> Self {
+        Self {
+            first: SamplingPlan::new(a.triangles, a.positions, spacing),
+            second: SamplingPlan::new(b.triangles, b.positions, spacing),
+        }
+    }
+}
+
+/// Both one-sided distances between surfaces `a` and `b` of one frame, each sampled with `spacing`.
+pub fn frame_distance(a: Surface<'_>, b: Surface<'_>, spacing: f64) -> Result<FrameDistance> {
+    let plans = SurfacePlans::new(a, b, spacing);
+    frame_distance_planned(a, b, &plans, &mut IndexCache::default())
+}
+
+/// [`frame_distance`] with sampling fixed by `plans` (made for these triangles), reusing and
+/// updating the trees in `cache` from an earlier frame.
+pub fn frame_distance_planned(
     a: Surface<'_>,
     b: Surface<'_>,
-    spacing: f64,
+    plans: &SurfacePlans,
     cache: &mut IndexCache,
 ) -> Result<FrameDistance> {
     let same = a.triangles == b.triangles;
     let a_index = refit_or_build(&mut cache.first, a, "first")?;
     let b_index = refit_or_build(&mut cache.second, b, "second")?;
-    Ok(FrameDistance {
-        forward: one_sided(a, b_index, spacing, same)?,
-        backward: one_sided(b, a_index, spacing, same)?,
-    })
+    plans
+        .first
+        .apply(a.triangles, a.positions, &mut cache.samples);
+    let forward = one_sided(&cache.samples, a, b_index, same)?;
+    plans
+        .second
+        .apply(b.triangles, b.positions, &mut cache.samples);
+    let backward = one_sided(&cache.samples, b, a_index, same)?;
+    Ok(FrameDistance { forward, backward })
 }
 
 #[cfg(test)]
