@@ -126,7 +126,7 @@ fn jpeg_frame_decodes_alone_when_every_other_frame_is_destroyed() {
     // Overwrite every byte of every other frame's chunk.
     let reader = ContainerReader::new(Cursor::new(bytes.clone())).unwrap();
     let images = reader.entry(Tag::FRAMES).unwrap();
-    let mut dec = decoder(bytes.clone()).unwrap();
+    let dec = decoder(bytes.clone()).unwrap();
     let frames = dec.header().frames as usize;
     let mut damaged = bytes;
     let mut offsets = Vec::new();
