@@ -1,0 +1,231 @@
+//! The encode / decode / inspect / eval commands through the binary, as a user runs them.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
+}
+
+fn media(name: &str) -> String {
+    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    serde_json::from_str(ok(out).trim()).expect("one JSON object")
+}
+
+#[test]
+fn encode_inspect_decode_eval_a_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let stream = dir.path().join("fig.mcgv");
+    let s = stream.to_str().unwrap();
+    let sample = media("RiggedFigure.glb");
+    let enc = json(&run(&[
+        "encode", &sample, "-o", s, "--codec", "mpeg4", "--quiet", "--json",
+    ]));
+    assert_eq!(enc["vertices"], 370);
+
+    let info = json(&run(&["inspect", s, "--json"]));
+    for key in [
+        "vertices",
+        "frames",
+        "codec",
+        "clusters",
+        "charts",
+        "lattice",
+        "packing_efficiency",
+        "bpvf",
+        "parts",
+    ] {
+        assert!(
+            info.get(key).is_some(),
+            "inspect --json lacks {key}: {info}"
+        );
+    }
+    assert_eq!(info["codec"], "mpeg4");
+    let bits: u64 = info["parts"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(
+        bits,
+        8 * std::fs::metadata(&stream).unwrap().len(),
+        "parts add up to the file"
+    );
+
+    let frames = dir.path().join("frames");
+    ok(&run(&[
+        "decode",
+        s,
+        "-o",
+        frames.to_str().unwrap(),
+        "--quiet",
+    ]));
+    assert!(frames.join("frame_0000.obj").exists() && frames.join("frame_0037.obj").exists());
+    let one = dir.path().join("one");
+    ok(&run(&[
+        "decode",
+        s,
+        "-o",
+        one.to_str().unwrap(),
+        "--frame",
+        "5",
+        "--quiet",
+    ]));
+    assert_eq!(
+        std::fs::read(one.join("frame_0005.obj")).unwrap(),
+        std::fs::read(frames.join("frame_0005.obj")).unwrap(),
+        "a frame decoded alone equals the same frame of the full decode"
+    );
+
+    let m = json(&run(&["eval", &sample, s, "--json", "--quiet"]));
+    assert!(m["rmse"].as_f64().unwrap() < 1e-3, "{m}");
+    assert!((m["bpvf"].as_f64().unwrap() - info["bpvf"].as_f64().unwrap()).abs() < 1e-9);
+    let same = json(&run(&["eval", &sample, frames.to_str().unwrap(), "--json"]));
+    assert!(
+        (same["rmse"].as_f64().unwrap() - m["rmse"].as_f64().unwrap()).abs() < 1e-6,
+        "{same} vs {m}"
+    );
+}
+
+#[test]
+fn inspect_writes_pngs_a_user_can_open() {
+    let dir = tempfile::tempdir().unwrap();
+    let stream = dir.path().join("s.mcgv");
+    let s = stream.to_str().unwrap();
+    let sample = media("RiggedSimple.glb");
+    ok(&run(&[
+        "encode",
+        &sample,
+        "-o",
+        s,
+        "--quiet",
+        "--padding",
+        "cg",
+    ]));
+    let png = dir.path().join("png");
+    let p = png.to_str().unwrap();
+    ok(&run(&[
+        "inspect",
+        s,
+        "--png",
+        p,
+        "--frames",
+        "0,3",
+        "--original",
+        &sample,
+    ]));
+    for name in [
+        "atlas.png",
+        "segmentation.png",
+        "frame_0003_raw.png",
+        "frame_0003_padded.png",
+        "frame_0003_decoded.png",
+    ] {
+        let img = image::open(png.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(
+            img.width() >= 256,
+            "{name} is {}x{}",
+            img.width(),
+            img.height()
+        );
+    }
+}
+
+#[test]
+fn bad_input_and_outputs_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Not a stream.
+    let junk = d.join("junk.mcgv");
+    std::fs::write(&junk, b"this is not a stream").unwrap();
+    let out = run(&[
+        "decode",
+        junk.to_str().unwrap(),
+        "-o",
+        d.join("x").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a .mcgv file"));
+    // A frame that does not exist.
+    let stream = d.join("s.mcgv");
+    let s = stream.to_str().unwrap();
+    ok(&run(&[
+        "encode",
+        &media("RiggedSimple.glb"),
+        "-o",
+        s,
+        "--quiet",
+        "--padding",
+        "cg",
+    ]));
+    let out = run(&[
+        "decode",
+        s,
+        "-o",
+        d.join("y").to_str().unwrap(),
+        "--frame",
+        "9999",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--frame 9999"));
+    // Overwriting the input is refused and the input is untouched.
+    let copy = d.join("in.glb");
+    std::fs::copy(media("RiggedSimple.glb"), &copy).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    let out = run(&[
+        "encode",
+        copy.to_str().unwrap(),
+        "-o",
+        copy.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("refusing to overwrite"));
+    assert_eq!(std::fs::read(&copy).unwrap(), before);
+    // An unwritable output leaves nothing behind.
+    let missing = d.join("no/such/dir/out.mcgv");
+    let out = run(&[
+        "encode",
+        &media("RiggedSimple.glb"),
+        "-o",
+        missing.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!Path::new(&missing).exists());
+    // Nonsense options.
+    let out = run(&[
+        "encode",
+        &media("RiggedSimple.glb"),
+        "-o",
+        s,
+        "--lattice",
+        "100x100",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("multiples of 16"));
+    let out = run(&[
+        "encode",
+        &media("RiggedSimple.glb"),
+        "-o",
+        s,
+        "--padding",
+        "magic",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+}
