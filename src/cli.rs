@@ -56,7 +56,7 @@ pub struct EncodeArgs {
     /// Image codec for the residuals.
     #[arg(long, value_enum, default_value_t = CodecChoice::Jpeg)]
     pub codec: CodecChoice,
-    /// Rate knob for every codec, 1..100 (higher = better quality, more bits).
+    /// Rate knob for every codec, 1..100 (higher = better quality, more bits; default 50).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
     pub quality: Option<u8>,
     /// MPEG-4 quantiser 1..31 (lower = better); overrides --quality for mpeg4.

@@ -171,8 +171,12 @@ impl<R: Read + Seek> Decoder<R> {
     }
 
     fn jpeg_plane(&mut self, f: usize) -> Result<Plane> {
-        let scan = self.frame_bytes(f)?;
-        let bytes = abbreviated::join(&self.codec_setup, &scan);
+        let chunk = self.frame_bytes(f)?;
+        let mut r = ByteReader::new(&chunk, "JPEG frame");
+        let tables = r.blob()?;
+        let scan = r.take(r.remaining())?;
+        let bytes = abbreviated::join(&self.codec_setup, tables, scan)
+            .map_err(|e| Error::Stream(format!("frame {f}: {e}")))?;
         let (w, h) = self.picture_size();
         jpeg::decode(&bytes, w, h).map_err(|e| Error::Stream(format!("frame {f}: {e}")))
     }
