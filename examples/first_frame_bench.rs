@@ -34,34 +34,10 @@ fn read_obj(path: &Path) -> Result<(Vec<Point>, Vec<Triangle>)> {
     Ok((positions, triangles))
 }
 
-/// Bind-pose positions and triangles of every triangle primitive in a glTF file, concatenated.
+/// Frame 0 and the triangles of a glTF file, through the project's reader.
 fn read_gltf(path: &Path) -> Result<(Vec<Point>, Vec<Triangle>)> {
-    let (doc, buffers, _) =
-        gltf::import(path).map_err(|e| Error::Mesh(format!("{}: {e}", path.display())))?;
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for mesh in doc.meshes() {
-        for prim in mesh.primitives() {
-            if prim.mode() != gltf::mesh::Mode::Triangles {
-                continue;
-            }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let Some(pos) = reader.read_positions() else {
-                continue;
-            };
-            let base = positions.len() as u32;
-            positions.extend(pos);
-            let count = positions.len() as u32 - base;
-            let idx: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..count).collect(),
-            };
-            triangles.extend(
-                idx.chunks_exact(3)
-                    .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
-            );
-        }
-    }
-    Ok((positions, triangles))
+    let mesh = mcgv_video::mesh::read_animation(&path.to_string_lossy(), &Default::default())?;
+    Ok((mesh.frame(0).to_vec(), mesh.triangles().to_vec()))
 }
 
 fn dump(dir: &Path, name: &str, positions: &[Point], triangles: &[Triangle]) -> Result<()> {

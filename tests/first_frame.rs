@@ -322,35 +322,10 @@ proptest! {
     }
 }
 
-/// Bind-pose positions and triangles of every triangle primitive of a glTF sample, concatenated
-/// (read with `gltf` directly until the project's reader is used here).
+/// Frame 0 and the triangles of a glTF sample, through the project's reader.
 fn gltf_mesh(path: &str) -> (Vec<Point>, Vec<Triangle>) {
-    let (doc, buffers, _) = gltf::import(path).unwrap();
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for prim in doc
-        .meshes()
-        .flat_map(|m| m.primitives().collect::<Vec<_>>())
-    {
-        if prim.mode() != gltf::mesh::Mode::Triangles {
-            continue;
-        }
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-        let Some(pos) = reader.read_positions() else {
-            continue;
-        };
-        let base = positions.len() as u32;
-        positions.extend(pos);
-        let count = positions.len() as u32 - base;
-        let idx: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..count).collect(),
-        };
-        triangles.extend(
-            idx.chunks_exact(3)
-                .map(|c| [c[0] + base, c[1] + base, c[2] + base]),
-        );
-    }
-    (positions, triangles)
+    let mesh = mcgv_video::mesh::read_animation(path, &Default::default()).unwrap();
+    (mesh.frame(0).to_vec(), mesh.triangles().to_vec())
 }
 
 #[test]
