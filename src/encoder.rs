@@ -76,6 +76,8 @@ pub struct EncodeReport {
     pub packing_efficiency: f64,
     /// Vertices moved to resolve lattice collisions.
     pub moved_vertices: usize,
+    /// Area-weighted L2 stretch of the charts (1 = none).
+    pub l2_stretch: f64,
     /// Seconds per stage.
     pub stage_seconds: Vec<(String, f64)>,
     /// If the first-frame coder reordered vertices: new index → input index.
@@ -215,6 +217,7 @@ pub fn encode(
         charts: stats.charts,
         packing_efficiency: stats.packing_efficiency,
         moved_vertices: stats.moved_vertices,
+        l2_stretch: stats.l2_stretch,
         stage_seconds: seconds,
         permutation: ff.permutation,
     };
