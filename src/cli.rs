@@ -164,6 +164,11 @@ pub struct InfoArgs {
 /// Runs the CLI and returns the process exit code: 0 on success, 1 on error (message on stderr),
 /// 2 on a usage error (clap's own).
 pub fn main() -> i32 {
+    // A panic anywhere (a dependency's bug, caught where it can be) is reported in one line, like
+    // every other error, instead of a backtrace.
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("mcgv-video: internal error: {info}");
+    }));
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

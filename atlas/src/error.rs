@@ -60,6 +60,9 @@ pub enum AtlasError {
     /// The unwrapping library refused the mesh.
     #[error("parameterization failed: {0}")]
     Unwrap(#[from] uvunwrap::Error),
+    /// The unwrapping library failed internally (a bug there, caught so it is an error here).
+    #[error("the UV unwrapper failed internally: {0}")]
+    UnwrapPanicked(String),
     /// A per-vertex array does not match the atlas.
     #[error("{what}: expected {expected} values, got {got}")]
     Length {

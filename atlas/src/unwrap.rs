@@ -47,7 +47,20 @@ fn flatten_once(
         packing: uvunwrap::Packing::Fast,
         ..uvunwrap::Options::default()
     };
-    let out = uvunwrap::generate(&[mesh], &options)?;
+    // uvunwrap's sparse Cholesky (faer's AMD ordering) has been seen to index out of bounds on a
+    // large many-part mesh (BrainStem, 34k vertices); a bug in a dependency must still reach the
+    // user as an error, not a crash.
+    let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        uvunwrap::generate(&[mesh], &options)
+    }))
+    .map_err(|payload| {
+        let what = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("unknown failure");
+        AtlasError::UnwrapPanicked(what.to_string())
+    })??;
     let texels = f64::from(out.texels_per_unit);
     let (w, h) = (f64::from(out.width), f64::from(out.height));
     let mesh = out.meshes.first();
