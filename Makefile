@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 CARGO ?= cargo
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PACKAGES := pkg-config clang libclang-dev libavcodec-dev libavformat-dev libavutil-dev \
-	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools
+	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools time
 PY_PACKAGES := pymeshlab DracoPy numpy
 
 .PHONY: help deps apt-deps venv demo test bench fuzz clean
