@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
     )?;
     let analysis = analyse(&mesh, ff.decoded_positions, &opts)?;
-    let (w, h) = (opts.lattice.0 as u32, opts.lattice.1 as u32);
+    let (w, h) = (analysis.lattice.0 as u32, analysis.lattice.1 as u32);
     let mask: Vec<u8> = analysis
         .atlas
         .fixed_mask()

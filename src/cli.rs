@@ -68,8 +68,9 @@ pub struct EncodeArgs {
     /// Bits per quantised affine coefficient.
     #[arg(long, default_value_t = 17)]
     pub affine_bits: u8,
-    /// Geometry-image lattice, WIDTHxHEIGHT (multiples of 8).
-    #[arg(long, default_value = "256x256")]
+    /// Geometry-image lattice: WIDTHxHEIGHT (multiples of 16), or `auto` to size it from the
+    /// vertex count (about 28 pixels per vertex, at most 256x256 unless the charts need more).
+    #[arg(long, default_value = "auto")]
     pub lattice: String,
     /// How free pixels of the geometry images are filled.
     #[arg(long)]

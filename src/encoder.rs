@@ -27,8 +27,8 @@ pub struct EncodeOptions {
     pub affine_bits: u8,
     /// Bits per coordinate of the first frame.
     pub first_frame_bits: u8,
-    /// Lattice width and height.
-    pub lattice: (u16, u16),
+    /// Lattice width and height, or chosen from the mesh.
+    pub lattice: Lattice,
     /// Padding of the free pixels; `None` picks the codec's measured best (see [`padding_method`]).
     pub padding: Option<padding::Method>,
     /// MPEG-4 group of pictures.
@@ -46,12 +46,38 @@ impl Default for EncodeOptions {
             clusters: 20,
             affine_bits: 17,
             first_frame_bits: 12,
-            lattice: (256, 256),
+            lattice: Lattice::Auto,
             padding: None,
             gop: 50,
             reorder: false,
         }
     }
+}
+
+/// The size of the geometry-image lattice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lattice {
+    /// Sized from the vertex count (see [`auto_side`]), grown until the charts fit.
+    Auto,
+    /// Exactly this width and height.
+    Fixed(u16, u16),
+}
+
+/// Lattice pixels per vertex for `Lattice::Auto`. The papers' sequences (2900–8400 vertices) use
+/// 256×256; a small mesh in that lattice pays for pixels it does not need: RiggedFigure (370
+/// vertices) costs 96 bpvf at 256×256 and 37 bpvf at 96×96 at about the same RMSE, Fox (1728) is
+/// best near 224×224 (encode --lattice WxH, eval; JPEG q30/q75).
+const AUTO_PIXELS_PER_VERTEX: f64 = 28.0;
+
+/// The first lattice side `Lattice::Auto` tries for `vertices`: about
+/// [`AUTO_PIXELS_PER_VERTEX`] pixels per vertex, at least 32, at most the papers' 256.
+pub fn auto_side(vertices: usize) -> u16 {
+    let side = (vertices as f64 * AUTO_PIXELS_PER_VERTEX).sqrt();
+    round_up_16(side).clamp(32, 256)
+}
+
+fn round_up_16(x: f64) -> u16 {
+    ((x / 16.0).ceil() * 16.0).min(4096.0) as u16
 }
 
 /// Default `--quality`: the middle of the useful range. On CesiumMan it gives RMSE 2.6e-4 of the
@@ -101,6 +127,8 @@ pub struct Analysis {
     pub partition: Partition,
     /// The quantised affine predictor.
     pub track: AffineTrack,
+    /// The lattice the atlas was built on.
+    pub lattice: (u16, u16),
     /// The atlas.
     pub atlas: atlas::Atlas,
     /// Residuals per frame and vertex.
@@ -155,8 +183,8 @@ pub fn encode(
         frames: mesh.frame_count() as u32,
         triangles: mesh.triangles().len() as u32,
         clusters: analysis.partition.clusters() as u32,
-        lattice_width: opts.lattice.0,
-        lattice_height: opts.lattice.1,
+        lattice_width: analysis.lattice.0,
+        lattice_height: analysis.lattice.1,
         codec: opts.codec,
         quality: opts.quality,
         qscale: qscale(opts),
@@ -188,7 +216,7 @@ pub fn encode(
         Tag::LATTICE,
         side_info::encode_lattice(
             analysis.atlas.vertex_pixels(),
-            opts.lattice,
+            analysis.lattice,
             mesh.triangles(),
         )?,
         Checksum::Whole,
@@ -233,11 +261,8 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
             "--affine-bits must be between 8 and 32".into(),
         ));
     }
-    let (w, h) = opts.lattice;
-    if w == 0 || h == 0 || w % 16 != 0 || h % 16 != 0 || w > 4096 || h > 4096 {
-        return Err(Error::Usage(format!(
-            "lattice {w}x{h}: width and height must be multiples of 16 between 16 and 4096"
-        )));
+    if let Lattice::Fixed(w, h) = opts.lattice {
+        check_lattice(w, h)?;
     }
     if opts.gop == 0 {
         return Err(Error::Usage("--gop must be at least 1".into()));
@@ -246,6 +271,15 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
         return Err(Error::Mesh(
             "the mesh has no triangles: nothing to parameterize".into(),
         ));
+    }
+    Ok(())
+}
+
+fn check_lattice(w: u16, h: u16) -> Result<()> {
+    if w == 0 || h == 0 || w % 16 != 0 || h % 16 != 0 || w > 4096 || h > 4096 {
+        return Err(Error::Usage(format!(
+            "lattice {w}x{h}: width and height must be multiples of 16 between 16 and 4096"
+        )));
     }
     Ok(())
 }
@@ -284,17 +318,7 @@ pub fn analyse(
         },
     )?;
     let track = AffineTrack::fit(mesh.frames(), &reference, &partition, opts.affine_bits)?;
-    let atlas = atlas::build(
-        &reference,
-        mesh.triangles(),
-        partition.labels(),
-        &atlas::AtlasOptions {
-            width: opts.lattice.0 as u32,
-            height: opts.lattice.1 as u32,
-            ..atlas::AtlasOptions::default()
-        },
-    )
-    .map_err(|e| Error::Usage(format!("atlas: {e}")))?;
+    let (lattice, atlas) = build_atlas(&reference, mesh.triangles(), &partition, opts.lattice)?;
     let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
         .map(|f| {
             Ok(motion::residuals(
@@ -312,10 +336,58 @@ pub fn analyse(
         reference,
         partition,
         track,
+        lattice,
         atlas,
         residuals,
         ranges,
     })
+}
+
+/// Builds the atlas on the requested lattice, or for `Lattice::Auto` on the smallest lattice from
+/// [`auto_side`] upwards on which the charts fit.
+fn build_atlas(
+    reference: &[Point],
+    triangles: &[[u32; 3]],
+    partition: &Partition,
+    lattice: Lattice,
+) -> Result<((u16, u16), atlas::Atlas)> {
+    let build = |w: u16, h: u16| {
+        atlas::build(
+            reference,
+            triangles,
+            partition.labels(),
+            &atlas::AtlasOptions {
+                width: u32::from(w),
+                height: u32::from(h),
+                ..atlas::AtlasOptions::default()
+            },
+        )
+    };
+    let fail = |e: atlas::AtlasError| Error::Usage(format!("atlas: {e}"));
+    let mut side = match lattice {
+        Lattice::Fixed(w, h) => return build(w, h).map(|a| ((w, h), a)).map_err(fail),
+        Lattice::Auto => auto_side(reference.len()),
+    };
+    loop {
+        let next = match build(side, side) {
+            Ok(a) => return Ok(((side, side), a)),
+            Err(atlas::AtlasError::ChartsDoNotFit { blocks, block, .. }) => {
+                // Room for the blocks with some slack, and at least a quarter more each time.
+                let needed = f64::from(block) * (blocks as f64 * 1.3).sqrt();
+                round_up_16(needed.max(f64::from(side) * 1.25))
+            }
+            Err(atlas::AtlasError::TooManyVertices { vertices, .. }) => {
+                round_up_16((vertices as f64 * 2.0).sqrt().max(f64::from(side) * 1.25))
+            }
+            Err(e) => return Err(fail(e)),
+        };
+        if side >= 4096 {
+            return Err(Error::Usage(format!(
+                "atlas: the charts do not fit even a {side}x{side} lattice"
+            )));
+        }
+        side = next;
+    }
 }
 
 /// Frame `f`'s residuals of coordinate `axis` as levels in `0..=255` on the lattice, before padding
@@ -340,7 +412,7 @@ pub fn residual_images(
     opts: &EncodeOptions,
     previous: Option<&[Vec<f32>; 3]>,
 ) -> Result<[Vec<f32>; 3]> {
-    let (w, h) = (opts.lattice.0 as usize, opts.lattice.1 as usize);
+    let (w, h) = (analysis.lattice.0 as usize, analysis.lattice.1 as usize);
     let fixed = analysis.atlas.fixed_mask();
     let mut out: [Vec<f32>; 3] = Default::default();
     for (a, img) in out.iter_mut().enumerate() {
@@ -369,7 +441,7 @@ fn code_images(
     opts: &EncodeOptions,
     progress: &ProgressBar,
 ) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
-    let (w, h) = (opts.lattice.0 as usize, opts.lattice.1 as usize);
+    let (w, h) = (analysis.lattice.0 as usize, analysis.lattice.1 as usize);
     let frames = analysis.residuals.len();
     let mut chunks = Vec::with_capacity(frames);
     match opts.codec {
@@ -434,5 +506,20 @@ fn code_images(
             }));
             Ok((Vec::new(), chunks))
         }
+    }
+}
+
+#[cfg(test)]
+mod lattice_tests {
+    use super::auto_side;
+
+    #[test]
+    fn auto_lattice_scales_with_vertices_up_to_the_papers_size() {
+        assert_eq!(auto_side(3), 32);
+        assert_eq!(auto_side(160), 80);
+        assert_eq!(auto_side(1728), 224);
+        assert_eq!(auto_side(3030), 256);
+        assert_eq!(auto_side(34_159), 256);
+        assert_eq!(auto_side(160) % 16, 0);
     }
 }

@@ -1,7 +1,7 @@
 //! `mcgv-video encode`.
 
 use crate::cli::{CodecChoice, EncodeArgs};
-use crate::encoder::{self, EncodeOptions};
+use crate::encoder::{self, EncodeOptions, Lattice};
 use crate::error::{Error, Result};
 use crate::mesh::read_animation;
 use crate::progress;
@@ -36,15 +36,18 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
     })
 }
 
-/// Parses `WIDTHxHEIGHT`.
-pub fn parse_lattice(s: &str) -> Result<(u16, u16)> {
+/// Parses `auto` or `WIDTHxHEIGHT`.
+pub fn parse_lattice(s: &str) -> Result<Lattice> {
+    if s.trim().eq_ignore_ascii_case("auto") {
+        return Ok(Lattice::Auto);
+    }
     let bad = || {
         Error::Usage(format!(
-            "--lattice {s}: expected WIDTHxHEIGHT, e.g. 256x256"
+            "--lattice {s}: expected auto or WIDTHxHEIGHT, e.g. 256x256"
         ))
     };
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    Ok((
+    Ok(Lattice::Fixed(
         w.trim().parse().map_err(|_| bad())?,
         h.trim().parse().map_err(|_| bad())?,
     ))
@@ -106,7 +109,8 @@ mod tests {
 
     #[test]
     fn lattice_parsing() {
-        assert_eq!(parse_lattice("256x128").unwrap(), (256, 128));
+        assert_eq!(parse_lattice("256x128").unwrap(), Lattice::Fixed(256, 128));
+        assert_eq!(parse_lattice("auto").unwrap(), Lattice::Auto);
         assert!(parse_lattice("256").is_err());
         assert!(parse_lattice("ax2").is_err());
         assert!(parse_lattice("99999x2").is_err());

@@ -2,7 +2,7 @@
 
 use crate::cli::InspectArgs;
 use crate::decoder::Decoder;
-use crate::encoder::{self, EncodeOptions};
+use crate::encoder::{self, EncodeOptions, Lattice};
 use crate::error::{Error, Result};
 use crate::geometry_image::tile;
 use crate::mesh::read_animation;
@@ -214,7 +214,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             clusters: header.requested_clusters as usize,
             affine_bits: header.affine_bits,
             first_frame_bits: header.first_frame_bits,
-            lattice: (header.lattice_width, header.lattice_height),
+            lattice: Lattice::Fixed(header.lattice_width, header.lattice_height),
             padding: Some(
                 header
                     .padding
