@@ -80,6 +80,10 @@ pub struct EncodeArgs {
     /// Let the first-frame coder reorder vertices for fewer bits (default keeps the input order).
     #[arg(long)]
     pub reorder: bool,
+    /// Motion predictor: one affine map per cluster, or per-vertex skinning weights over
+    /// neighbouring clusters' maps (coded in the stream; the decoder follows the stream's choice).
+    #[arg(long, value_enum, default_value_t = PredictorChoice::Affine)]
+    pub predictor: PredictorChoice,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -95,6 +99,15 @@ pub enum CodecChoice {
     Jpeg,
     /// MPEG-4 Part 2: an I-frame, then P-frames.
     Mpeg4,
+}
+
+/// The motion predictors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PredictorChoice {
+    /// One affine map per cluster and frame.
+    Affine,
+    /// Per-vertex weights blending the own and neighbouring clusters' maps.
+    Skinning,
 }
 
 /// `decode` arguments.

@@ -4,7 +4,7 @@ use crate::codec::{self, abbreviated, mpeg4, Plane};
 use crate::error::{Error, Result};
 use crate::geometry_image::{quantise, tile, FrameRanges, RangeMode};
 use crate::mesh::{AnimatedMesh, Point};
-use crate::motion::{self, AffineTrack, Partition, SegmentOptions};
+use crate::motion::{self, AffineTrack, Partition, PredictorKind, SegmentOptions, SkinningWeights};
 use crate::stream::container::{Checksum, ContainerWriter, Tag};
 use crate::stream::frame_index::{FrameChunk, FrameIndex};
 use crate::stream::header::{CodecKind, Header};
@@ -35,6 +35,8 @@ pub struct EncodeOptions {
     pub gop: usize,
     /// Let the first-frame coder permute vertices.
     pub reorder: bool,
+    /// The motion predictor (piecewise affine by default).
+    pub predictor: PredictorKind,
 }
 
 impl Default for EncodeOptions {
@@ -50,6 +52,7 @@ impl Default for EncodeOptions {
             padding: None,
             gop: 50,
             reorder: false,
+            predictor: PredictorKind::Affine,
         }
     }
 }
@@ -101,6 +104,8 @@ pub struct Analysis {
     pub partition: Partition,
     /// The quantised affine predictor.
     pub track: AffineTrack,
+    /// The quantised skinning weights, for the skinning predictor.
+    pub weights: Option<SkinningWeights>,
     /// The atlas.
     pub atlas: atlas::Atlas,
     /// Residuals per frame and vertex.
@@ -171,6 +176,7 @@ pub fn encode(
         reorder: opts.reorder,
         charts: analysis.atlas.stats().charts as u32,
         chart_pixels: analysis.atlas.stats().chart_pixels as u32,
+        predictor: opts.predictor,
     };
     let mut container = ContainerWriter::new();
     container.add(Tag::HEADER, header.to_bytes(), Checksum::Whole);
@@ -198,6 +204,13 @@ pub fn encode(
         side_info::encode_affine(&analysis.track)?,
         Checksum::Whole,
     );
+    if let Some(weights) = &analysis.weights {
+        container.add(
+            Tag::WEIGHTS,
+            side_info::encode_weights(weights, &analysis.partition, mesh.triangles())?,
+            Checksum::Whole,
+        );
+    }
     let mut w = crate::stream::bytes::ByteWriter::new();
     quantise::write_ranges(&analysis.ranges, &mut w);
     container.add(Tag::RANGES, w.into_bytes(), Checksum::Whole);
@@ -284,6 +297,16 @@ pub fn analyse(
         },
     )?;
     let track = AffineTrack::fit(mesh.frames(), &reference, &partition, opts.affine_bits)?;
+    let weights = match opts.predictor {
+        PredictorKind::Affine => None,
+        PredictorKind::Skinning => Some(SkinningWeights::fit(
+            mesh.frames(),
+            &reference,
+            &partition,
+            mesh.triangles(),
+            &track,
+        )?),
+    };
     let atlas = atlas::build(
         &reference,
         mesh.triangles(),
@@ -295,11 +318,12 @@ pub fn analyse(
         },
     )
     .map_err(|e| Error::Usage(format!("atlas: {e}")))?;
+    // Against the quantised predictor the decoder will rebuild: closed loop.
     let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
         .map(|f| {
             Ok(motion::residuals(
                 mesh.frame(f),
-                &track.try_predict(f, &reference, &partition)?,
+                &motion::predict_frame(&track, weights.as_ref(), f, &reference, &partition)?,
             ))
         })
         .collect::<Result<_>>()?;
@@ -312,6 +336,7 @@ pub fn analyse(
         reference,
         partition,
         track,
+        weights,
         atlas,
         residuals,
         ranges,
