@@ -89,8 +89,9 @@ fn jpeg_skinning_round_trip_keeps_connectivity_and_bounds_error() {
         oriented_set(mesh.triangles())
     );
     let m = compare(&mesh, &decoded).unwrap();
-    // The affine test's bound at quality 30 is 5e-5; skinning at 50 must do at least as well.
-    assert!(m.rmse < 5e-5, "RMSE {}", m.rmse);
+    // Measured 5.1e-6 (release build, `mcgv-video eval`); the bound is about twice that, and half
+    // of what the affine predictor reaches at the same settings (2.3e-5).
+    assert!(m.rmse < 1.2e-5, "RMSE {}", m.rmse);
     // Random access goes through the same prediction.
     let f = 7;
     assert_eq!(
@@ -115,8 +116,8 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
         oriented_set(mesh.triangles())
     );
     let m = compare(&mesh, &decoded).unwrap();
-    // Same bound as the affine MPEG-4 test (4e-5 at qscale 4).
-    assert!(m.rmse < 4e-5, "RMSE {}", m.rmse);
+    // Measured 2.0e-6 (affine: 2.0e-5 at the same settings); the bound is 2.5 times that.
+    assert!(m.rmse < 5e-6, "RMSE {}", m.rmse);
     let f = 15;
     let alone = decoder(bytes).unwrap().decode_frame(f).unwrap();
     assert_eq!(alone, decoded.frame(f));
@@ -209,4 +210,46 @@ fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
         skinning < 0.9 * affine,
         "skinning {skinning}, affine {affine}"
     );
+}
+
+#[test]
+fn cli_records_the_predictor_and_inspect_reports_the_weights() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = format!("{}/media/RiggedSimple.glb", env!("CARGO_MANIFEST_DIR"));
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
+            .args(args)
+            .output()
+            .expect("runs mcgv-video")
+    };
+    let mut bits = Vec::new();
+    for predictor in ["affine", "skinning"] {
+        let path = dir.path().join(format!("{predictor}.mcgv"));
+        let s = path.to_str().unwrap();
+        let enc = run(&[
+            "encode",
+            &sample,
+            "-o",
+            s,
+            "--predictor",
+            predictor,
+            "--padding",
+            "cg",
+            "--quiet",
+        ]);
+        assert!(
+            enc.status.success(),
+            "{}",
+            String::from_utf8_lossy(&enc.stderr)
+        );
+        let out = run(&["inspect", s, "--json"]);
+        assert!(out.status.success());
+        let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(info["predictor"], predictor);
+        bits.push(info["parts"]["skinning weights"].as_u64());
+    }
+    assert_eq!(bits[0], None);
+    assert!(bits[1].is_some_and(|b| b > 0), "{bits:?}");
+    let bad = run(&["encode", &sample, "-o", "x.mcgv", "--predictor", "bones"]);
+    assert_eq!(bad.status.code(), Some(2));
 }
