@@ -6,13 +6,14 @@
 //! `cargo bench --bench motion [-- INPUT ...]` (any input `read_animation` takes); with no arguments,
 //! every sequence found under
 //! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
-//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`;
+//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`,
+//! `SKIN_RIDGE` and `SKIN_BITS` the relative ridge and bits per weight of the skinning fits;
 //! `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
 
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
     energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions, SkinningWeights,
-    DEFAULT_AFFINE_BITS,
+    DEFAULT_AFFINE_BITS, DEFAULT_RIDGE, WEIGHT_BITS,
 };
 use mcgv_video::stream::side_info::encode_weights;
 use mcgv_video::AnimatedMesh;
@@ -162,12 +163,14 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
 
     // Skinning: weights fitted to the same (quantised) maps, predictions from the quantised weights.
     let start = Instant::now();
-    let weights = match SkinningWeights::fit(
+    let weights = match SkinningWeights::fit_with(
         mesh.frames(),
         reference,
         &partition,
         mesh.triangles(),
         &track,
+        knob("SKIN_RIDGE").unwrap_or(DEFAULT_RIDGE),
+        knob("SKIN_BITS").unwrap_or(WEIGHT_BITS),
     ) {
         Ok(w) => w,
         Err(e) => return println!("{name:<22} skinning failed: {e}"),

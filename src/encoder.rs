@@ -37,6 +37,8 @@ pub struct EncodeOptions {
     pub reorder: bool,
     /// The motion predictor (piecewise affine by default).
     pub predictor: PredictorKind,
+    /// Bits per skinning weight, sign included (the paper's 16 by default).
+    pub weight_bits: u8,
 }
 
 impl Default for EncodeOptions {
@@ -53,6 +55,7 @@ impl Default for EncodeOptions {
             gop: 50,
             reorder: false,
             predictor: PredictorKind::Affine,
+            weight_bits: motion::WEIGHT_BITS,
         }
     }
 }
@@ -252,6 +255,11 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
             "lattice {w}x{h}: width and height must be multiples of 16 between 16 and 4096"
         )));
     }
+    if !(2..=31).contains(&opts.weight_bits) {
+        return Err(Error::Usage(
+            "--weight-bits must be between 2 and 31".into(),
+        ));
+    }
     if opts.gop == 0 {
         return Err(Error::Usage("--gop must be at least 1".into()));
     }
@@ -299,12 +307,14 @@ pub fn analyse(
     let track = AffineTrack::fit(mesh.frames(), &reference, &partition, opts.affine_bits)?;
     let weights = match opts.predictor {
         PredictorKind::Affine => None,
-        PredictorKind::Skinning => Some(SkinningWeights::fit(
+        PredictorKind::Skinning => Some(SkinningWeights::fit_with(
             mesh.frames(),
             &reference,
             &partition,
             mesh.triangles(),
             &track,
+            motion::DEFAULT_RIDGE,
+            opts.weight_bits,
         )?),
     };
     let atlas = atlas::build(

@@ -223,8 +223,8 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
             .expect("runs mcgv-video")
     };
     let mut bits = Vec::new();
-    for predictor in ["affine", "skinning"] {
-        let path = dir.path().join(format!("{predictor}.mcgv"));
+    for (predictor, weight_bits) in [("affine", "16"), ("skinning", "16"), ("skinning", "10")] {
+        let path = dir.path().join(format!("{predictor}{weight_bits}.mcgv"));
         let s = path.to_str().unwrap();
         let enc = run(&[
             "encode",
@@ -233,6 +233,8 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
             s,
             "--predictor",
             predictor,
+            "--weight-bits",
+            weight_bits,
             "--padding",
             "cg",
             "--quiet",
@@ -246,10 +248,20 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
         assert!(out.status.success());
         let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(info["predictor"], predictor);
+        if predictor == "skinning" {
+            assert_eq!(info["weight_bits"].to_string(), weight_bits);
+        } else {
+            assert!(info["weight_bits"].is_null());
+        }
         bits.push(info["parts"]["skinning weights"].as_u64());
     }
     assert_eq!(bits[0], None);
     assert!(bits[1].is_some_and(|b| b > 0), "{bits:?}");
+    // Coarser weights take fewer bits.
+    assert!(
+        bits[2].is_some_and(|b| bits[1].is_some_and(|full| b < full)),
+        "{bits:?}"
+    );
     let bad = run(&["encode", &sample, "-o", "x.mcgv", "--predictor", "bones"]);
     assert_eq!(bad.status.code(), Some(2));
 }

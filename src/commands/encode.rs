@@ -37,6 +37,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             PredictorChoice::Affine => PredictorKind::Affine,
             PredictorChoice::Skinning => PredictorKind::Skinning,
         },
+        weight_bits: args.weight_bits,
         ..EncodeOptions::default()
     })
 }

@@ -44,6 +44,7 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "gop": header.gop,
             "clusters": header.clusters,
             "predictor": header.predictor.name(),
+            "weight_bits": decoder.weights().map(|w| w.bits),
             "charts": header.charts,
             "lattice": [header.lattice_width, header.lattice_height],
             "packing_efficiency": header.packing_efficiency(),
@@ -226,6 +227,9 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             gop: header.gop as usize,
             reorder: header.reorder,
             predictor: header.predictor,
+            weight_bits: decoder
+                .weights()
+                .map_or(crate::motion::WEIGHT_BITS, |w| w.bits),
         };
         let ff = first_frame::encode(
             mesh.frame(0),

@@ -20,5 +20,6 @@ pub use predict::{energy, residuals};
 pub use render::render_partition_png;
 pub use segment::{segment, Partition, SegmentOptions, MIN_CLUSTER_SIZE};
 pub use skinning::{
-    cluster_neighbours, predict_frame, PredictorKind, SkinningWeights, MAX_WEIGHT, WEIGHT_BITS,
+    cluster_neighbours, predict_frame, PredictorKind, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT,
+    WEIGHT_BITS,
 };

@@ -36,7 +36,7 @@ pub const WEIGHT_BITS: u8 = 16;
 
 /// Ridge of the weight fits, relative to the mean diagonal of the normal matrix: far below what
 /// changes a well-determined weight, enough to keep weights of indistinguishable maps near 0.
-const RIDGE: f64 = 1e-4;
+pub const DEFAULT_RIDGE: f64 = 1e-4;
 
 /// Largest weight magnitude kept; larger fits (from near-degenerate normal matrices) are clamped,
 /// which keeps the 16-bit step fine for the ordinary weights of the stream.
@@ -163,6 +163,39 @@ impl SkinningWeights {
         triangles: &[Triangle],
         track: &AffineTrack,
     ) -> Result<Self> {
+        Self::fit_with(
+            frames,
+            reference,
+            partition,
+            triangles,
+            track,
+            DEFAULT_RIDGE,
+            WEIGHT_BITS,
+        )
+    }
+
+    /// [`SkinningWeights::fit`] with another relative ridge and bits per weight (2..=31; the
+    /// motion bench measures their effect on residual energy and weight bits).
+    #[allow(clippy::too_many_arguments)]
+    pub fn fit_with(
+        frames: &[Vec<Point>],
+        reference: &[Point],
+        partition: &Partition,
+        triangles: &[Triangle],
+        track: &AffineTrack,
+        ridge: f64,
+        bits: u8,
+    ) -> Result<Self> {
+        if !(2..=31).contains(&bits) {
+            return Err(Error::Usage(format!(
+                "skinning weights: {bits} bits is outside 2..=31"
+            )));
+        }
+        if !(ridge.is_finite() && ridge >= 0.0) {
+            return Err(Error::Usage(format!(
+                "skinning ridge {ridge} is not a non-negative number"
+            )));
+        }
         check_sizes(track, reference, partition)?;
         if frames.len() != track.frame_count() {
             return Err(Error::Usage(format!(
@@ -182,7 +215,14 @@ impl SkinningWeights {
             .into_par_iter()
             .map(|v| {
                 let k = partition.labels()[v] as usize;
-                fit_vertex(frames, v, unit, k, &neighbours[k], track, reference)
+                let problem = VertexFit {
+                    frames,
+                    reference,
+                    track,
+                    unit,
+                    ridge,
+                };
+                problem.solve(v, k, &neighbours[k])
             })
             .collect();
         let largest = exact
@@ -192,7 +232,6 @@ impl SkinningWeights {
             .min(MAX_WEIGHT);
         // A stream without any weight (or with all zero) still needs a valid, positive limit.
         let limit = if largest > 0.0 { largest as f32 } else { 1.0 };
-        let bits = WEIGHT_BITS;
         let top = Self::top(bits);
         let step = limit as f64 / top as f64;
         let values = exact
@@ -301,63 +340,73 @@ fn check_sizes(track: &AffineTrack, reference: &[Point], partition: &Partition) 
     Ok(())
 }
 
-/// The unconstrained weights `β` of one vertex: least squares of
-/// `Σ_i ‖Σ_j β_j (p_j^i − p_k^i) − (x_i − p_k^i)‖²` plus the ridge.
-fn fit_vertex(
-    frames: &[Vec<Point>],
-    v: usize,
+/// What every vertex's weight fit shares.
+struct VertexFit<'a> {
+    frames: &'a [Vec<Point>],
+    reference: &'a [Point],
+    track: &'a AffineTrack,
     unit: UnitFrame,
-    k: usize,
-    neighbours: &[u32],
-    track: &AffineTrack,
-    reference: &[Point],
-) -> Vec<f64> {
-    let m = neighbours.len();
-    if m == 0 {
-        return Vec::new();
-    }
-    let x0 = unit.to_unit(&reference[v]);
-    let mut gram = DMatrix::<f64>::zeros(m, m);
-    let mut rhs = DVector::<f64>::zeros(m);
-    let mut d = vec![[0f64; 3]; m];
-    for (i, frame) in frames.iter().enumerate() {
-        let own = track.map(i, k).map_or(x0, |h| apply(h, x0));
-        let target = unit.to_unit(&frame[v]);
-        let r = [0, 1, 2].map(|a| target[a] - own[a]);
-        for (dj, &j) in d.iter_mut().zip(neighbours) {
-            let other = track.map(i, j as usize).map_or(x0, |h| apply(h, x0));
-            *dj = [0, 1, 2].map(|a| other[a] - own[a]);
+    ridge: f64,
+}
+
+impl VertexFit<'_> {
+    /// The unconstrained weights `β` of vertex `v` of cluster `k`: least squares of
+    /// `Σ_i ‖Σ_j β_j (p_j^i − p_k^i) − (x_i − p_k^i)‖²` plus the ridge.
+    fn solve(&self, v: usize, k: usize, neighbours: &[u32]) -> Vec<f64> {
+        let Self {
+            frames,
+            reference,
+            track,
+            unit,
+            ridge,
+        } = *self;
+        let m = neighbours.len();
+        if m == 0 {
+            return Vec::new();
         }
-        for a in 0..m {
-            rhs[a] += (0..3).map(|c| d[a][c] * r[c]).sum::<f64>();
-            for b in a..m {
-                gram[(a, b)] += (0..3).map(|c| d[a][c] * d[b][c]).sum::<f64>();
+        let x0 = unit.to_unit(&reference[v]);
+        let mut gram = DMatrix::<f64>::zeros(m, m);
+        let mut rhs = DVector::<f64>::zeros(m);
+        let mut d = vec![[0f64; 3]; m];
+        for (i, frame) in frames.iter().enumerate() {
+            let own = track.map(i, k).map_or(x0, |h| apply(h, x0));
+            let target = unit.to_unit(&frame[v]);
+            let r = [0, 1, 2].map(|a| target[a] - own[a]);
+            for (dj, &j) in d.iter_mut().zip(neighbours) {
+                let other = track.map(i, j as usize).map_or(x0, |h| apply(h, x0));
+                *dj = [0, 1, 2].map(|a| other[a] - own[a]);
+            }
+            for a in 0..m {
+                rhs[a] += (0..3).map(|c| d[a][c] * r[c]).sum::<f64>();
+                for b in a..m {
+                    gram[(a, b)] += (0..3).map(|c| d[a][c] * d[b][c]).sum::<f64>();
+                }
             }
         }
-    }
-    for a in 0..m {
-        for b in 0..a {
-            gram[(a, b)] = gram[(b, a)];
+        for a in 0..m {
+            for b in 0..a {
+                gram[(a, b)] = gram[(b, a)];
+            }
         }
-    }
-    let lambda = RIDGE * gram.trace() / m as f64 + 1e-30;
-    for a in 0..m {
-        gram[(a, a)] += lambda;
-    }
-    match gram.cholesky() {
-        Some(ch) => ch
-            .solve(&rhs)
-            .iter()
-            .map(|&w| {
-                if w.is_finite() {
-                    w.clamp(-MAX_WEIGHT, MAX_WEIGHT)
-                } else {
-                    0.0
-                }
-            })
-            .collect(),
-        // Not positive definite only if the maps are non-finite: keep the piecewise affine prediction.
-        None => vec![0.0; m],
+        let lambda = ridge * gram.trace() / m as f64 + 1e-30;
+        for a in 0..m {
+            gram[(a, a)] += lambda;
+        }
+        match gram.cholesky() {
+            Some(ch) => ch
+                .solve(&rhs)
+                .iter()
+                .map(|&w| {
+                    if w.is_finite() {
+                        w.clamp(-MAX_WEIGHT, MAX_WEIGHT)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+            // Not positive definite only if the maps are non-finite: keep the piecewise affine prediction.
+            None => vec![0.0; m],
+        }
     }
 }
 
