@@ -1,17 +1,21 @@
-//! Segmentation and piecewise affine prediction on real sequences: K, residual energy against raw
-//! motion energy, largest residual, and the time of each stage.
+//! Segmentation and prediction on real sequences: K, residual energy against raw motion energy,
+//! largest residual, and the time of each stage, for the piecewise affine predictor and the
+//! skinning predictor (follow-up paper eq. 7–10; its per-frame mean and max residual energy against
+//! the affine one's, and the bits of its coded weights).
 //!
 //! `cargo bench --bench motion [-- INPUT ...]` (any input `read_animation` takes); with no arguments,
 //! every sequence found under
 //! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
-//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`;
+//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`,
+//! `SKIN_RIDGE` and `SKIN_BITS` the relative ridge and bits per weight of the skinning fits;
 //! `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
 
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
-    energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions,
-    DEFAULT_AFFINE_BITS,
+    energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions, SkinningWeights,
+    DEFAULT_AFFINE_BITS, DEFAULT_RIDGE, WEIGHT_BITS,
 };
+use mcgv_video::stream::side_info::encode_weights;
 use mcgv_video::AnimatedMesh;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -27,7 +31,7 @@ fn main() {
         args.iter().map(PathBuf::from).collect()
     };
     println!(
-        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>11} {:>9} {:>9}",
+        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>11} {:>9} {:>9} {:>12} {:>10} {:>9} {:>9} {:>10} {:>7} {:>7}",
         "sequence",
         "V",
         "F",
@@ -36,7 +40,14 @@ fn main() {
         "max % diag",
         "quant % diag",
         "segment s",
-        "predict s"
+        "predict s",
+        "skin r/m",
+        "skin max %",
+        "Δmean E_f",
+        "Δmax E_f",
+        "weight bits",
+        "w bpvf",
+        "skin s"
     );
     for input in inputs {
         // Sequences are named by their folder: `pdance`, `walking_cat/OBJ` → walking_cat, `…/Fox/headA.glb` → the folder.
@@ -123,9 +134,11 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
     let mut residual_energy = 0.0;
     let mut motion_energy = 0.0;
     let mut largest = 0f64;
+    let mut affine_frames = Vec::with_capacity(mesh.frame_count());
     for f in 0..mesh.frame_count() {
         let predicted = track.predict(f, reference, &partition);
         let e = residuals(mesh.frame(f), &predicted);
+        affine_frames.push(energy(&e));
         residual_energy += energy(&e);
         motion_energy += energy(&residuals(mesh.frame(f), reference));
         largest = e
@@ -147,8 +160,43 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
                 .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
                 .fold(0.0, f64::max)
         });
+
+    // Skinning: weights fitted to the same (quantised) maps, predictions from the quantised weights.
+    let start = Instant::now();
+    let weights = match SkinningWeights::fit_with(
+        mesh.frames(),
+        reference,
+        &partition,
+        mesh.triangles(),
+        &track,
+        knob("SKIN_RIDGE").unwrap_or(DEFAULT_RIDGE),
+        knob("SKIN_BITS").unwrap_or(WEIGHT_BITS),
+    ) {
+        Ok(w) => w,
+        Err(e) => return println!("{name:<22} skinning failed: {e}"),
+    };
+    let mut skin_frames = Vec::with_capacity(mesh.frame_count());
+    let mut skin_largest = 0f64;
+    for f in 0..mesh.frame_count() {
+        let predicted = match weights.try_predict(f, &track, reference, &partition) {
+            Ok(p) => p,
+            Err(e) => return println!("{name:<22} skinning failed: {e}"),
+        };
+        let e = residuals(mesh.frame(f), &predicted);
+        skin_frames.push(energy(&e));
+        skin_largest = e
+            .iter()
+            .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+            .fold(skin_largest, f64::max);
+    }
+    let skin_time = start.elapsed().as_secs_f64();
+    let weight_bits = encode_weights(&weights, &partition, mesh.triangles())
+        .map_or(f64::NAN, |b| 8.0 * b.len() as f64);
+    let mean = |e: &[f64]| e.iter().sum::<f64>() / e.len().max(1) as f64;
+    let max = |e: &[f64]| e.iter().copied().fold(0f64, f64::max);
+    let change = |skin: f64, affine: f64| 100.0 * (skin / affine.max(f64::MIN_POSITIVE) - 1.0);
     println!(
-        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
+        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3} {:>12.5} {:>10.3} {:>8.1}% {:>8.1}% {:>10.0} {:>7.3} {:>7.2}",
         mesh.vertex_count(),
         mesh.frame_count(),
         partition.clusters(),
@@ -156,7 +204,14 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
         100.0 * largest / mesh.bbox_diagonal(),
         100.0 * quantisation / mesh.bbox_diagonal(),
         segment_time,
-        predict_time
+        predict_time,
+        skin_frames.iter().sum::<f64>() / motion_energy.max(f64::MIN_POSITIVE),
+        100.0 * skin_largest / mesh.bbox_diagonal(),
+        change(mean(&skin_frames), mean(&affine_frames)),
+        change(max(&skin_frames), max(&affine_frames)),
+        weight_bits,
+        weight_bits / (mesh.vertex_count() * mesh.frame_count()) as f64,
+        skin_time
     );
 }
 

@@ -4,7 +4,7 @@ use crate::codec::{abbreviated, jpeg, mpeg4, Plane};
 use crate::error::{Error, Result};
 use crate::geometry_image::{quantise, tile, FrameRanges};
 use crate::mesh::{AnimatedMesh, Point, Triangle};
-use crate::motion::{AffineTrack, Partition};
+use crate::motion::{predict_frame, AffineTrack, Partition, PredictorKind, SkinningWeights};
 use crate::stream::bytes::ByteReader;
 use crate::stream::container::{ContainerReader, Tag};
 use crate::stream::frame_index::{ChunkEntry, FrameIndex};
@@ -23,6 +23,7 @@ pub struct Decoder<R> {
     reference: Vec<Point>,
     partition: Partition,
     track: AffineTrack,
+    weights: Option<SkinningWeights>,
     pixels: Vec<[u16; 2]>,
     ranges: Vec<FrameRanges>,
     index: FrameIndex,
@@ -66,6 +67,19 @@ impl<R: Read + Seek> Decoder<R> {
             partition.clusters(),
             header.affine_bits,
         )?;
+        let weights = match header.predictor {
+            PredictorKind::Affine if reader.has(Tag::WEIGHTS) => {
+                return Err(Error::Stream(
+                    "the header says affine predictor but the stream has skinning weights".into(),
+                ))
+            }
+            PredictorKind::Affine => None,
+            PredictorKind::Skinning => Some(side_info::decode_weights(
+                &reader.part(Tag::WEIGHTS)?,
+                &partition,
+                &triangles,
+            )?),
+        };
         let ranges_bytes = reader.part(Tag::RANGES)?;
         let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
         let ranges = quantise::read_ranges(&mut r, f)?;
@@ -80,6 +94,7 @@ impl<R: Read + Seek> Decoder<R> {
             reference,
             partition,
             track,
+            weights,
             pixels,
             ranges,
             index,
@@ -105,6 +120,11 @@ impl<R: Read + Seek> Decoder<R> {
     /// The motion partition.
     pub fn partition(&self) -> &Partition {
         &self.partition
+    }
+
+    /// The skinning weights, when the stream uses the skinning predictor.
+    pub fn weights(&self) -> Option<&SkinningWeights> {
+        self.weights.as_ref()
     }
 
     /// Lattice pixel of every vertex.
@@ -216,9 +236,13 @@ impl<R: Read + Seek> Decoder<R> {
             )));
         }
         let lw = self.header.lattice_width as usize;
-        let mut out = self
-            .track
-            .try_predict(f, &self.reference, &self.partition)?;
+        let mut out = predict_frame(
+            &self.track,
+            self.weights.as_ref(),
+            f,
+            &self.reference,
+            &self.partition,
+        )?;
         for a in 0..3 {
             let levels = tile::sample(plane, a, lw, &self.pixels);
             let range = self.ranges[f][a];

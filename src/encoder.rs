@@ -4,7 +4,7 @@ use crate::codec::{self, abbreviated, mpeg4, Plane};
 use crate::error::{Error, Result};
 use crate::geometry_image::{quantise, tile, FrameRanges, RangeMode};
 use crate::mesh::{AnimatedMesh, Point};
-use crate::motion::{self, AffineTrack, Partition, SegmentOptions};
+use crate::motion::{self, AffineTrack, Partition, PredictorKind, SegmentOptions, SkinningWeights};
 use crate::stream::container::{Checksum, ContainerWriter, Tag};
 use crate::stream::frame_index::{FrameChunk, FrameIndex};
 use crate::stream::header::{CodecKind, Header};
@@ -35,6 +35,10 @@ pub struct EncodeOptions {
     pub gop: usize,
     /// Let the first-frame coder permute vertices.
     pub reorder: bool,
+    /// The motion predictor (piecewise affine by default).
+    pub predictor: PredictorKind,
+    /// Bits per skinning weight, sign included (the paper's 16 by default).
+    pub weight_bits: u8,
 }
 
 impl Default for EncodeOptions {
@@ -50,6 +54,8 @@ impl Default for EncodeOptions {
             padding: None,
             gop: 50,
             reorder: false,
+            predictor: PredictorKind::Affine,
+            weight_bits: motion::WEIGHT_BITS,
         }
     }
 }
@@ -69,11 +75,20 @@ pub enum Lattice {
 /// best near 224×224 (encode --lattice WxH, eval; JPEG q30/q75).
 const AUTO_PIXELS_PER_VERTEX: f64 = 28.0;
 
+/// Lattice pixels per vertex below which `Lattice::Auto` grows past 256×256: BrainStem (34 159
+/// vertices) at 336×336 had 70 % of its vertices moved off colliding pixels, at 512×512 28 %.
+const MIN_PIXELS_PER_VERTEX: f64 = 8.0;
+
 /// The first lattice side `Lattice::Auto` tries for `vertices`: about
-/// [`AUTO_PIXELS_PER_VERTEX`] pixels per vertex, at least 32, at most the papers' 256.
+/// [`AUTO_PIXELS_PER_VERTEX`] pixels per vertex, at least 32, at most the papers' 256 unless that
+/// leaves fewer than [`MIN_PIXELS_PER_VERTEX`] (meshes over 8192 vertices).
 pub fn auto_side(vertices: usize) -> u16 {
-    let side = (vertices as f64 * AUTO_PIXELS_PER_VERTEX).sqrt();
-    round_up_16(side).clamp(32, 256)
+    let v = vertices as f64;
+    let side = (v * AUTO_PIXELS_PER_VERTEX)
+        .sqrt()
+        .min(256.0)
+        .max((v * MIN_PIXELS_PER_VERTEX).sqrt());
+    round_up_16(side).max(32)
 }
 
 fn round_up_16(x: f64) -> u16 {
@@ -127,6 +142,8 @@ pub struct Analysis {
     pub partition: Partition,
     /// The quantised affine predictor.
     pub track: AffineTrack,
+    /// The quantised skinning weights, for the skinning predictor.
+    pub weights: Option<SkinningWeights>,
     /// The lattice the atlas was built on.
     pub lattice: (u16, u16),
     /// The atlas.
@@ -199,6 +216,7 @@ pub fn encode(
         reorder: opts.reorder,
         charts: analysis.atlas.stats().charts as u32,
         chart_pixels: analysis.atlas.stats().chart_pixels as u32,
+        predictor: opts.predictor,
     };
     let mut container = ContainerWriter::new();
     container.add(Tag::HEADER, header.to_bytes(), Checksum::Whole);
@@ -226,6 +244,13 @@ pub fn encode(
         side_info::encode_affine(&analysis.track)?,
         Checksum::Whole,
     );
+    if let Some(weights) = &analysis.weights {
+        container.add(
+            Tag::WEIGHTS,
+            side_info::encode_weights(weights, &analysis.partition, mesh.triangles())?,
+            Checksum::Whole,
+        );
+    }
     let mut w = crate::stream::bytes::ByteWriter::new();
     quantise::write_ranges(&analysis.ranges, &mut w);
     container.add(Tag::RANGES, w.into_bytes(), Checksum::Whole);
@@ -263,6 +288,11 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
     }
     if let Lattice::Fixed(w, h) = opts.lattice {
         check_lattice(w, h)?;
+    }
+    if !(2..=31).contains(&opts.weight_bits) {
+        return Err(Error::Usage(
+            "--weight-bits must be between 2 and 31".into(),
+        ));
     }
     if opts.gop == 0 {
         return Err(Error::Usage("--gop must be at least 1".into()));
@@ -318,12 +348,25 @@ pub fn analyse(
         },
     )?;
     let track = AffineTrack::fit(mesh.frames(), &reference, &partition, opts.affine_bits)?;
+    let weights = match opts.predictor {
+        PredictorKind::Affine => None,
+        PredictorKind::Skinning => Some(SkinningWeights::fit_with(
+            mesh.frames(),
+            &reference,
+            &partition,
+            mesh.triangles(),
+            &track,
+            motion::DEFAULT_RIDGE,
+            opts.weight_bits,
+        )?),
+    };
     let (lattice, atlas) = build_atlas(&reference, mesh.triangles(), &partition, opts.lattice)?;
+    // Against the quantised predictor the decoder will rebuild: closed loop.
     let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
         .map(|f| {
             Ok(motion::residuals(
                 mesh.frame(f),
-                &track.try_predict(f, &reference, &partition)?,
+                &motion::predict_frame(&track, weights.as_ref(), f, &reference, &partition)?,
             ))
         })
         .collect::<Result<_>>()?;
@@ -336,6 +379,7 @@ pub fn analyse(
         reference,
         partition,
         track,
+        weights,
         lattice,
         atlas,
         residuals,
@@ -519,7 +563,8 @@ mod lattice_tests {
         assert_eq!(auto_side(160), 80);
         assert_eq!(auto_side(1728), 224);
         assert_eq!(auto_side(3030), 256);
-        assert_eq!(auto_side(34_159), 256);
+        assert_eq!(auto_side(8431), 256);
+        assert_eq!(auto_side(34_159), 528);
         assert_eq!(auto_side(160) % 16, 0);
     }
 }

@@ -1,9 +1,10 @@
 //! `mcgv-video encode`.
 
-use crate::cli::{CodecChoice, EncodeArgs};
+use crate::cli::{CodecChoice, EncodeArgs, PredictorChoice};
 use crate::encoder::{self, EncodeOptions, Lattice};
 use crate::error::{Error, Result};
 use crate::mesh::read_animation;
+use crate::motion::PredictorKind;
 use crate::progress;
 use crate::stream::header::CodecKind;
 use std::path::Path;
@@ -32,6 +33,11 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         padding,
         gop: args.gop,
         reorder: args.reorder,
+        predictor: match args.predictor {
+            PredictorChoice::Affine => PredictorKind::Affine,
+            PredictorChoice::Skinning => PredictorKind::Skinning,
+        },
+        weight_bits: args.weight_bits,
         ..EncodeOptions::default()
     })
 }
@@ -88,13 +94,14 @@ pub fn run(args: &EncodeArgs, quiet: bool) -> Result<()> {
         println!("{value}");
     } else if !quiet {
         println!(
-            "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters, {} charts), {:.1} s ({:.1} frames/s)",
+            "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters, {} predictor, {} charts), {:.1} s ({:.1} frames/s)",
             args.output.display(),
             r.bytes,
             r.bpvf,
             r.header.vertices,
             r.header.frames,
             r.header.clusters,
+            r.header.predictor.name(),
             r.charts,
             seconds,
             r.header.frames as f64 / seconds.max(1e-9)

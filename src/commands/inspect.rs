@@ -43,6 +43,8 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "qscale": header.qscale,
             "gop": header.gop,
             "clusters": header.clusters,
+            "predictor": header.predictor.name(),
+            "weight_bits": decoder.weights().map(|w| w.bits),
             "charts": header.charts,
             "lattice": [header.lattice_width, header.lattice_height],
             "packing_efficiency": header.packing_efficiency(),
@@ -86,12 +88,13 @@ fn summary(h: &Header, path: &Path) -> String {
         CodecKind::Mpeg4 => format!("mpeg4 qscale {} gop {}", h.qscale, h.gop),
     };
     format!(
-        "{}: {} vertices x {} frames, {} faces; {codec}; {} clusters, {} charts in {}x{} (packing {:.1}%), padding {}",
+        "{}: {} vertices x {} frames, {} faces; {codec}; {} clusters, {} predictor, {} charts in {}x{} (packing {:.1}%), padding {}",
         path.display(),
         h.vertices,
         h.frames,
         h.triangles,
         h.clusters,
+        h.predictor.name(),
         h.charts,
         h.lattice_width,
         h.lattice_height,
@@ -223,6 +226,10 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             ),
             gop: header.gop as usize,
             reorder: header.reorder,
+            predictor: header.predictor,
+            weight_bits: decoder
+                .weights()
+                .map_or(crate::motion::WEIGHT_BITS, |w| w.bits),
         };
         let ff = first_frame::encode(
             mesh.frame(0),

@@ -1,5 +1,6 @@
 //! Motion analysis (MCGV §3.1–3.2): segmentation of the vertices by affine motion, the piecewise
-//! affine predictor of every frame from the decoded frame 0, and its residuals.
+//! affine predictor of every frame from the decoded frame 0, the skinning predictor of the follow-up
+//! paper (§3.2, eq. 7–10) that blends neighbouring clusters' maps per vertex, and the residuals.
 //!
 //! ```text
 //! segment(mesh) ─► Partition ─► AffineTrack::fit(frames, decoded frame 0) ─► predict(i) ─► residuals
@@ -11,9 +12,14 @@ mod predict;
 mod refine;
 mod render;
 mod segment;
+mod skinning;
 
 pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_BITS};
 pub use fit::AffineCoefficients;
 pub use predict::{energy, residuals};
 pub use render::render_partition_png;
 pub use segment::{segment, Partition, SegmentOptions, MIN_CLUSTER_SIZE};
+pub use skinning::{
+    cluster_neighbours, predict_frame, PredictorKind, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT,
+    WEIGHT_BITS,
+};

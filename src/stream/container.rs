@@ -41,6 +41,8 @@ impl Tag {
     pub const LATTICE: Tag = Tag(*b"LATC");
     /// Quantised affine coefficients per cluster and frame.
     pub const AFFINE: Tag = Tag(*b"AFFN");
+    /// Quantised per-vertex skinning weights (only in skinning streams).
+    pub const WEIGHTS: Tag = Tag(*b"SKIN");
     /// Residual quantisation ranges.
     pub const RANGES: Tag = Tag(*b"RANG");
     /// Codec set-up shared by all frames (e.g. JPEG tables).
@@ -58,6 +60,7 @@ impl Tag {
             b"PART" => "partition",
             b"LATC" => "lattice coordinates",
             b"AFFN" => "affine coefficients",
+            b"SKIN" => "skinning weights",
             b"RANG" => "residual ranges",
             b"CSET" => "codec set-up",
             b"INDX" => "frame index",

@@ -1,6 +1,7 @@
 //! The stream header: everything the decoder must know before it reads any other part.
 
 use crate::error::{Error, Result};
+use crate::motion::PredictorKind;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 
 /// The residual image codec recorded in the stream.
@@ -75,6 +76,23 @@ pub struct Header {
     pub charts: u32,
     /// Lattice pixels covered by chart blocks (informational: packing efficiency).
     pub chart_pixels: u32,
+    /// The motion predictor: piecewise affine, or skinning (then a weights part follows).
+    pub predictor: PredictorKind,
+}
+
+fn predictor_id(p: PredictorKind) -> u8 {
+    match p {
+        PredictorKind::Affine => 0,
+        PredictorKind::Skinning => 1,
+    }
+}
+
+fn predictor_from_id(id: u8) -> Result<PredictorKind> {
+    match id {
+        0 => Ok(PredictorKind::Affine),
+        1 => Ok(PredictorKind::Skinning),
+        _ => Err(Error::Stream(format!("unknown predictor id {id}"))),
+    }
 }
 
 /// Upper bound on any count in the header, far above any real animation and far below what would let
@@ -107,6 +125,12 @@ impl Header {
             .u8(self.reorder as u8)
             .u32(self.charts)
             .u32(self.chart_pixels);
+        // The predictor byte is written only when it is not the affine default, so affine streams
+        // stay byte-identical to (and readable by) builds from before the skinning predictor, and
+        // those builds refuse a skinning stream (trailing header bytes) instead of mispredicting it.
+        if self.predictor != PredictorKind::Affine {
+            w.u8(predictor_id(self.predictor));
+        }
         w.into_bytes()
     }
 
@@ -131,6 +155,11 @@ impl Header {
             reorder: r.u8()? != 0,
             charts: r.u32()?,
             chart_pixels: r.u32()?,
+            predictor: if r.remaining() > 0 {
+                predictor_from_id(r.u8()?)?
+            } else {
+                PredictorKind::Affine
+            },
         };
         r.finish()?;
         for (what, n) in [
@@ -196,6 +225,7 @@ mod tests {
             reorder: false,
             charts: 31,
             chart_pixels: 40_000,
+            predictor: PredictorKind::Affine,
         }
     }
 
@@ -203,6 +233,18 @@ mod tests {
     fn round_trip() {
         let h = sample();
         assert_eq!(Header::from_bytes(&h.to_bytes()).unwrap(), h);
+        let skin = Header {
+            predictor: PredictorKind::Skinning,
+            ..sample()
+        };
+        let bytes = skin.to_bytes();
+        assert_eq!(bytes.len(), h.to_bytes().len() + 1);
+        assert_eq!(Header::from_bytes(&bytes).unwrap(), skin);
+        let mut unknown = bytes;
+        if let Some(last) = unknown.last_mut() {
+            *last = 7;
+        }
+        assert!(Header::from_bytes(&unknown).is_err());
     }
 
     #[test]

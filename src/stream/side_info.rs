@@ -4,12 +4,13 @@
 //!
 //! What is exploited: labels are spatially coherent (a vertex usually shares the label most of its
 //! already-coded neighbours have); lattice coordinates of mesh neighbours are near each other; affine
-//! coefficients change slowly from frame to frame.
+//! coefficients change slowly from frame to frame; skinning weights vary smoothly over the surface
+//! and are large only near the cluster they blend toward.
 
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
-use crate::motion::{AffineTrack, QuantisedAffine};
+use crate::motion::{cluster_neighbours, AffineTrack, Partition, QuantisedAffine, SkinningWeights};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::entropy::{
     self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel,
@@ -249,4 +250,118 @@ pub fn decode_affine(
     let mut dec = Decoder::new(rest)?;
     code_affine_values(&mut dec, &mut q)?;
     AffineTrack::from_quantised(q)
+}
+
+/// Per vertex, the weight toward each neighbouring cluster as a difference from the rounded mean of
+/// the same weight at the vertex's already-coded mesh neighbours of the same cluster (0 if none).
+/// Contexts: whether such a guess exists, and whether the target cluster touches the vertex's 1-ring
+/// (seam vertices carry the large weights).
+fn code_weight_values<C: SymbolCoder>(
+    c: &mut C,
+    w: &mut SkinningWeights,
+    labels: &[u32],
+    adj: &VertexAdjacency,
+) -> Result<()> {
+    let mut models: [[IntModel; 2]; 2] = Default::default();
+    let top = SkinningWeights::top(w.bits) as i64;
+    let mut offsets = Vec::with_capacity(labels.len());
+    let mut next = 0usize;
+    for &l in labels {
+        offsets.push(next);
+        next += w.neighbours.get(l as usize).map_or(0, Vec::len);
+    }
+    if next != w.values.len() {
+        return Err(Error::Stream(
+            "skinning weights: count does not match the partition".into(),
+        ));
+    }
+    for v in 0..labels.len() {
+        let k = labels[v];
+        let Some(neighbours) = w.neighbours.get(k as usize) else {
+            continue;
+        };
+        let ring = adj.neighbours(v);
+        for (idx, &j) in neighbours.iter().enumerate() {
+            let (mut sum, mut n) = (0i64, 0i64);
+            for &u in ring.iter().filter(|&&u| (u as usize) < v) {
+                if labels[u as usize] == k {
+                    sum += w.values[offsets[u as usize] + idx] as i64;
+                    n += 1;
+                }
+            }
+            let guess = if n > 0 {
+                (sum as f64 / n as f64).round() as i64
+            } else {
+                0
+            };
+            let touches = ring.iter().any(|&u| labels[u as usize] == j);
+            let model = &mut models[(n > 0) as usize][touches as usize];
+            let slot = offsets[v] + idx;
+            let value = guess + c.signed(w.values[slot] as i64 - guess, model)?;
+            if value.abs() > top {
+                return Err(Error::Stream(format!(
+                    "skinning weight of vertex {v} does not fit in {} bits",
+                    w.bits
+                )));
+            }
+            w.values[slot] = value as i32;
+        }
+    }
+    // The range decoder reads a cut-off stream as if zeros followed, so a truncated part (with a
+    // forged checksum) would otherwise decode to plausible weights; a trailing word catches that.
+    if c.raw_bits(WEIGHTS_END as u64, 32)? != WEIGHTS_END as u64 {
+        return Err(Error::Stream(
+            "skinning weights: the coded data end early (truncated or damaged)".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Coded after the last skinning weight, checked by the decoder.
+const WEIGHTS_END: u32 = 0x5EED_C0DE;
+
+/// Codes the quantised skinning weights: bits and limit, then the weights (the neighbour lists are
+/// not stored: the decoder derives them from the partition and the connectivity).
+pub fn encode_weights(
+    weights: &SkinningWeights,
+    partition: &Partition,
+    triangles: &[Triangle],
+) -> Result<Vec<u8>> {
+    weights.check(partition)?;
+    let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
+    let mut w = ByteWriter::new();
+    w.u8(weights.bits).f32(weights.limit);
+    let mut enc = Encoder::new();
+    code_weight_values(&mut enc, &mut weights.clone(), partition.labels(), &adj)?;
+    w.raw(&enc.finish()?);
+    Ok(w.into_bytes())
+}
+
+/// Decodes the skinning weights of `partition` on the mesh of `triangles`.
+pub fn decode_weights(
+    bytes: &[u8],
+    partition: &Partition,
+    triangles: &[Triangle],
+) -> Result<SkinningWeights> {
+    let mut r = ByteReader::new(bytes, "skinning weights");
+    let bits = r.u8()?;
+    let limit = r.f32()?;
+    let neighbours = cluster_neighbours(partition, triangles);
+    let count = SkinningWeights::expected_count(&neighbours, partition.labels())
+        .ok_or_else(|| Error::Stream("skinning weights: partition out of range".into()))?;
+    let rest = r.take(r.remaining())?;
+    check_capacity(count as u64, rest.len(), "skinning weights")?;
+    let mut weights = SkinningWeights {
+        bits,
+        limit,
+        neighbours,
+        values: vec![0; count],
+    };
+    // Bits and limit first: the coder's range check depends on them.
+    weights.check(partition)?;
+    let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
+    let mut dec = Decoder::new(rest)?;
+    code_weight_values(&mut dec, &mut weights, partition.labels(), &adj)?;
+    weights.check(partition)?;
+    Ok(weights)
 }
