@@ -1,11 +1,13 @@
-//! Motion analysis (MCGV §3.1–3.2): segmentation of the vertices by affine motion, the piecewise
-//! affine predictor of every frame from the decoded frame 0, and its residuals.
+//! Motion analysis (MCGV §3.1–3.2): segmentation of the vertices by affine motion (k-means, or the
+//! skinning paper's decimation), the piecewise affine predictor of every frame from the decoded
+//! frame 0, and its residuals.
 //!
 //! ```text
-//! segment(mesh) ─► Partition ─► AffineTrack::fit(frames, decoded frame 0) ─► predict(i) ─► residuals
+//! segment(mesh) | decimate(mesh) ─► Partition ─► AffineTrack::fit(frames, decoded frame 0) ─► predict(i) ─► residuals
 //! ```
 
 mod affine;
+mod decimate;
 mod fit;
 mod predict;
 mod refine;
@@ -13,6 +15,7 @@ mod render;
 mod segment;
 
 pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_BITS};
+pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
 pub use fit::AffineCoefficients;
 pub use predict::{energy, residuals};
 pub use render::render_partition_png;
