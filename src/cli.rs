@@ -62,9 +62,16 @@ pub struct EncodeArgs {
     /// MPEG-4 quantiser 1..31 (lower = better); overrides --quality for mpeg4.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=31))]
     pub qscale: Option<u8>,
-    /// Number of motion clusters K.
-    #[arg(long, default_value_t = 20)]
-    pub clusters: usize,
+    /// Number of motion clusters K for k-means (default 20).
+    #[arg(long)]
+    pub clusters: Option<usize>,
+    /// Motion segmentation: k-means with K = --clusters, or decimation, which finds K itself.
+    #[arg(long, value_enum, default_value_t = SegmentationChoice::Kmeans)]
+    pub segmentation: SegmentationChoice,
+    /// Decimation's error threshold E0: RMS affine-fit error per vertex and frame, as a fraction of
+    /// the bounding-box diagonal (default 0.003, the paper's).
+    #[arg(long)]
+    pub e0: Option<f64>,
     /// Bits per quantised affine coefficient.
     #[arg(long, default_value_t = 17)]
     pub affine_bits: u8,
@@ -86,6 +93,15 @@ pub struct EncodeArgs {
     /// How to read the input.
     #[command(flatten)]
     pub input_args: InputArgs,
+}
+
+/// The motion segmentations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SegmentationChoice {
+    /// k-means on per-vertex affine motion, K = --clusters (MCGV).
+    Kmeans,
+    /// Half-edge collapses by affine-motion cost until the error reaches --e0 (skinning paper).
+    Decimation,
 }
 
 /// The residual image codecs.

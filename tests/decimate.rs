@@ -1,9 +1,14 @@
 //! Segmentation by decimation (skinning paper §3.1) on synthetic animations with a known answer.
 
+use mcgv_video::decoder::Decoder;
+use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::topology::ManifoldReport;
-use mcgv_video::mesh::{Point, Triangle};
+use mcgv_video::mesh::{read_animation, Point, ReadOptions, Triangle};
+use mcgv_video::metrics::compare;
 use mcgv_video::motion::{decimate, DecimateOptions, Decimation};
+use mcgv_video::stream::container::ContainerReader;
 use mcgv_video::AnimatedMesh;
+use std::io::Cursor;
 
 const FRAMES: usize = 10;
 const RING_SIZE: usize = 12;
@@ -321,4 +326,48 @@ fn the_cap_continues_collapsing_past_e0() {
     .expect("decimates");
     assert_eq!(capped.partition.clusters(), 2);
     assert!(capped.error > free.error);
+}
+
+/// Encode with decimation, decode, and compare: the stream carries the K decimation found (the
+/// two-bone cylinder's two parts), and the decoded animation stays within the error bound.
+#[test]
+fn decimation_round_trips_through_the_stream() {
+    let path = format!("{}/media/RiggedSimple.glb", env!("CARGO_MANIFEST_DIR"));
+    let mesh = read_animation(&path, &ReadOptions::default()).expect("media sample reads");
+    let opts = EncodeOptions {
+        segmentation: Segmentation::Decimation { e0: 0.003 },
+        // The paper's padding keeps this debug-build test fast.
+        padding: Some(padding::Method::Cg),
+        ..EncodeOptions::default()
+    };
+    let hidden = indicatif::ProgressBar::hidden();
+    let encoded = encode(&mesh, &opts, &hidden).expect("encodes");
+    let report = encoded.report;
+    let k = report.segmentation.clusters;
+    assert_eq!(report.segmentation.method, "decimation");
+    assert_eq!(report.header.clusters as usize, k);
+    assert!(report.segmentation.error.is_some_and(|e| e <= 0.003));
+    let bytes = encoded.container.to_bytes();
+    let mut decoder =
+        Decoder::new(ContainerReader::new(Cursor::new(bytes)).expect("container")).expect("stream");
+    assert_eq!(decoder.partition().clusters(), k);
+    let decoded = decoder.decode_all(&hidden).expect("decodes");
+    // The first-frame coder may store triangles in another order and rotation, never others.
+    let canonical = |tris: &[Triangle]| {
+        let mut v: Vec<Triangle> = tris
+            .iter()
+            .map(|t| {
+                let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+                [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
+    assert_eq!(decoded.frame_count(), mesh.frame_count());
+    let m = compare(&mesh, &decoded).expect("comparable");
+    // Measured 7.1e-5 of the diagonal (K = 2: the two bones); the bound is twice that.
+    assert_eq!(k, 2);
+    assert!(m.rmse < 1.4e-4, "RMSE {}", m.rmse);
 }
