@@ -1,16 +1,19 @@
 //! Segmentation and piecewise affine prediction on real sequences: K, residual energy against raw
-//! motion energy, largest residual, and the time of each stage.
+//! motion energy, largest residual, and the time of each stage — for k-means (K = 20) and for
+//! decimation (K found from E0 = 0.003), one row each.
 //!
 //! `cargo bench --bench motion [-- INPUT ...]` (any input `read_animation` takes); with no arguments,
 //! every sequence found under
 //! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
-//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`;
-//! `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
+//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`,
+//! `CLUSTERS` k-means' K, `E0` decimation's threshold, and `SEGMENTATION=kmeans|decimation` runs one
+//! method only; `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
+//! The `E_l` column is decimation's RMS affine-fit error per vertex and frame over the bbox diagonal.
 
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
-    energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions,
-    DEFAULT_AFFINE_BITS,
+    decimate, energy, render_partition_png, residuals, segment, AffineTrack, DecimateOptions,
+    Partition, SegmentOptions, DEFAULT_AFFINE_BITS,
 };
 use mcgv_video::AnimatedMesh;
 use std::path::{Path, PathBuf};
@@ -27,11 +30,13 @@ fn main() {
         args.iter().map(PathBuf::from).collect()
     };
     println!(
-        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>11} {:>9} {:>9}",
+        "{:<22} {:<10} {:>6} {:>5} {:>4} {:>8} {:>12} {:>10} {:>11} {:>9} {:>9}",
         "sequence",
+        "method",
         "V",
         "F",
         "K",
+        "E_l",
         "resid/motion",
         "max % diag",
         "quant % diag",
@@ -49,8 +54,16 @@ fn main() {
             || input.display().to_string(),
             |n| n.to_string_lossy().into(),
         );
+        let which = std::env::var("SEGMENTATION").unwrap_or_default();
         match load(&input) {
-            Ok(mesh) => measure(&name, &mesh),
+            Ok(mesh) => {
+                if which.is_empty() || which == "kmeans" {
+                    measure(&name, &mesh, Method::KMeans);
+                }
+                if which.is_empty() || which == "decimation" {
+                    measure(&name, &mesh, Method::Decimation);
+                }
+            }
             Err(e) => println!("{name:<22} skipped: {e}"),
         }
     }
@@ -91,22 +104,51 @@ fn knob<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
 
-fn measure(name: &str, mesh: &AnimatedMesh) {
-    let start = Instant::now();
-    let defaults = SegmentOptions::default();
-    let opts = SegmentOptions {
-        refine_passes: knob("REFINE").unwrap_or(defaults.refine_passes),
-        feature_frames: knob("FEATURE_FRAMES").unwrap_or(defaults.feature_frames),
-        max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
-        ..defaults
+#[derive(Clone, Copy)]
+enum Method {
+    KMeans,
+    Decimation,
+}
+
+/// The partition of one method, with decimation's E_l (NaN for k-means).
+fn partition_by(mesh: &AnimatedMesh, method: Method) -> mcgv_video::Result<(Partition, f64)> {
+    match method {
+        Method::KMeans => {
+            let defaults = SegmentOptions::default();
+            let opts = SegmentOptions {
+                clusters: knob("CLUSTERS").unwrap_or(defaults.clusters),
+                refine_passes: knob("REFINE").unwrap_or(defaults.refine_passes),
+                feature_frames: knob("FEATURE_FRAMES").unwrap_or(defaults.feature_frames),
+                max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
+                ..defaults
+            };
+            Ok((segment(mesh, &opts)?, f64::NAN))
+        }
+        Method::Decimation => {
+            let defaults = DecimateOptions::default();
+            let opts = DecimateOptions {
+                e0: knob("E0").unwrap_or(defaults.e0),
+                ..defaults
+            };
+            let d = decimate(mesh, &opts)?;
+            Ok((d.partition, d.error))
+        }
+    }
+}
+
+fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
+    let label = match method {
+        Method::KMeans => "kmeans",
+        Method::Decimation => "decimation",
     };
-    let partition = match segment(mesh, &opts) {
+    let start = Instant::now();
+    let (partition, fit_error) = match partition_by(mesh, method) {
         Ok(p) => p,
-        Err(e) => return println!("{name:<22} segmentation failed: {e}"),
+        Err(e) => return println!("{name:<22} {label:<10} segmentation failed: {e}"),
     };
     let segment_time = start.elapsed().as_secs_f64();
     if let Ok(dir) = std::env::var("PICTURES") {
-        let path = Path::new(&dir).join(format!("{name}.png"));
+        let path = Path::new(&dir).join(format!("{name}-{label}.png"));
         let (frame0, labels) = (mesh.frame(0), partition.labels());
         if let Err(e) = render_partition_png(frame0, mesh.triangles(), labels, 512, &path) {
             println!("{name}: picture not written: {e}");
@@ -118,7 +160,7 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
     let reference = mesh.frame(0);
     let track = match AffineTrack::fit(mesh.frames(), reference, &partition, DEFAULT_AFFINE_BITS) {
         Ok(t) => t,
-        Err(e) => return println!("{name:<22} prediction failed: {e}"),
+        Err(e) => return println!("{name:<22} {label:<10} prediction failed: {e}"),
     };
     let mut residual_energy = 0.0;
     let mut motion_energy = 0.0;
@@ -148,10 +190,11 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
                 .fold(0.0, f64::max)
         });
     println!(
-        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
+        "{name:<22} {label:<10} {:>6} {:>5} {:>4} {:>8.5} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
         mesh.vertex_count(),
         mesh.frame_count(),
         partition.clusters(),
+        fit_error,
         residual_energy / motion_energy.max(f64::MIN_POSITIVE),
         100.0 * largest / mesh.bbox_diagonal(),
         100.0 * quantisation / mesh.bbox_diagonal(),
