@@ -8,7 +8,8 @@
 //! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`,
 //! `CLUSTERS` k-means' K, `E0` decimation's threshold, and `SEGMENTATION=kmeans|decimation` runs one
 //! method only; `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
-//! The `E_l` column is decimation's RMS affine-fit error per vertex and frame over the bbox diagonal.
+//! The `E_l` column is decimation's RMS affine-fit error per vertex and frame over the bbox diagonal;
+//! `K0` is the K its collapses alone left, before border refinement (`DECIMATE_REFINE` sets its rounds).
 
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
@@ -30,12 +31,13 @@ fn main() {
         args.iter().map(PathBuf::from).collect()
     };
     println!(
-        "{:<22} {:<10} {:>6} {:>5} {:>4} {:>8} {:>12} {:>10} {:>11} {:>9} {:>9}",
+        "{:<22} {:<10} {:>6} {:>5} {:>4} {:>4} {:>8} {:>12} {:>10} {:>11} {:>9} {:>9}",
         "sequence",
         "method",
         "V",
         "F",
         "K",
+        "K0",
         "E_l",
         "resid/motion",
         "max % diag",
@@ -110,8 +112,11 @@ enum Method {
     Decimation,
 }
 
-/// The partition of one method, with decimation's E_l (NaN for k-means).
-fn partition_by(mesh: &AnimatedMesh, method: Method) -> mcgv_video::Result<(Partition, f64)> {
+/// The partition of one method, with decimation's E_l and K before refinement (NaN, 0 for k-means).
+fn partition_by(
+    mesh: &AnimatedMesh,
+    method: Method,
+) -> mcgv_video::Result<(Partition, f64, usize)> {
     match method {
         Method::KMeans => {
             let defaults = SegmentOptions::default();
@@ -122,16 +127,17 @@ fn partition_by(mesh: &AnimatedMesh, method: Method) -> mcgv_video::Result<(Part
                 max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
                 ..defaults
             };
-            Ok((segment(mesh, &opts)?, f64::NAN))
+            Ok((segment(mesh, &opts)?, f64::NAN, 0))
         }
         Method::Decimation => {
             let defaults = DecimateOptions::default();
             let opts = DecimateOptions {
                 e0: knob("E0").unwrap_or(defaults.e0),
+                refine_passes: knob("DECIMATE_REFINE").unwrap_or(defaults.refine_passes),
                 ..defaults
             };
             let d = decimate(mesh, &opts)?;
-            Ok((d.partition, d.error))
+            Ok((d.partition, d.error, d.decimated_clusters))
         }
     }
 }
@@ -142,7 +148,7 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
         Method::Decimation => "decimation",
     };
     let start = Instant::now();
-    let (partition, fit_error) = match partition_by(mesh, method) {
+    let (partition, fit_error, plain_k) = match partition_by(mesh, method) {
         Ok(p) => p,
         Err(e) => return println!("{name:<22} {label:<10} segmentation failed: {e}"),
     };
@@ -190,10 +196,11 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
                 .fold(0.0, f64::max)
         });
     println!(
-        "{name:<22} {label:<10} {:>6} {:>5} {:>4} {:>8.5} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
+        "{name:<22} {label:<10} {:>6} {:>5} {:>4} {:>4} {:>8.5} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
         mesh.vertex_count(),
         mesh.frame_count(),
         partition.clusters(),
+        plain_k,
         fit_error,
         residual_energy / motion_energy.max(f64::MIN_POSITIVE),
         100.0 * largest / mesh.bbox_diagonal(),

@@ -30,13 +30,14 @@
 //! - Ties (sets of up to three vertices fit exactly: cost 0) go to the smaller merged set, so sets
 //!   grow evenly instead of one set sweeping a rigid part vertex by vertex; then to the lower ids, so
 //!   the result is deterministic.
-//! - Border refinement (as after k-means, `refine_passes`): sets of up to four vertices fit any
-//!   motion exactly, so early zero-cost collapses can join vertices across the border of two parts;
-//!   such a set later fits neither part and stays a small cluster of its own (a two-part tube split
-//!   into 3 clusters). Afterwards each border vertex may move to a neighbouring cluster whose affine
-//!   maps predict its trajectory better; clusters emptied so vanish. Whole components never move,
-//!   so each stays segmented on its own. The result is kept only if `E_l` does not grow, so the
-//!   final `E_l` is still at most E0.
+//! - Border refinement (beyond the paper; `refine_passes`, 0 = the paper's plain decimation): sets
+//!   of up to four vertices fit any motion exactly, so early zero-cost collapses can join vertices
+//!   across the border of two parts; such a set later fits neither part and stays a cluster of its
+//!   own (a two-part triangle soup gave 3 clusters). Each round moves every border vertex to the
+//!   neighbouring cluster whose affine maps predict its trajectory best (as after k-means), then
+//!   resumes the collapses on the clusters so refined with the budget left — a band now fitting
+//!   one part exactly merges into it for free. Whole components never move, so each stays
+//!   segmented on its own; a round that would raise the error is dropped, so `E_l` ≤ E0 holds.
 //! - Memory is 12 numbers per set and frame; past `max_vertex_frames` vertices × frames, the frames
 //!   are subsampled evenly (as the k-means features are) and `E_l` is estimated from them.
 
@@ -68,9 +69,9 @@ pub struct DecimateOptions {
     pub max_clusters: usize,
     /// Vertices × frames above which frames are subsampled (default 2 000 000, about 100 MB of sums).
     pub max_vertex_frames: usize,
-    /// Passes of border refinement after the collapses (default 4; 0 = the paper's plain decimation):
-    /// each vertex may move to a neighbouring cluster whose affine maps predict it better (see
-    /// the module documentation). Kept only when it does not raise `E_l`.
+    /// Rounds of border refinement after the collapses (default 4; 0 = the paper's plain
+    /// decimation): each vertex may move to a neighbouring cluster whose affine maps predict it
+    /// better, then the collapses resume within the budget (see the module documentation).
     pub refine_passes: usize,
 }
 
@@ -99,9 +100,9 @@ pub struct Decimation {
     pub frames_used: usize,
     /// Half-edge collapses done.
     pub collapses: usize,
-    /// Clusters the collapses left, before border refinement emptied any.
+    /// K of the paper's plain decimation: the clusters the first collapses left, before refinement.
     pub decimated_clusters: usize,
-    /// `E_l` the collapses reached, before border refinement.
+    /// `E_l` of the paper's plain decimation, before refinement.
     pub decimated_error: f64,
 }
 
@@ -404,8 +405,8 @@ impl State {
             size[*rep as usize] += 1;
         }
         let mut set_sums: Vec<Option<Vec<f64>>> = vec![None; v_count];
-        for v in 0..v_count {
-            let r = parent[v] as usize;
+        for (v, &r) in parent.iter().enumerate() {
+            let r = r as usize;
             if size[r] > 1 {
                 let s = set_sums[r].get_or_insert_with(|| vec![0.0; sums.len()]);
                 sums.add_vertex(s, v);
@@ -416,8 +417,7 @@ impl State {
             .map(|s| s.as_ref().map_or(0.0, |s| sums.error(s)))
             .collect();
         let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); v_count];
-        for v in 0..v_count {
-            let r = parent[v];
+        for (v, &r) in parent.iter().enumerate() {
             for &u in adjacency.neighbours(v) {
                 let q = parent[u as usize];
                 if q != r {
