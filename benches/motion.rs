@@ -196,7 +196,7 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
                 .fold(0.0, f64::max)
         });
     println!(
-        "{name:<22} {label:<10} {:>6} {:>5} {:>4} {:>4} {:>8.5} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
+        "{name:<22} {label:<10} {:>6} {:>5} {:>4} {:>4} {:>8.5} {:>12.4e} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
         mesh.vertex_count(),
         mesh.frame_count(),
         partition.clusters(),
