@@ -56,6 +56,9 @@
 //!
 //! At the K decimation found, k-means (`CLUSTERS=K`) predicts worse on all five: 7.76e-6 (chicken,
 //! K = 65 after dissolving), 9.35e-5, 2.79e-5, 2.51e-3, 3.06e-4 (horse-collapse, 32.7 s).
+//! BrainStem (34159 × 1310, frames subsampled to 58): K = 391, its welded components (each moves
+//! rigidly, E_l ≈ 0), in 2.5 s (segmentation only: not encoded, so the partition coder's path for
+//! more than 256 clusters is untested by this).
 
 use super::refine::refine_borders;
 use super::segment::{compact, feature_frames, welded_adjacency, Partition, SampledMotion};
