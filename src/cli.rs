@@ -62,14 +62,21 @@ pub struct EncodeArgs {
     /// MPEG-4 quantiser 1..31 (lower = better); overrides --quality for mpeg4.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=31))]
     pub qscale: Option<u8>,
-    /// Number of motion clusters K.
-    #[arg(long, default_value_t = 20)]
-    pub clusters: usize,
+    /// Number of motion clusters K for k-means (default 20).
+    #[arg(long)]
+    pub clusters: Option<usize>,
+    /// Motion segmentation: k-means with K = --clusters, or decimation, which finds K itself.
+    #[arg(long, value_enum, default_value_t = SegmentationChoice::Kmeans)]
+    pub segmentation: SegmentationChoice,
+    /// Decimation's error threshold E0: RMS affine-fit error per vertex and frame, as a fraction of
+    /// the bounding-box diagonal (default 0.003, the paper's).
+    #[arg(long)]
+    pub e0: Option<f64>,
     /// Bits per quantised affine coefficient.
     #[arg(long, default_value_t = 17)]
     pub affine_bits: u8,
     /// Geometry-image lattice: WIDTHxHEIGHT (multiples of 16), or `auto` to size it from the
-    /// vertex count (about 28 pixels per vertex; 256x256 for 2341..8192 vertices, more above).
+    /// vertex count (about 28 pixels per vertex; 256x256 for 2341..8738 vertices, more above).
     /// Grown until the charts fit.
     #[arg(long, default_value = "auto")]
     pub lattice: String,
@@ -96,6 +103,15 @@ pub struct EncodeArgs {
     /// How to read the input.
     #[command(flatten)]
     pub input_args: InputArgs,
+}
+
+/// The motion segmentations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SegmentationChoice {
+    /// k-means on per-vertex affine motion, K = --clusters (MCGV).
+    Kmeans,
+    /// Half-edge collapses by affine-motion cost until the error reaches --e0 (skinning paper).
+    Decimation,
 }
 
 /// The residual image codecs.

@@ -1,7 +1,7 @@
 //! `mcgv-video encode`.
 
-use crate::cli::{CodecChoice, EncodeArgs, PredictorChoice};
-use crate::encoder::{self, EncodeOptions, Lattice};
+use crate::cli::{CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
+use crate::encoder::{self, EncodeOptions, Lattice, Segmentation};
 use crate::error::{Error, Result};
 use crate::mesh::read_animation;
 use crate::motion::PredictorKind;
@@ -20,6 +20,28 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         ),
         None => None,
     };
+    let segmentation = match args.segmentation {
+        SegmentationChoice::Kmeans => {
+            if args.e0.is_some() {
+                return Err(Error::Usage(
+                    "--e0 applies to --segmentation decimation only".into(),
+                ));
+            }
+            Segmentation::KMeans
+        }
+        SegmentationChoice::Decimation => {
+            if args.clusters.is_some() {
+                return Err(Error::Usage(
+                    "--clusters applies to --segmentation kmeans only: decimation finds K from --e0"
+                        .into(),
+                ));
+            }
+            Segmentation::Decimation {
+                e0: args.e0.unwrap_or(crate::motion::DEFAULT_E0),
+            }
+        }
+    };
+    let defaults = EncodeOptions::default();
     Ok(EncodeOptions {
         codec: match args.codec {
             CodecChoice::Jpeg => CodecKind::Jpeg,
@@ -27,7 +49,8 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         },
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
         qscale: args.qscale,
-        clusters: args.clusters,
+        clusters: args.clusters.unwrap_or(defaults.clusters),
+        segmentation,
         affine_bits: args.affine_bits,
         lattice,
         padding,
@@ -38,7 +61,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             PredictorChoice::Skinning => PredictorKind::Skinning,
         },
         weight_bits: args.weight_bits,
-        ..EncodeOptions::default()
+        ..defaults
     })
 }
 
@@ -94,13 +117,15 @@ pub fn run(args: &EncodeArgs, quiet: bool) -> Result<()> {
         println!("{value}");
     } else if !quiet {
         println!(
-            "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters, {} predictor, {} charts), {:.1} s ({:.1} frames/s)",
+            "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters by {} in {:.2} s, {} predictor, {} charts), {:.1} s ({:.1} frames/s)",
             args.output.display(),
             r.bytes,
             r.bpvf,
             r.header.vertices,
             r.header.frames,
             r.header.clusters,
+            r.segmentation.method,
+            r.segmentation.seconds,
             r.header.predictor.name(),
             r.charts,
             seconds,

@@ -215,6 +215,8 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             quality: header.quality,
             qscale: Some(header.qscale).filter(|&q| q > 0),
             clusters: header.requested_clusters as usize,
+            // Unused: the analysis below takes the stream's own partition.
+            segmentation: encoder::Segmentation::KMeans,
             affine_bits: header.affine_bits,
             first_frame_bits: header.first_frame_bits,
             lattice: Lattice::Fixed(header.lattice_width, header.lattice_height),
@@ -243,7 +245,14 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             Some(p) => mesh.permuted(p)?,
             None => mesh,
         };
-        let analysis = encoder::analyse(&mesh, ff.decoded_positions, &opts)?;
+        // The stream's partition, not a re-run segmentation: decimation's K is not in the options,
+        // and the images must be those of the clusters the stream was coded with.
+        let analysis = encoder::analyse_partition(
+            &mesh,
+            ff.decoded_positions,
+            decoder.partition().clone(),
+            &opts,
+        )?;
         let fixed = analysis.atlas.fixed_mask();
         for &f in &frames {
             // Raw: the quantised residuals on the pixels that carry data, free pixels black.

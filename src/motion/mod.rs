@@ -1,12 +1,14 @@
-//! Motion analysis (MCGV §3.1–3.2): segmentation of the vertices by affine motion, the piecewise
-//! affine predictor of every frame from the decoded frame 0, the skinning predictor of the follow-up
-//! paper (§3.2, eq. 7–10) that blends neighbouring clusters' maps per vertex, and the residuals.
+//! Motion analysis (MCGV §3.1–3.2): segmentation of the vertices by affine motion (k-means, or the
+//! skinning paper's decimation), the piecewise affine predictor of every frame from the decoded
+//! frame 0, the skinning predictor of the follow-up paper (§3.2, eq. 7–10) that blends
+//! neighbouring clusters' maps per vertex, and the residuals.
 //!
 //! ```text
-//! segment(mesh) ─► Partition ─► AffineTrack::fit(frames, decoded frame 0) ─► predict(i) ─► residuals
+//! segment(mesh) | decimate(mesh) ─► Partition ─► AffineTrack::fit(frames, decoded frame 0) ─► predict(i) ─► residuals
 //! ```
 
 mod affine;
+mod decimate;
 mod fit;
 mod predict;
 mod refine;
@@ -15,6 +17,7 @@ mod segment;
 mod skinning;
 
 pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_BITS};
+pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
 pub use fit::AffineCoefficients;
 pub use predict::{energy, residuals};
 pub use render::render_partition_png;

@@ -85,14 +85,15 @@ pub(super) fn assign_by_trajectory(
 }
 
 /// Moves cluster borders to lower the prediction error, keeping clusters spatially coherent: a
-/// vertex may only join a cluster one of its neighbours is in, and a connected component lying
-/// wholly in one cluster may move as a whole to any cluster.
+/// vertex may only join a cluster one of its neighbours is in, and (with `move_components`) a
+/// connected component lying wholly in one cluster may move as a whole to any cluster.
 pub(super) fn refine_borders(
     labels: &mut Vec<usize>,
     adjacency: &VertexAdjacency,
     motion: &SampledMotion,
     k: usize,
     passes: usize,
+    move_components: bool,
 ) {
     let (component, component_count) = adjacency.components();
     for _ in 0..passes {
@@ -130,7 +131,7 @@ pub(super) fn refine_borders(
             component_count,
         );
         for (c, vertices) in members.iter().enumerate() {
-            if single[c].is_none() || vertices.is_empty() {
+            if !move_components || single[c].is_none() || vertices.is_empty() {
                 continue;
             }
             let best = (0..k)

@@ -173,7 +173,14 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
         assign_by_trajectory(&mut labels, &inliers, &sampled, k);
     }
     if opts.refine_passes > 0 {
-        refine_borders(&mut labels, &adjacency, &sampled, k, opts.refine_passes);
+        refine_borders(
+            &mut labels,
+            &adjacency,
+            &sampled,
+            k,
+            opts.refine_passes,
+            true,
+        );
     }
     let labels = dissolve_small_clusters(labels, &features, model.centroids(), k);
     compact(labels)
@@ -187,7 +194,7 @@ const MAX_WELD_GROUP: usize = 8;
 /// that stay together (within float noise) in every sampled frame. Exporters split vertices along
 /// UV and normal seams (glTF meshes often fall into dozens of pieces, a triangle soup at worst);
 /// without these edges the rings would stop at every seam, down to a lone flat triangle.
-fn welded_adjacency(mesh: &AnimatedMesh, motion: &SampledMotion) -> VertexAdjacency {
+pub(super) fn welded_adjacency(mesh: &AnimatedMesh, motion: &SampledMotion) -> VertexAdjacency {
     let mut groups: std::collections::HashMap<[u32; 3], Vec<u32>> =
         std::collections::HashMap::new();
     for (v, p) in mesh.frame(0).iter().enumerate() {
@@ -226,7 +233,8 @@ pub(super) struct SampledMotion {
 }
 
 impl SampledMotion {
-    fn new(mesh: &AnimatedMesh, wanted: usize) -> Self {
+    /// Frame 0 and up to `wanted` evenly spread frames (see [`feature_frames`]), in unit coordinates.
+    pub(super) fn new(mesh: &AnimatedMesh, wanted: usize) -> Self {
         let unit = UnitFrame::of(mesh.frame(0));
         let to_unit = |f: &[crate::mesh::Point]| f.iter().map(|p| unit.to_unit(p)).collect();
         Self {
@@ -315,7 +323,7 @@ fn motion_features(
 }
 
 /// Up to `wanted` frames spread evenly over `1..frame_count` (frame 0 is the identity for every vertex).
-fn feature_frames(frame_count: usize, wanted: usize) -> Vec<usize> {
+pub(super) fn feature_frames(frame_count: usize, wanted: usize) -> Vec<usize> {
     if frame_count <= 1 {
         return vec![0];
     }
@@ -389,7 +397,7 @@ fn dissolve_small_clusters(
 }
 
 /// Renumbers labels `0..n` in order of first appearance.
-fn compact(labels: Vec<usize>) -> Result<Partition> {
+pub(super) fn compact(labels: Vec<usize>) -> Result<Partition> {
     let mut map = std::collections::HashMap::new();
     let compact: Vec<u32> = labels
         .into_iter()

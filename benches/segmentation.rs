@@ -1,0 +1,215 @@
+//! Segmentation and piecewise affine prediction on real sequences: K, residual energy against raw
+//! motion energy, largest residual, and the time of each stage — for k-means (K = 20) and for
+//! decimation (K found from E0 = 0.003), one row each.
+//!
+//! `cargo bench --bench segmentation [-- INPUT ...]` (any input `read_animation` takes); with no arguments,
+//! every sequence found under
+//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
+//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`,
+//! `CLUSTERS` k-means' K, `E0` decimation's threshold, and `SEGMENTATION=kmeans|decimation` runs one
+//! method only; `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
+//! The `E_l` column is decimation's RMS affine-fit error per vertex and frame over the bbox diagonal;
+//! `K0` is the K its collapses alone left, before border refinement (`DECIMATE_REFINE` sets its rounds).
+
+use mcgv_video::mesh::{read_animation, ReadOptions};
+use mcgv_video::motion::{
+    decimate, energy, render_partition_png, residuals, segment, AffineTrack, DecimateOptions,
+    Partition, SegmentOptions, DEFAULT_AFFINE_BITS,
+};
+use mcgv_video::AnimatedMesh;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let inputs: Vec<PathBuf> = if args.is_empty() {
+        default_inputs()
+    } else {
+        args.iter().map(PathBuf::from).collect()
+    };
+    println!(
+        "{:<22} {:<10} {:>6} {:>5} {:>4} {:>4} {:>8} {:>12} {:>10} {:>11} {:>9} {:>9}",
+        "sequence",
+        "method",
+        "V",
+        "F",
+        "K",
+        "K0",
+        "E_l",
+        "resid/motion",
+        "max % diag",
+        "quant % diag",
+        "segment s",
+        "predict s"
+    );
+    for input in inputs {
+        // Sequences are named by their folder: `pdance`, `walking_cat/OBJ` → walking_cat, `…/Fox/headA.glb` → the folder.
+        let folder = if input.is_file() || input.ends_with("OBJ") {
+            input.parent().unwrap_or(&input)
+        } else {
+            &input
+        };
+        let name = folder.file_name().map_or_else(
+            || input.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
+        let which = std::env::var("SEGMENTATION").unwrap_or_default();
+        match load(&input) {
+            Ok(mesh) => {
+                if which.is_empty() || which == "kmeans" {
+                    measure(&name, &mesh, Method::KMeans);
+                }
+                if which.is_empty() || which == "decimation" {
+                    measure(&name, &mesh, Method::Decimation);
+                }
+            }
+            Err(e) => println!("{name:<22} skipped: {e}"),
+        }
+    }
+}
+
+fn default_inputs() -> Vec<PathBuf> {
+    let unpacked = Path::new("/work/media-unpacked");
+    let mut inputs: Vec<PathBuf> = [
+        "chickenCrossing",
+        "pcow",
+        "pdance",
+        "horse-gallop",
+        "horse-collapse",
+    ]
+    .iter()
+    .map(|n| unpacked.join(n))
+    .collect();
+    let shared = Path::new("/work/shared/media");
+    inputs.push(shared.join("walking_cat/OBJ"));
+    for glb in [
+        "khronos_RiggedSimple/robeA.glb",
+        "khronos_RiggedFigure/bodyC.glb",
+        "khronos_Fox/headA.glb",
+        "khronos_CesiumMan/bodyA.glb",
+        "khronos_BrainStem/BrainStem.glb",
+        "threejs_Horse/Horse.glb",
+        "threejs_Flamingo/Flamingo.glb",
+        "threejs_Parrot/Parrot.glb",
+        "threejs_Stork/Stork.glb",
+    ] {
+        inputs.push(shared.join(glb));
+    }
+    inputs.into_iter().filter(|p| p.exists()).collect()
+}
+
+/// A segmentation option overridden from the environment.
+fn knob<T: std::str::FromStr>(name: &str) -> Option<T> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
+#[derive(Clone, Copy)]
+enum Method {
+    KMeans,
+    Decimation,
+}
+
+/// The partition of one method, with decimation's E_l and K before refinement (NaN, 0 for k-means).
+fn partition_by(
+    mesh: &AnimatedMesh,
+    method: Method,
+) -> mcgv_video::Result<(Partition, f64, usize)> {
+    match method {
+        Method::KMeans => {
+            let defaults = SegmentOptions::default();
+            let opts = SegmentOptions {
+                clusters: knob("CLUSTERS").unwrap_or(defaults.clusters),
+                refine_passes: knob("REFINE").unwrap_or(defaults.refine_passes),
+                feature_frames: knob("FEATURE_FRAMES").unwrap_or(defaults.feature_frames),
+                max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
+                ..defaults
+            };
+            Ok((segment(mesh, &opts)?, f64::NAN, 0))
+        }
+        Method::Decimation => {
+            let defaults = DecimateOptions::default();
+            let opts = DecimateOptions {
+                e0: knob("E0").unwrap_or(defaults.e0),
+                refine_passes: knob("DECIMATE_REFINE").unwrap_or(defaults.refine_passes),
+                ..defaults
+            };
+            let d = decimate(mesh, &opts)?;
+            Ok((d.partition, d.error, d.decimated_clusters))
+        }
+    }
+}
+
+fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
+    let label = match method {
+        Method::KMeans => "kmeans",
+        Method::Decimation => "decimation",
+    };
+    let start = Instant::now();
+    let (partition, fit_error, plain_k) = match partition_by(mesh, method) {
+        Ok(p) => p,
+        Err(e) => return println!("{name:<22} {label:<10} segmentation failed: {e}"),
+    };
+    let segment_time = start.elapsed().as_secs_f64();
+    if let Ok(dir) = std::env::var("PICTURES") {
+        let path = Path::new(&dir).join(format!("{name}-{label}.png"));
+        let (frame0, labels) = (mesh.frame(0), partition.labels());
+        if let Err(e) = render_partition_png(frame0, mesh.triangles(), labels, 512, &path) {
+            println!("{name}: picture not written: {e}");
+        }
+    }
+
+    // The reference is the original frame 0: the decoded one is not available to this stage alone.
+    let start = Instant::now();
+    let reference = mesh.frame(0);
+    let track = match AffineTrack::fit(mesh.frames(), reference, &partition, DEFAULT_AFFINE_BITS) {
+        Ok(t) => t,
+        Err(e) => return println!("{name:<22} {label:<10} prediction failed: {e}"),
+    };
+    let mut residual_energy = 0.0;
+    let mut motion_energy = 0.0;
+    let mut largest = 0f64;
+    for f in 0..mesh.frame_count() {
+        let predicted = track.predict(f, reference, &partition);
+        let e = residuals(mesh.frame(f), &predicted);
+        residual_energy += energy(&e);
+        motion_energy += energy(&residuals(mesh.frame(f), reference));
+        largest = e
+            .iter()
+            .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+            .fold(largest, f64::max);
+    }
+    let predict_time = start.elapsed().as_secs_f64();
+    // What quantisation alone costs: the 17-bit prediction against a (nearly) unquantised one.
+    let quantisation =
+        AffineTrack::fit(mesh.frames(), reference, &partition, 30).map_or(f64::NAN, |fine| {
+            (0..mesh.frame_count())
+                .flat_map(|f| {
+                    residuals(
+                        &track.predict(f, reference, &partition),
+                        &fine.predict(f, reference, &partition),
+                    )
+                })
+                .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+                .fold(0.0, f64::max)
+        });
+    println!(
+        "{name:<22} {label:<10} {:>6} {:>5} {:>4} {:>4} {:>8.5} {:>12.4e} {:>10.3} {:>11.5} {:>9.3} {:>9.3}",
+        mesh.vertex_count(),
+        mesh.frame_count(),
+        partition.clusters(),
+        plain_k,
+        fit_error,
+        residual_energy / motion_energy.max(f64::MIN_POSITIVE),
+        100.0 * largest / mesh.bbox_diagonal(),
+        100.0 * quantisation / mesh.bbox_diagonal(),
+        segment_time,
+        predict_time
+    );
+}
+
+fn load(input: &Path) -> mcgv_video::Result<AnimatedMesh> {
+    read_animation(&input.to_string_lossy(), &ReadOptions::default())
+}

@@ -1,0 +1,115 @@
+//! `encode --segmentation decimation` through the binary: the report, the stream, `inspect`, and
+//! the options that do not belong together.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
+}
+
+fn media(name: &str) -> String {
+    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    serde_json::from_str(ok(out).trim()).expect("one JSON object")
+}
+
+fn grey(path: &Path) -> Vec<u8> {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_luma8()
+        .into_raw()
+}
+
+#[test]
+fn decimation_reports_k_and_time_and_inspect_uses_the_streams_clusters() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let stream = dir.path().join("s.mcgv");
+    let s = stream.to_str().expect("utf-8 path");
+    let sample = media("RiggedSimple.glb");
+    let enc = json(&run(&[
+        "encode",
+        &sample,
+        "-o",
+        s,
+        "--quiet",
+        "--json",
+        "--padding",
+        "cg",
+        "--segmentation",
+        "decimation",
+        "--e0",
+        "0.003",
+    ]));
+    let seg = &enc["segmentation"];
+    assert_eq!(seg["method"], "decimation", "{enc}");
+    let k = seg["clusters"].as_u64().expect("clusters");
+    assert_eq!(enc["header"]["clusters"].as_u64(), Some(k));
+    assert!(k >= seg["components"].as_u64().expect("components"));
+    assert!(seg["seconds"].as_f64().expect("seconds") >= 0.0);
+    assert!(seg["error"].as_f64().expect("error") <= 0.003);
+    let stages = enc["stage_seconds"].as_array().expect("stages");
+    assert!(stages.iter().any(|s| s[0] == "segmentation"), "{enc}");
+
+    let info = json(&run(&["inspect", s, "--json"]));
+    assert_eq!(info["clusters"].as_u64(), Some(k));
+
+    // inspect re-runs the analysis with the stream's own partition: the padded images it derives
+    // are what was coded, so they match the decoded ones up to JPEG loss (a different partition
+    // would give a different atlas and images nothing alike).
+    let png = dir.path().join("png");
+    let p = png.to_str().expect("utf-8 path");
+    ok(&run(&["inspect", s, "--png", p, "--original", &sample]));
+    let padded = grey(&png.join("frame_0000_padded.png"));
+    let decoded = grey(&png.join("frame_0000_decoded.png"));
+    assert_eq!(padded.len(), decoded.len());
+    let mean = padded
+        .iter()
+        .zip(&decoded)
+        .map(|(&a, &b)| (a as f64 - b as f64).abs())
+        .sum::<f64>()
+        / padded.len() as f64;
+    assert!(
+        mean < 3.0,
+        "padded vs decoded differ by {mean} levels on average"
+    );
+}
+
+#[test]
+fn options_of_the_other_segmentation_are_refused() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let out = dir.path().join("s.mcgv");
+    let o = out.to_str().expect("utf-8 path");
+    let sample = media("RiggedSimple.glb");
+    for (args, needle) in [
+        (
+            vec!["--segmentation", "decimation", "--clusters", "5"],
+            "--clusters",
+        ),
+        (vec!["--e0", "0.01"], "--e0"),
+        (vec!["--segmentation", "decimation", "--e0", "0"], "--e0"),
+        (vec!["--segmentation", "decimation", "--e0=-1"], "--e0"),
+    ] {
+        let mut all = vec!["encode", sample.as_str(), "-o", o, "--quiet"];
+        all.extend(args.iter().copied());
+        let res = run(&all);
+        assert_eq!(res.status.code(), Some(1), "{all:?} should fail");
+        let err = String::from_utf8_lossy(&res.stderr);
+        assert!(err.contains(needle), "{all:?}: {err}");
+        assert!(!out.exists(), "{all:?} left a file");
+    }
+}
