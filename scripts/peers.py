@@ -7,7 +7,8 @@ Usage (with the virtualenv `make venv` makes):
   peers.py decode CODEC STREAM OUT.pc2            one decoding (writes OUT.obj, the faces, beside it)
 
 Environment for `run`: MCGV_BIN (default target/release/mcgv-video), PEERS_WORK (scratch folder,
-default bench-out/peers-work), PEERS_CODECS (default "draco zstd pca dynapack").
+default bench-out/peers-work), PEERS_CODECS (default "draco zstd pca dynapack"), PEERS_DRACO_QP (default "8 10 12 14 16": Draco
+is the slowest peer to measure, see below).
 
 Each input is first rewritten losslessly by `mcgv-video convert` as a PC2 + base OBJ, so every codec
 starts from exactly the frames mcgv-video reads (glTF baked by the same code). Each encoding and each
@@ -52,7 +53,7 @@ import zstandard
 SCHEMA = ("sequence,codec,setting,bytes,bpvf,rmse,vertex_rmse,kg_error,hausdorff,encode_s,decode_s,"
           "encode_cpu_s,decode_cpu_s,encode_rss_kb,decode_rss_kb,frames,vertices")
 SETTINGS = {
-    "draco": ["qp 8", "qp 10", "qp 12", "qp 14", "qp 16"],
+    "draco": [f"qp {q}" for q in os.environ.get("PEERS_DRACO_QP", "8 10 12 14 16").split()],
     "zstd": ["level 19"],
     "pca": ["basis 2", "basis 4", "basis 8", "basis 16", "basis 32", "basis 64"],
     "dynapack": ["qp 8", "qp 10", "qp 12", "qp 14", "qp 16"],
