@@ -8,7 +8,8 @@ Usage (with the virtualenv `make venv` makes):
 
 Environment for `run`: MCGV_BIN (default target/release/mcgv-video), PEERS_WORK (scratch folder,
 default bench-out/peers-work), PEERS_CODECS (default "draco zstd pca dynapack"), PEERS_DRACO_QP (default "8 10 12 14 16": Draco
-is the slowest peer to measure, see below).
+is the slowest peer to measure, see below), PEERS_SETTINGS (e.g. "dynapack=qp 6,qp 8;pca=basis 32":
+other settings for the codecs named).
 
 Each input is first rewritten losslessly by `mcgv-video convert` as a PC2 + base OBJ, so every codec
 starts from exactly the frames mcgv-video reads (glTF baked by the same code). Each encoding and each
@@ -58,6 +59,10 @@ SETTINGS = {
     "pca": ["basis 2", "basis 4", "basis 8", "basis 16", "basis 32", "basis 64"],
     "dynapack": ["qp 8", "qp 10", "qp 12", "qp 14", "qp 16"],
 }
+# PEERS_SETTINGS="dynapack=qp 6,qp 8;pca=basis 32" replaces the settings of the codecs it names.
+for _item in filter(None, os.environ.get("PEERS_SETTINGS", "").split(";")):
+    _codec, _, _list = _item.partition("=")
+    SETTINGS[_codec.strip()] = [x.strip() for x in _list.split(",") if x.strip()]
 ZSTD_LEVEL = 19
 
 
