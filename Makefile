@@ -6,8 +6,9 @@ PY := $(VENV)/bin/python
 CARGO ?= cargo
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PACKAGES := pkg-config clang libclang-dev libavcodec-dev libavformat-dev libavutil-dev \
-	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools time
-PY_PACKAGES := pymeshlab DracoPy numpy
+	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools time \
+	fonts-dejavu-core
+PY_PACKAGES := pymeshlab DracoPy numpy zstandard
 
 .PHONY: help deps apt-deps venv demo test bench fuzz clean
 
@@ -29,7 +30,8 @@ apt-deps:
 
 venv: $(VENV)/.done
 
-$(VENV)/.done:
+# Re-run when the Makefile (and so PY_PACKAGES) changes; pip skips what is already installed.
+$(VENV)/.done: Makefile
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install -q --disable-pip-version-check $(PY_PACKAGES)
 	touch $@

@@ -29,6 +29,8 @@ pub enum Command {
     Eval(EvalArgs),
     /// Print vertices, frames, faces, components, manifoldness and bounding box of an animation.
     Info(InfoArgs),
+    /// Rewrite an animation (any input form) losslessly as a PC2 + base OBJ or an OBJ folder.
+    Convert(ConvertArgs),
 }
 
 /// How to read an animation: options that apply to every input form.
@@ -196,6 +198,20 @@ pub struct InfoArgs {
     pub input_args: InputArgs,
 }
 
+/// `convert` arguments.
+#[derive(Debug, Args)]
+pub struct ConvertArgs {
+    /// The animation (any input form).
+    pub input: String,
+    /// Output: a file ending in .pc2 (the base OBJ with the faces is written beside it, same stem),
+    /// or a folder for an OBJ sequence (frame_0000.obj …).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// How to read the input.
+    #[command(flatten)]
+    pub input_args: InputArgs,
+}
+
 /// Runs the CLI and returns the process exit code: 0 on success, 1 on error (message on stderr),
 /// 2 on a usage error (clap's own).
 pub fn main() -> i32 {
@@ -218,6 +234,7 @@ pub fn main() -> i32 {
         Command::Inspect(a) => commands::inspect::run(a, cli.quiet),
         Command::Eval(a) => commands::eval::run(a, cli.quiet),
         Command::Info(a) => commands::info::run(a, cli.quiet),
+        Command::Convert(a) => commands::convert::run(a, cli.quiet),
     };
     match result {
         Ok(()) => 0,

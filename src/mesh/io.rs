@@ -79,6 +79,16 @@ pub fn write_obj_sequence_from(mesh: &AnimatedMesh, dir: &Path, first: usize) ->
     Ok(())
 }
 
+/// Writes one frame as an OBJ file (`v` lines in vertex order, then the triangles). Rust prints an
+/// `f32` with the fewest digits that read back to the same value, so the file is lossless.
+pub fn write_obj_frame(
+    triangles: &[super::Triangle],
+    positions: &[super::Point],
+    path: &Path,
+) -> Result<()> {
+    write_atomic(path, obj::obj_text(triangles, positions).as_bytes())
+}
+
 /// Writes the animation's positions as a PC2 point cache (start frame 0, one sample per frame).
 pub fn write_pc2(mesh: &AnimatedMesh, path: &Path) -> Result<()> {
     let bytes =

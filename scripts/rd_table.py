@@ -1,0 +1,196 @@
+#!/usr/bin/env python3
+"""Markdown tables for the README from bench CSVs (scripts/sweep.sh and scripts/peers.py rows).
+
+Usage: rd_table.py CSV... [--speed SEQUENCE] > table.md
+
+Per sequence: for each codec, the RMSE (x 1e-4 of the bbox diagonal) at the MCGV paper's rates 2.2,
+4 and 8 bpvf, read off the codec's rate-distortion frontier (its points no other of its points beats
+at a lower or equal rate) by linear interpolation in log(bpvf)-log(RMSE); "—" outside the measured
+range, never extrapolated. Then one line naming the rates at which mcgv-video (the better of its JPEG
+and MPEG-4 frontiers) has the lowest RMSE of all codecs measured there, and the peers that beat it
+elsewhere with the largest factor (rates where no peer was measured are left out). Last, speed and peak memory for the largest sequence (V x F),
+or for --speed SEQUENCE: whole-process figures as the CSV records them.
+Only standard-library Python, so it also runs outside the virtualenv.
+"""
+import csv
+import math
+import sys
+from collections import defaultdict
+
+PAPER_RATES = (2.2, 4.0, 8.0)
+OURS = ("jpeg", "mpeg4")
+GRID = 200  # rates per sequence at which codecs are compared for the closing line
+
+
+def die(message):
+    sys.exit(f"rd_table.py: error: {message}")
+
+
+def read(paths):
+    rows = []
+    for path in paths:
+        with open(path, newline="") as f:
+            reader = csv.DictReader(f)
+            for need in ("sequence", "codec", "setting", "bpvf", "rmse"):
+                if need not in (reader.fieldnames or []):
+                    die(f"{path}: no column {need}")
+            for r in reader:
+                r["bpvf"], r["rmse"] = float(r["bpvf"]), float(r["rmse"])
+                rows.append(r)
+    if not rows:
+        die("no rows")
+    return rows
+
+
+def frontier(points):
+    """Points (bpvf, rmse) sorted by rate, keeping only those with a lower RMSE than every cheaper one."""
+    best, out = math.inf, []
+    for b, e in sorted(points):
+        if e < best:
+            out.append((b, e))
+            best = e
+    return out
+
+
+def at_rate(front, rate):
+    """RMSE at `rate` by log-log interpolation on the frontier; None outside its range."""
+    if not front or rate < front[0][0] or rate > front[-1][0]:
+        return None
+    for (b0, e0), (b1, e1) in zip(front, front[1:]):
+        if b0 <= rate <= b1:
+            if e0 <= 0 or e1 <= 0:
+                return None
+            t = (math.log(rate) - math.log(b0)) / (math.log(b1) - math.log(b0))
+            return math.exp(math.log(e0) + t * (math.log(e1) - math.log(e0)))
+    return front[0][1] if rate == front[0][0] else None
+
+
+def e4(value):
+    return "—" if value is None else f"{value * 1e4:.3g}"
+
+
+def label(codec):
+    return f"mcgv-video {codec}" if codec in OURS else codec
+
+
+def sequence_section(name, rows):
+    by_codec = defaultdict(list)
+    for r in rows:
+        by_codec[r["codec"]].append((r["bpvf"], r["rmse"]))
+    frames, vertices = rows[0].get("frames", "?"), rows[0].get("vertices", "?")
+    out = [f"#### {name} (V = {vertices}, F = {frames})", "",
+           "| codec | points | bpvf measured | RMSE ×1e-4 at 2.2 | at 4 | at 8 | lowest RMSE ×1e-4 (at bpvf) |",
+           "|---|---|---|---|---|---|---|"]
+    fronts = {}
+    for codec in sorted(by_codec, key=lambda c: (c not in OURS, c)):
+        pts = by_codec[codec]
+        lo, hi = min(p[0] for p in pts), max(p[0] for p in pts)
+        if all(e == 0 for _, e in pts):
+            out.append(f"| {label(codec)} | {len(pts)} | {lo:.3g} | lossless | lossless | lossless | "
+                       f"0 (at {lo:.3g}) |")
+            continue
+        front = frontier([p for p in pts if p[1] > 0])
+        fronts[codec] = front
+        cells = " | ".join(e4(at_rate(front, r)) for r in PAPER_RATES)
+        best_b, best_e = min(pts, key=lambda p: (p[1], p[0]))
+        out.append(f"| {label(codec)} | {len(pts)} | {lo:.3g}–{hi:.3g} | {cells} | "
+                   f"{e4(best_e)} (at {best_b:.3g}) |")
+    lossless = min((b for c, pts in by_codec.items() for b, e in pts if e == 0), default=None)
+    out += ["", closing_line(fronts, lossless), ""]
+    return out
+
+
+def closing_line(fronts, lossless):
+    ours = {c: f for c, f in fronts.items() if c in OURS}
+    peers = {c: f for c, f in fronts.items() if c not in OURS}
+    if not ours:
+        return "No mcgv-video rows for this sequence."
+    lo = min(f[0][0] for f in ours.values())
+    hi = max(f[-1][0] for f in ours.values())
+    wins, losses = [], defaultdict(lambda: (0.0, None))   # peer -> (largest factor, at rate)
+    for i in range(GRID + 1):
+        rate = math.exp(math.log(lo) + (math.log(hi) - math.log(lo)) * i / GRID)
+        mine = [v for v in (at_rate(f, rate) for f in ours.values()) if v is not None]
+        if not mine:
+            continue
+        mine = min(mine)
+        theirs = {p: at_rate(f, rate) for p, f in peers.items()}
+        theirs = {p: v for p, v in theirs.items() if v is not None}
+        if not theirs:
+            continue    # no peer measured at this rate: no contest, no claim
+        if all(mine <= v for v in theirs.values()):
+            wins.append(rate)
+        for p, v in theirs.items():
+            if v < mine and mine / v > losses[p][0]:
+                losses[p] = (mine / v, rate)
+    text = []
+    if wins:
+        spans, start, prev = [], wins[0], wins[0]
+        step = math.exp((math.log(hi) - math.log(lo)) / GRID) * 1.0001
+        for r in wins[1:]:
+            if r > prev * step:
+                spans.append((start, prev))
+                start = r
+            prev = r
+        spans.append((start, prev))
+        text.append("mcgv-video has the lowest RMSE of all codecs at "
+                    + ", ".join(f"{a:.3g}–{b:.3g}" for a, b in spans) + " bpvf")
+    else:
+        text.append(f"mcgv-video ({lo:.3g}–{hi:.3g} bpvf measured) never has the lowest RMSE where a "
+                    "peer is measured at the same rate")
+    beaten = [f"{p} by up to {f:.3g}× lower RMSE (at {r:.3g} bpvf)" for p, (f, r) in
+              sorted(losses.items(), key=lambda kv: -kv[1][0])]
+    if beaten:
+        text.append("beaten by " + "; ".join(beaten))
+    if lossless is not None and hi >= lossless:
+        text.append(f"above {lossless:.3g} bpvf zstd is lossless")
+    return "; ".join(text) + "."
+
+
+def speed_section(name, rows):
+    out = [f"#### Speed and peak memory: {name} (V = {rows[0].get('vertices')}, "
+           f"F = {rows[0].get('frames')}), whole process (GNU time)", "",
+           "| codec | setting | bpvf | encode frames/s | decode frames/s | encode CPU s | decode CPU s "
+           "| encode peak MB | decode peak MB |", "|---|---|---|---|---|---|---|---|---|"]
+    frames = float(rows[0]["frames"])
+    for r in sorted(rows, key=lambda r: (r["codec"] not in OURS, r["codec"], r["bpvf"])):
+        def rate(key):
+            s = float(r[key]) if r.get(key) else 0
+            return f"{frames / s:.1f}" if s > 0 else "—"
+
+        def mb(key):
+            return f"{int(r[key]) / 1024:.0f}" if r.get(key) else "—"
+        out.append(f"| {label(r['codec'])} | {r['setting']} | {r['bpvf']:.3g} | {rate('encode_s')} | "
+                   f"{rate('decode_s')} | {r.get('encode_cpu_s') or '—'} | {r.get('decode_cpu_s') or '—'} | "
+                   f"{mb('encode_rss_kb')} | {mb('decode_rss_kb')} |")
+    return out + [""]
+
+
+def main():
+    args = sys.argv[1:]
+    speed = None
+    if "--speed" in args:
+        k = args.index("--speed")
+        speed = args[k + 1]
+        del args[k:k + 2]
+    if not args:
+        sys.exit(__doc__)
+    rows = read(args)
+    by_seq = defaultdict(list)
+    for r in rows:
+        by_seq[r["sequence"]].append(r)
+    lines = []
+    for name in sorted(by_seq, key=str.lower):
+        lines += sequence_section(name, by_seq[name])
+    if speed is None:
+        sized = [(int(r.get("vertices") or 0) * int(r.get("frames") or 0), s) for s, rs in by_seq.items()
+                 for r in rs[:1]]
+        speed = max(sized)[1]
+    if speed not in by_seq:
+        die(f"--speed {speed}: no such sequence in the CSVs")
+    lines += speed_section(speed, by_seq[speed])
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
