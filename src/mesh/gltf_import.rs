@@ -28,12 +28,38 @@ const MAX_INFLUENCE_SETS: u32 = 4;
 /// clip's keyframe rate if plausible, else 30).
 pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Result<AnimatedMesh> {
     let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
-    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(|e| match e {
+    let gltf = gltf::Gltf::open(path).map_err(|e| match e {
         gltf::Error::Io(io) => Error::io(path, io),
         other => fail(other.to_string()),
     })?;
-    let buffers = gltf::import_buffers(&document, path.parent(), blob)
-        .map_err(|e| fail(format!("buffer: {e}")))?;
+    bake(gltf, path.parent(), path, fps, clip)
+}
+
+/// Parses a `.gltf` or `.glb` held in memory and bakes it like [`read_gltf`]; `path` only names
+/// errors. Nothing is read from disk, so buffers must be embedded (GLB chunk or `data:` URI).
+pub(crate) fn parse_gltf(
+    bytes: &[u8],
+    path: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+) -> Result<AnimatedMesh> {
+    let gltf = gltf::Gltf::from_slice(bytes)
+        .map_err(|e| Error::Mesh(format!("{}: {e}", path.display())))?;
+    bake(gltf, None, path, fps, clip)
+}
+
+/// Bakes a parsed glTF; buffer files are looked up in `folder` (none: only embedded buffers).
+fn bake(
+    gltf: gltf::Gltf,
+    folder: Option<&Path>,
+    path: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+) -> Result<AnimatedMesh> {
+    let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
+    let gltf::Gltf { document, blob } = gltf;
+    let buffers =
+        gltf::import_buffers(&document, folder, blob).map_err(|e| fail(format!("buffer: {e}")))?;
     let data = buffers.as_slice();
 
     let scene = document
