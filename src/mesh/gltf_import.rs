@@ -35,6 +35,22 @@ pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Re
     bake(gltf, path.parent(), path, fps, clip)
 }
 
+/// The glTF file and the buffer files beside it that it refers to (those that can be told without
+/// reading them); an unreadable file is just itself, reading it reports the error.
+pub(crate) fn files(path: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = vec![path.to_path_buf()];
+    if let (Ok(gltf), Some(folder)) = (gltf::Gltf::open(path), path.parent()) {
+        for buffer in gltf.document.buffers() {
+            if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+                if !uri.contains(':') {
+                    out.push(folder.join(uri));
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Parses a `.gltf` or `.glb` held in memory and bakes it like [`read_gltf`]; `path` only names
 /// errors. Nothing is read from disk, so buffers must be embedded (GLB chunk or `data:` URI).
 pub(crate) fn parse_gltf(

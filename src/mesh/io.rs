@@ -56,6 +56,25 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
     }
 }
 
+/// Every file [`read_animation`] would read for `input`: the OBJ frames of a folder or glob, a PC2
+/// cache and its base OBJ, or the glTF file itself (with its external buffers, when they resolve).
+pub fn input_files(input: &str, opts: &ReadOptions) -> Result<Vec<PathBuf>> {
+    let path = Path::new(input);
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match extension.as_deref() {
+        Some("pc2") => Ok(vec![
+            path.to_path_buf(),
+            opts.base
+                .clone()
+                .unwrap_or_else(|| path.with_extension("obj")),
+        ]),
+        Some("gltf") | Some("glb") => Ok(gltf_import::files(path)),
+        _ => obj::frame_files(input),
+    }
+}
+
 /// Parses one OBJ held in memory as a one-frame animation; `name` only labels errors.
 pub fn parse_obj(text: &str, name: &Path) -> Result<AnimatedMesh> {
     let frame = obj::parse_obj(text, name)?;
