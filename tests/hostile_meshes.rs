@@ -167,7 +167,7 @@ fn round_trip(mesh: &AnimatedMesh, opts: &EncodeOptions, tolerance: f64) -> Vec<
 }
 
 proptest! {
-    #![proptest_config(cases(6))]
+    #![proptest_config(cases(12))]
     #[test]
     fn odd_meshes_round_trip(
         grids in proptest::collection::vec((2usize..5, 2usize..5), 1..4),

@@ -9,6 +9,7 @@
 
 use super::{AnimatedMesh, Point, Triangle};
 use crate::error::{Error, Result};
+use gltf::accessor::{DataType, Dimensions};
 use gltf::animation::util::ReadOutputs;
 use gltf::animation::{Interpolation, Property};
 use nalgebra::{Matrix4, Quaternion, UnitQuaternion, Vector3, Vector4};
@@ -74,6 +75,16 @@ fn bake(
 ) -> Result<AnimatedMesh> {
     let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
     let gltf::Gltf { document, blob } = gltf;
+    for buffer in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+            if !uri.contains(':') && !percent_decodes_to_utf8(uri) {
+                return Err(fail(format!(
+                    "buffer {}: the file name {uri:?} is not valid percent-encoded UTF-8",
+                    buffer.index()
+                )));
+            }
+        }
+    }
     let buffers =
         gltf::import_buffers(&document, folder, blob).map_err(|e| fail(format!("buffer: {e}")))?;
     let data = buffers.as_slice();
@@ -164,6 +175,61 @@ struct Channel {
     width: usize,
 }
 
+/// The gltf crate's readers take an accessor's element type from its use and only debug-assert (or
+/// `unreachable!`) that the file agrees; a file that lies about it must be an error, not a panic or
+/// a misread.
+fn check_accessor(
+    accessor: Option<gltf::Accessor>,
+    what: &str,
+    dimensions: Dimensions,
+    types: &[DataType],
+) -> Result<(), String> {
+    match accessor {
+        Some(a) if a.dimensions() != dimensions || !types.contains(&a.data_type()) => Err(format!(
+            "{what}: accessor {} holds {:?} {:?}, expected {dimensions:?} of {types:?}",
+            a.index(),
+            a.dimensions(),
+            a.data_type()
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Whether a relative URI percent-decodes to UTF-8: gltf 1.4 unwraps that decoding, so a file naming
+/// a buffer `%FF` would panic inside `import_buffers`. Decodes as the `urlencoding` crate does: a `%`
+/// not followed by two hex digits stays as it is.
+fn percent_decodes_to_utf8(uri: &str) -> bool {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (bytes[i], hex) {
+            (b'%', Some(b)) => {
+                out.push(b);
+                i += 3;
+            }
+            (b, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(out).is_ok()
+}
+
+/// Component types glTF allows for rotations and morph weights (floats or normalised integers).
+const NORMALISED: [DataType; 5] = [
+    DataType::F32,
+    DataType::I8,
+    DataType::U8,
+    DataType::I16,
+    DataType::U16,
+];
+
 fn read_channels<'a>(
     animation: &gltf::Animation<'a>,
     data: Buffers,
@@ -175,6 +241,24 @@ fn read_channels<'a>(
             animation.index(),
             channel.index()
         );
+        let sampler = channel.sampler();
+        check_accessor(
+            Some(sampler.input()),
+            &format!("{name} key times"),
+            Dimensions::Scalar,
+            &[DataType::F32],
+        )?;
+        let (dimensions, types): (Dimensions, &[DataType]) = match channel.target().property() {
+            Property::Translation | Property::Scale => (Dimensions::Vec3, &[DataType::F32]),
+            Property::Rotation => (Dimensions::Vec4, &NORMALISED),
+            Property::MorphTargetWeights => (Dimensions::Scalar, &NORMALISED),
+        };
+        check_accessor(
+            Some(sampler.output()),
+            &format!("{name} values"),
+            dimensions,
+            types,
+        )?;
         let reader = channel.reader(|b| buffer_data(data, b));
         let times: Vec<f32> = reader
             .read_inputs()
@@ -459,6 +543,12 @@ fn read_skins(document: &gltf::Document, data: Buffers) -> Result<Vec<Skin>, Str
         .skins()
         .map(|skin| {
             let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+            check_accessor(
+                skin.inverse_bind_matrices(),
+                &format!("skin {} inverse bind matrices", skin.index()),
+                Dimensions::Mat4,
+                &[DataType::F32],
+            )?;
             let inverse_bind: Vec<Matrix4<f64>> = match skin
                 .reader(|b| buffer_data(data, b))
                 .read_inverse_bind_matrices()
@@ -541,6 +631,12 @@ impl Geometry {
                         range
                     }
                 };
+                check_accessor(
+                    primitive.indices(),
+                    &format!("{name} indices"),
+                    Dimensions::Scalar,
+                    &[DataType::U8, DataType::U16, DataType::U32],
+                )?;
                 let reader = primitive.reader(|b| buffer_data(data, b));
                 let indices: Vec<u32> = match reader.read_indices() {
                     Some(it) => it.into_u32().collect(),
@@ -696,6 +792,31 @@ impl Part {
                 "{name}: positions in accessor {} are not float triples (quantised meshes are not supported)",
                 bad.index()
             ));
+        }
+        // Morph normals and tangents are not used, but reading the targets opens their accessors.
+        for target in primitive.morph_targets() {
+            for a in [target.normals(), target.tangents()] {
+                check_accessor(
+                    a,
+                    &format!("{name} morph target"),
+                    Dimensions::Vec3,
+                    &[DataType::F32],
+                )?;
+            }
+        }
+        for set in 0..MAX_INFLUENCE_SETS {
+            check_accessor(
+                primitive.get(&gltf::Semantic::Joints(set)),
+                &format!("{name} JOINTS_{set}"),
+                Dimensions::Vec4,
+                &[DataType::U8, DataType::U16],
+            )?;
+            check_accessor(
+                primitive.get(&gltf::Semantic::Weights(set)),
+                &format!("{name} WEIGHTS_{set}"),
+                Dimensions::Vec4,
+                &[DataType::F32, DataType::U8, DataType::U16],
+            )?;
         }
         let reader = primitive.reader(|b| buffer_data(data, b));
         let Some(positions) = reader.read_positions() else {
