@@ -158,3 +158,16 @@ fn a_huge_lattice_is_refused() {
     let msg = stream_error(bytes);
     assert!(msg.contains("65520x65520"), "{msg}");
 }
+
+#[test]
+fn a_glb_claiming_4_gb_is_refused_without_allocating_it() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz/glb-claims-4gb.glb");
+    assert_eq!(std::fs::metadata(&path).unwrap().len(), 12);
+    let err = mcgv_video::mesh::read_animation(path.to_str().unwrap(), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("GLB header gives a length of 4294967280 bytes"),
+        "{err}"
+    );
+}

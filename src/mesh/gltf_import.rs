@@ -28,19 +28,43 @@ const MAX_INFLUENCE_SETS: u32 = 4;
 /// Reads `path` and bakes the chosen clip (name or index, default the first) at `fps` (default the
 /// clip's keyframe rate if plausible, else 30).
 pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Result<AnimatedMesh> {
-    let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
-    let gltf = gltf::Gltf::open(path).map_err(|e| match e {
-        gltf::Error::Io(io) => Error::io(path, io),
-        other => fail(other.to_string()),
-    })?;
+    // Read whole and parsed from memory: gltf's own reader allocates what a GLB header claims (up to
+    // 4 GB for a 12-byte file) before reading it.
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let gltf = from_slice(&bytes, path)?;
     bake(gltf, path.parent(), path, fps, clip)
+}
+
+/// Parses glTF JSON or a GLB, after checking the GLB header's total length (gltf 1.4 subtracts
+/// the header size from it unchecked, which overflows for lengths under 12).
+fn from_slice(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
+    let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
+    if bytes.starts_with(b"glTF") {
+        let length = bytes
+            .get(8..12)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]) as usize);
+        match length {
+            Some(n) if (12..=bytes.len()).contains(&n) => {}
+            Some(n) => {
+                return Err(fail(format!(
+                    "GLB header gives a length of {n} bytes, the file has {} (at least 12 needed)",
+                    bytes.len()
+                )))
+            }
+            None => return Err(fail("GLB header is truncated".into())),
+        }
+    }
+    gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))
 }
 
 /// The glTF file and the buffer files beside it that it refers to (those that can be told without
 /// reading them); an unreadable file is just itself, reading it reports the error.
 pub(crate) fn files(path: &Path) -> Vec<std::path::PathBuf> {
     let mut out = vec![path.to_path_buf()];
-    if let (Ok(gltf), Some(folder)) = (gltf::Gltf::open(path), path.parent()) {
+    let gltf = std::fs::read(path)
+        .ok()
+        .and_then(|bytes| from_slice(&bytes, path).ok());
+    if let (Some(gltf), Some(folder)) = (gltf, path.parent()) {
         for buffer in gltf.document.buffers() {
             if let gltf::buffer::Source::Uri(uri) = buffer.source() {
                 if !uri.contains(':') {
@@ -60,8 +84,7 @@ pub(crate) fn parse_gltf(
     fps: Option<f64>,
     clip: Option<&str>,
 ) -> Result<AnimatedMesh> {
-    let gltf = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| Error::Mesh(format!("{}: {e}", path.display())))?;
+    let gltf = from_slice(bytes, path)?;
     bake(gltf, None, path, fps, clip)
 }
 
