@@ -12,6 +12,7 @@ use crate::error::{Error, Result};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::animation::util::ReadOutputs;
 use gltf::animation::{Interpolation, Property};
+use gltf::json::validation::Validate;
 use nalgebra::{Matrix4, Quaternion, UnitQuaternion, Vector3, Vector4};
 use std::collections::HashMap;
 use std::path::Path;
@@ -54,7 +55,36 @@ fn from_slice(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
             None => return Err(fail("GLB header is truncated".into())),
         }
     }
-    gltf::Gltf::from_slice(bytes).map_err(|e| fail(e.to_string()))
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
+    // gltf-json's validation looks up a primitive's POSITION accessor before checking the index
+    // (an out-of-range one panics), so indices are checked first and the validation run here.
+    let root = gltf.document.as_json();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for primitive in &mesh.primitives {
+            if let Some(bad) = primitive
+                .attributes
+                .values()
+                .find(|a| a.value() >= root.accessors.len())
+            {
+                return Err(fail(format!(
+                    "mesh {m}: attribute accessor {} does not exist ({} accessors)",
+                    bad.value(),
+                    root.accessors.len()
+                )));
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        errors.push(format!("{}: {error}", path()))
+    });
+    match errors.first() {
+        Some(first) => Err(fail(format!(
+            "invalid glTF ({} problems), first: {first}",
+            errors.len()
+        ))),
+        None => Ok(gltf),
+    }
 }
 
 /// The glTF file and the buffer files beside it that it refers to (those that can be told without
