@@ -244,8 +244,31 @@ fn check_accessor(
             a.dimensions(),
             a.data_type()
         )),
-        _ => Ok(()),
+        Some(a) => check_extent(&a, what),
+        None => Ok(()),
     }
+}
+
+/// An accessor must have elements and end inside its buffer view: gltf 1.4 computes its end as
+/// `offset + stride * (count - 1) + size` unchecked (overflow for count 0 or huge counts).
+fn check_extent(a: &gltf::Accessor, what: &str) -> Result<(), String> {
+    if a.count() == 0 {
+        return Err(format!("{what}: accessor {} has no elements", a.index()));
+    }
+    if let Some(view) = a.view() {
+        let stride = view.stride().unwrap_or(a.size());
+        let end = (a.count() - 1)
+            .checked_mul(stride)
+            .and_then(|n| n.checked_add(a.offset()))
+            .and_then(|n| n.checked_add(a.size()));
+        if end.is_none_or(|e| e > view.length()) {
+            return Err(format!(
+                "{what}: accessor {} runs past the end of its buffer view",
+                a.index()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Whether a relative URI percent-decodes to UTF-8: gltf 1.4 unwraps that decoding, so a file naming
@@ -836,15 +859,18 @@ impl Part {
             a.data_type() == gltf::accessor::DataType::F32
                 && a.dimensions() == gltf::accessor::Dimensions::Vec3
         };
-        let mut positions_accessors = primitive
+        let positions_accessors = primitive
             .get(&gltf::Semantic::Positions)
             .into_iter()
             .chain(primitive.morph_targets().filter_map(|t| t.positions()));
-        if let Some(bad) = positions_accessors.find(|a| !float_vec3(a)) {
-            return Err(format!(
-                "{name}: positions in accessor {} are not float triples (quantised meshes are not supported)",
-                bad.index()
-            ));
+        for a in positions_accessors {
+            if !float_vec3(&a) {
+                return Err(format!(
+                    "{name}: positions in accessor {} are not float triples (quantised meshes are not supported)",
+                    a.index()
+                ));
+            }
+            check_extent(&a, &format!("{name} positions"))?;
         }
         // Morph normals and tangents are not used, but reading the targets opens their accessors.
         for target in primitive.morph_targets() {
