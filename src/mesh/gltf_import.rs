@@ -257,6 +257,13 @@ fn check_extent(a: &gltf::Accessor, what: &str) -> Result<(), String> {
     }
     if let Some(view) = a.view() {
         let stride = view.stride().unwrap_or(a.size());
+        if stride < a.size() {
+            return Err(format!(
+                "{what}: accessor {} has elements of {} bytes in a buffer view of stride {stride}",
+                a.index(),
+                a.size()
+            ));
+        }
         let end = (a.count() - 1)
             .checked_mul(stride)
             .and_then(|n| n.checked_add(a.offset()))
