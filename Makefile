@@ -16,6 +16,7 @@ help:
 	@echo "make demo   encode a sample animation both ways and print size and error"
 	@echo "make test   format check, clippy, all tests"
 	@echo "make bench  rate-distortion and speed tables and plots (bench-out/)"
+	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
 	@echo "make deps   install Debian packages and the reference-tool virtualenv (done by demo/test)"
 
 deps: apt-deps venv
@@ -48,6 +49,38 @@ test: deps
 bench: deps
 	$(CARGO) build --release --quiet
 	MCGV_PYTHON=$(abspath $(PY)) bash scripts/bench.sh
+
+# libFuzzer through cargo-fuzz: a nightly toolchain when there is one (with AddressSanitizer), else the
+# stable compiler unlocked by RUSTC_BOOTSTRAP and no sanitizer (safe Rust needs none to find panics).
+# Seeds are small real streams and meshes made from media/; new inputs libFuzzer finds accumulate in
+# fuzz/corpus/TARGET, crashers land in fuzz/artifacts/TARGET (replay them with tests/fuzz_regressions.rs).
+# One process per target, overflow checks on, 10 s per input at most, 2 GB of memory at most.
+FUZZ_SECONDS ?= 300
+FUZZ_TARGETS ?= decode_stream read_mesh
+HAVE_NIGHTLY := $(shell rustup run nightly rustc --version >/dev/null 2>&1 && echo yes)
+ifeq ($(HAVE_NIGHTLY),yes)
+FUZZ_CARGO := $(CARGO) +nightly
+FUZZ_SANITIZER ?= address
+else
+FUZZ_CARGO := RUSTC_BOOTSTRAP=1 $(CARGO)
+FUZZ_SANITIZER ?= none
+endif
+
+fuzz: apt-deps
+	@command -v cargo-fuzz >/dev/null || $(CARGO) install cargo-fuzz --locked
+	$(CARGO) build --quiet
+	bash scripts/fuzz_seeds.sh target/debug/mcgv-video fuzz/seeds >/dev/null
+	@mkdir -p fuzz/logs; status=0; \
+	for t in $(FUZZ_TARGETS); do \
+		mkdir -p fuzz/corpus/$$t; \
+		echo "fuzzing $$t for $(FUZZ_SECONDS) s (log: fuzz/logs/$$t.log)"; \
+		$(FUZZ_CARGO) fuzz run --fuzz-dir fuzz -s $(FUZZ_SANITIZER) --debug-assertions $$t \
+			fuzz/corpus/$$t fuzz/seeds/$$t -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
+			-rss_limit_mb=2048 -print_final_stats=1 >fuzz/logs/$$t.log 2>&1 || status=1; \
+		grep -E "^(Done|stat::number_of_executed_units)|SUMMARY|panicked|deadly signal|out-of-memory|timeout" \
+			fuzz/logs/$$t.log | head -5; \
+	done; \
+	exit $$status
 
 clean:
 	$(CARGO) clean

@@ -370,9 +370,10 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
 }
 
 fn check_lattice(w: u16, h: u16) -> Result<()> {
-    if w == 0 || h == 0 || w % 16 != 0 || h % 16 != 0 || w > 4096 || h > 4096 {
+    let max = crate::stream::header::MAX_LATTICE_SIDE;
+    if w == 0 || h == 0 || w % 16 != 0 || h % 16 != 0 || w > max || h > max {
         return Err(Error::Usage(format!(
-            "lattice {w}x{h}: width and height must be multiples of 16 between 16 and 4096"
+            "lattice {w}x{h}: width and height must be multiples of 16 between 16 and {max}"
         )));
     }
     Ok(())

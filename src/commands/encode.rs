@@ -3,11 +3,12 @@
 use crate::cli::{CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::encoder::{self, EncodeOptions, Lattice, Segmentation};
 use crate::error::{Error, Result};
-use crate::mesh::read_animation;
+use crate::mesh::io::input_files;
+use crate::mesh::{read_animation, ReadOptions};
 use crate::motion::PredictorKind;
 use crate::progress;
 use crate::stream::header::CodecKind;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Parses the encode arguments into encoder options, rejecting nonsense with a clear message.
@@ -82,15 +83,24 @@ pub fn parse_lattice(s: &str) -> Result<Lattice> {
     ))
 }
 
-/// Refuses to write the output over the input.
-fn check_not_input(input: &str, output: &Path) -> Result<()> {
-    if let (Ok(a), Ok(b)) = (Path::new(input).canonicalize(), output.canonicalize()) {
-        if a == b {
-            return Err(Error::Usage(format!(
-                "refusing to overwrite the input {}",
-                output.display()
-            )));
-        }
+/// Refuses to write the output over the input or any file it is read from (a frame of an OBJ folder
+/// or glob, the base OBJ of a PC2 cache, a glTF's buffer), comparing canonical paths so that links
+/// and `./` spellings cannot sneak past. An output that does not exist yet cannot be an input.
+fn check_not_input(input: &str, opts: &ReadOptions, output: &Path) -> Result<()> {
+    let Ok(target) = output.canonicalize() else {
+        return Ok(());
+    };
+    let mut inputs = vec![PathBuf::from(input)];
+    // Listing fails for inputs that do not exist or are not readable; reading reports that.
+    inputs.extend(input_files(input, opts).unwrap_or_default());
+    if inputs
+        .iter()
+        .any(|p| p.canonicalize().is_ok_and(|p| p == target))
+    {
+        return Err(Error::Usage(format!(
+            "refusing to overwrite the input {}",
+            output.display()
+        )));
     }
     Ok(())
 }
@@ -98,10 +108,11 @@ fn check_not_input(input: &str, output: &Path) -> Result<()> {
 /// Runs `encode`.
 pub fn run(args: &EncodeArgs, quiet: bool) -> Result<()> {
     let opts = options(args)?;
-    check_not_input(&args.input, &args.output)?;
+    let read_options: ReadOptions = (&args.input_args).into();
+    check_not_input(&args.input, &read_options, &args.output)?;
     let start = Instant::now();
     let spin = progress::spinner("reading", quiet);
-    let mesh = read_animation(&args.input, &(&args.input_args).into())?;
+    let mesh = read_animation(&args.input, &read_options)?;
     spin.finish_and_clear();
     let pb = progress::bar(mesh.frame_count() as u64, "encode", quiet);
     let encoded = encoder::encode(&mesh, &opts, &pb)?;

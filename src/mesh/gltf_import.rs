@@ -9,8 +9,10 @@
 
 use super::{AnimatedMesh, Point, Triangle};
 use crate::error::{Error, Result};
+use gltf::accessor::{DataType, Dimensions};
 use gltf::animation::util::ReadOutputs;
 use gltf::animation::{Interpolation, Property};
+use gltf::json::validation::Validate;
 use nalgebra::{Matrix4, Quaternion, UnitQuaternion, Vector3, Vector4};
 use std::collections::HashMap;
 use std::path::Path;
@@ -27,13 +29,117 @@ const MAX_INFLUENCE_SETS: u32 = 4;
 /// Reads `path` and bakes the chosen clip (name or index, default the first) at `fps` (default the
 /// clip's keyframe rate if plausible, else 30).
 pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Result<AnimatedMesh> {
+    // Read whole and parsed from memory: gltf's own reader allocates what a GLB header claims (up to
+    // 4 GB for a 12-byte file) before reading it.
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let gltf = from_slice(&bytes, path)?;
+    bake(gltf, path.parent(), path, fps, clip)
+}
+
+/// Parses glTF JSON or a GLB, after checking the GLB header's total length (gltf 1.4 subtracts
+/// the header size from it unchecked, which overflows for lengths under 12).
+fn from_slice(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
     let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
-    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(|e| match e {
-        gltf::Error::Io(io) => Error::io(path, io),
-        other => fail(other.to_string()),
-    })?;
-    let buffers = gltf::import_buffers(&document, path.parent(), blob)
-        .map_err(|e| fail(format!("buffer: {e}")))?;
+    if bytes.starts_with(b"glTF") {
+        let length = bytes
+            .get(8..12)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]) as usize);
+        match length {
+            Some(n) if (12..=bytes.len()).contains(&n) => {}
+            Some(n) => {
+                return Err(fail(format!(
+                    "GLB header gives a length of {n} bytes, the file has {} (at least 12 needed)",
+                    bytes.len()
+                )))
+            }
+            None => return Err(fail("GLB header is truncated".into())),
+        }
+    }
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
+    // gltf-json's validation looks up a primitive's POSITION accessor before checking the index
+    // (an out-of-range one panics), so indices are checked first and the validation run here.
+    let root = gltf.document.as_json();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for primitive in &mesh.primitives {
+            if let Some(bad) = primitive
+                .attributes
+                .values()
+                .find(|a| a.value() >= root.accessors.len())
+            {
+                return Err(fail(format!(
+                    "mesh {m}: attribute accessor {} does not exist ({} accessors)",
+                    bad.value(),
+                    root.accessors.len()
+                )));
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        errors.push(format!("{}: {error}", path()))
+    });
+    match errors.first() {
+        Some(first) => Err(fail(format!(
+            "invalid glTF ({} problems), first: {first}",
+            errors.len()
+        ))),
+        None => Ok(gltf),
+    }
+}
+
+/// The glTF file and the buffer files beside it that it refers to (those that can be told without
+/// reading them); an unreadable file is just itself, reading it reports the error.
+pub(crate) fn files(path: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = vec![path.to_path_buf()];
+    let gltf = std::fs::read(path)
+        .ok()
+        .and_then(|bytes| from_slice(&bytes, path).ok());
+    if let (Some(gltf), Some(folder)) = (gltf, path.parent()) {
+        for buffer in gltf.document.buffers() {
+            if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+                if !uri.contains(':') {
+                    out.push(folder.join(uri));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Parses a `.gltf` or `.glb` held in memory and bakes it like [`read_gltf`]; `path` only names
+/// errors. Nothing is read from disk, so buffers must be embedded (GLB chunk or `data:` URI).
+pub(crate) fn parse_gltf(
+    bytes: &[u8],
+    path: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+) -> Result<AnimatedMesh> {
+    let gltf = from_slice(bytes, path)?;
+    bake(gltf, None, path, fps, clip)
+}
+
+/// Bakes a parsed glTF; buffer files are looked up in `folder` (none: only embedded buffers).
+fn bake(
+    gltf: gltf::Gltf,
+    folder: Option<&Path>,
+    path: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+) -> Result<AnimatedMesh> {
+    let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
+    let gltf::Gltf { document, blob } = gltf;
+    for buffer in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+            if !uri.contains(':') && !percent_decodes_to_utf8(uri) {
+                return Err(fail(format!(
+                    "buffer {}: the file name {uri:?} is not valid percent-encoded UTF-8",
+                    buffer.index()
+                )));
+            }
+        }
+    }
+    let buffers =
+        gltf::import_buffers(&document, folder, blob).map_err(|e| fail(format!("buffer: {e}")))?;
     let data = buffers.as_slice();
 
     let scene = document
@@ -122,6 +228,91 @@ struct Channel {
     width: usize,
 }
 
+/// The gltf crate's readers take an accessor's element type from its use and only debug-assert (or
+/// `unreachable!`) that the file agrees; a file that lies about it must be an error, not a panic or
+/// a misread.
+fn check_accessor(
+    accessor: Option<gltf::Accessor>,
+    what: &str,
+    dimensions: Dimensions,
+    types: &[DataType],
+) -> Result<(), String> {
+    match accessor {
+        Some(a) if a.dimensions() != dimensions || !types.contains(&a.data_type()) => Err(format!(
+            "{what}: accessor {} holds {:?} {:?}, expected {dimensions:?} of {types:?}",
+            a.index(),
+            a.dimensions(),
+            a.data_type()
+        )),
+        Some(a) => check_extent(&a, what),
+        None => Ok(()),
+    }
+}
+
+/// An accessor must have elements and end inside its buffer view: gltf 1.4 computes its end as
+/// `offset + stride * (count - 1) + size` unchecked (overflow for count 0 or huge counts).
+fn check_extent(a: &gltf::Accessor, what: &str) -> Result<(), String> {
+    if a.count() == 0 {
+        return Err(format!("{what}: accessor {} has no elements", a.index()));
+    }
+    if let Some(view) = a.view() {
+        let stride = view.stride().unwrap_or(a.size());
+        if stride < a.size() {
+            return Err(format!(
+                "{what}: accessor {} has elements of {} bytes in a buffer view of stride {stride}",
+                a.index(),
+                a.size()
+            ));
+        }
+        let end = (a.count() - 1)
+            .checked_mul(stride)
+            .and_then(|n| n.checked_add(a.offset()))
+            .and_then(|n| n.checked_add(a.size()));
+        if end.is_none_or(|e| e > view.length()) {
+            return Err(format!(
+                "{what}: accessor {} runs past the end of its buffer view",
+                a.index()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Whether a relative URI percent-decodes to UTF-8: gltf 1.4 unwraps that decoding, so a file naming
+/// a buffer `%FF` would panic inside `import_buffers`. Decodes as the `urlencoding` crate does: a `%`
+/// not followed by two hex digits stays as it is.
+fn percent_decodes_to_utf8(uri: &str) -> bool {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (bytes[i], hex) {
+            (b'%', Some(b)) => {
+                out.push(b);
+                i += 3;
+            }
+            (b, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(out).is_ok()
+}
+
+/// Component types glTF allows for rotations and morph weights (floats or normalised integers).
+const NORMALISED: [DataType; 5] = [
+    DataType::F32,
+    DataType::I8,
+    DataType::U8,
+    DataType::I16,
+    DataType::U16,
+];
+
 fn read_channels<'a>(
     animation: &gltf::Animation<'a>,
     data: Buffers,
@@ -133,6 +324,24 @@ fn read_channels<'a>(
             animation.index(),
             channel.index()
         );
+        let sampler = channel.sampler();
+        check_accessor(
+            Some(sampler.input()),
+            &format!("{name} key times"),
+            Dimensions::Scalar,
+            &[DataType::F32],
+        )?;
+        let (dimensions, types): (Dimensions, &[DataType]) = match channel.target().property() {
+            Property::Translation | Property::Scale => (Dimensions::Vec3, &[DataType::F32]),
+            Property::Rotation => (Dimensions::Vec4, &NORMALISED),
+            Property::MorphTargetWeights => (Dimensions::Scalar, &NORMALISED),
+        };
+        check_accessor(
+            Some(sampler.output()),
+            &format!("{name} values"),
+            dimensions,
+            types,
+        )?;
         let reader = channel.reader(|b| buffer_data(data, b));
         let times: Vec<f32> = reader
             .read_inputs()
@@ -417,6 +626,12 @@ fn read_skins(document: &gltf::Document, data: Buffers) -> Result<Vec<Skin>, Str
         .skins()
         .map(|skin| {
             let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+            check_accessor(
+                skin.inverse_bind_matrices(),
+                &format!("skin {} inverse bind matrices", skin.index()),
+                Dimensions::Mat4,
+                &[DataType::F32],
+            )?;
             let inverse_bind: Vec<Matrix4<f64>> = match skin
                 .reader(|b| buffer_data(data, b))
                 .read_inverse_bind_matrices()
@@ -499,6 +714,12 @@ impl Geometry {
                         range
                     }
                 };
+                check_accessor(
+                    primitive.indices(),
+                    &format!("{name} indices"),
+                    Dimensions::Scalar,
+                    &[DataType::U8, DataType::U16, DataType::U32],
+                )?;
                 let reader = primitive.reader(|b| buffer_data(data, b));
                 let indices: Vec<u32> = match reader.read_indices() {
                     Some(it) => it.into_u32().collect(),
@@ -645,15 +866,43 @@ impl Part {
             a.data_type() == gltf::accessor::DataType::F32
                 && a.dimensions() == gltf::accessor::Dimensions::Vec3
         };
-        let mut positions_accessors = primitive
+        let positions_accessors = primitive
             .get(&gltf::Semantic::Positions)
             .into_iter()
             .chain(primitive.morph_targets().filter_map(|t| t.positions()));
-        if let Some(bad) = positions_accessors.find(|a| !float_vec3(a)) {
-            return Err(format!(
-                "{name}: positions in accessor {} are not float triples (quantised meshes are not supported)",
-                bad.index()
-            ));
+        for a in positions_accessors {
+            if !float_vec3(&a) {
+                return Err(format!(
+                    "{name}: positions in accessor {} are not float triples (quantised meshes are not supported)",
+                    a.index()
+                ));
+            }
+            check_extent(&a, &format!("{name} positions"))?;
+        }
+        // Morph normals and tangents are not used, but reading the targets opens their accessors.
+        for target in primitive.morph_targets() {
+            for a in [target.normals(), target.tangents()] {
+                check_accessor(
+                    a,
+                    &format!("{name} morph target"),
+                    Dimensions::Vec3,
+                    &[DataType::F32],
+                )?;
+            }
+        }
+        for set in 0..MAX_INFLUENCE_SETS {
+            check_accessor(
+                primitive.get(&gltf::Semantic::Joints(set)),
+                &format!("{name} JOINTS_{set}"),
+                Dimensions::Vec4,
+                &[DataType::U8, DataType::U16],
+            )?;
+            check_accessor(
+                primitive.get(&gltf::Semantic::Weights(set)),
+                &format!("{name} WEIGHTS_{set}"),
+                Dimensions::Vec4,
+                &[DataType::F32, DataType::U8, DataType::U16],
+            )?;
         }
         let reader = primitive.reader(|b| buffer_data(data, b));
         let Some(positions) = reader.read_positions() else {

@@ -56,6 +56,48 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
     }
 }
 
+/// Every file [`read_animation`] would read for `input`: the OBJ frames of a folder or glob, a PC2
+/// cache and its base OBJ, or the glTF file itself (with its external buffers, when they resolve).
+pub fn input_files(input: &str, opts: &ReadOptions) -> Result<Vec<PathBuf>> {
+    let path = Path::new(input);
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match extension.as_deref() {
+        Some("pc2") => Ok(vec![
+            path.to_path_buf(),
+            opts.base
+                .clone()
+                .unwrap_or_else(|| path.with_extension("obj")),
+        ]),
+        Some("gltf") | Some("glb") => Ok(gltf_import::files(path)),
+        _ => obj::frame_files(input),
+    }
+}
+
+/// Parses one OBJ held in memory as a one-frame animation; `name` only labels errors.
+pub fn parse_obj(text: &str, name: &Path) -> Result<AnimatedMesh> {
+    let frame = obj::parse_obj(text, name)?;
+    AnimatedMesh::new(frame.triangles, vec![frame.positions])
+}
+
+/// Parses a PC2 point cache held in memory, with the triangles of `base_obj` (an OBJ's text);
+/// `name` only labels errors.
+pub fn parse_pc2(bytes: &[u8], base_obj: &str, name: &Path) -> Result<AnimatedMesh> {
+    pc2::parse_pc2_animation(bytes, base_obj, name, &name.with_extension("obj"))
+}
+
+/// Parses and bakes a `.gltf`/`.glb` held in memory as [`read_animation`] would; `name` only labels
+/// errors. Nothing is read from disk, so its buffers must be embedded (GLB chunk or `data:` URI).
+pub fn parse_gltf(
+    bytes: &[u8],
+    name: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+) -> Result<AnimatedMesh> {
+    gltf_import::parse_gltf(bytes, name, fps, clip)
+}
+
 /// Writes one OBJ per frame into `dir` as `frame_0000.obj`, … (created if missing).
 ///
 /// Numbers have at least four digits, more when the frame count needs them, so the files sort by

@@ -10,7 +10,10 @@ mod gltf_import;
 mod obj;
 mod pc2;
 
-pub use io::{read_animation, write_obj_frame, write_obj_sequence, write_pc2, ReadOptions};
+pub use io::{
+    parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_sequence, write_pc2,
+    ReadOptions,
+};
 
 use crate::error::{Error, Result};
 

@@ -4,7 +4,7 @@
 //! f32 sample rate, i32 sample count, then sample count × point count × 3 f32. So small and fixed a
 //! format needs no crate; none of the PC2 crates on crates.io is kept up.
 
-use super::obj::read_obj;
+use super::obj::{parse_obj, read_obj, ObjFrame};
 use super::{AnimatedMesh, Point};
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -38,6 +38,24 @@ pub(crate) fn read_pc2_animation(path: &Path, base: Option<&Path>) -> Result<Ani
         }
     };
     let mesh = read_obj(&base)?;
+    with_base(cache, mesh, path, &base)
+}
+
+/// Parses PC2 bytes held in memory with the base mesh's OBJ text; the paths only name errors.
+pub(crate) fn parse_pc2_animation(
+    bytes: &[u8],
+    base_text: &str,
+    path: &Path,
+    base: &Path,
+) -> Result<AnimatedMesh> {
+    let cache =
+        parse_pc2(bytes).map_err(|what| Error::Mesh(format!("{}: {what}", path.display())))?;
+    let mesh = parse_obj(base_text, base)?;
+    with_base(cache, mesh, path, base)
+}
+
+/// The animation of `cache`'s frames on `mesh`'s triangles; their vertex counts must agree.
+fn with_base(cache: PointCache, mesh: ObjFrame, path: &Path, base: &Path) -> Result<AnimatedMesh> {
     let points = cache.frames.first().map_or(0, Vec::len);
     if mesh.positions.len() != points {
         return Err(Error::Mesh(format!(

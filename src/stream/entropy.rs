@@ -421,13 +421,17 @@ impl Decoder {
     /// Decodes a signed integer.
     pub fn signed(&mut self, model: &mut IntModel) -> Result<i64> {
         let magnitude = self.unsigned(&mut model.magnitude)?;
-        let magnitude =
-            i64::try_from(magnitude).map_err(|_| corrupt("signed integer overflows"))?;
-        if magnitude != 0 && self.bit(&mut model.sign)? {
-            Ok(-magnitude)
-        } else {
-            Ok(magnitude)
+        if magnitude == 0 {
+            return Ok(0);
         }
+        // The sign is read before the range check: i64::MIN has magnitude 2^63, which the encoder
+        // writes and only a negative sign makes representable.
+        let value = if self.bit(&mut model.sign)? {
+            0i64.checked_sub_unsigned(magnitude)
+        } else {
+            i64::try_from(magnitude).ok()
+        };
+        value.ok_or_else(|| corrupt("signed integer overflows"))
     }
 }
 

@@ -99,6 +99,10 @@ fn predictor_from_id(id: u8) -> Result<PredictorKind> {
 /// a forged header exhaust memory before the parts' real sizes are checked.
 const MAX_COUNT: u32 = 1 << 28;
 
+/// Largest lattice side the encoder makes (and the decoder accepts): a forged header cannot make the
+/// image decoders allocate pictures of 3 × 65535 × 65535 bytes.
+pub const MAX_LATTICE_SIDE: u16 = 4096;
+
 impl Header {
     /// Packing efficiency of the atlas: chart pixels / lattice pixels.
     pub fn packing_efficiency(&self) -> f64 {
@@ -184,10 +188,19 @@ impl Header {
             || h.lattice_height == 0
             || h.lattice_width % 16 != 0
             || h.lattice_height % 16 != 0
+            || h.lattice_width > MAX_LATTICE_SIDE
+            || h.lattice_height > MAX_LATTICE_SIDE
         {
             return Err(Error::Stream(format!(
-                "lattice {}x{} is not a positive multiple of 16",
+                "lattice {}x{} is not a multiple of 16 between 16 and {MAX_LATTICE_SIDE}",
                 h.lattice_width, h.lattice_height
+            )));
+        }
+        // Every vertex has its own lattice pixel.
+        if u64::from(h.vertices) > u64::from(h.lattice_width) * u64::from(h.lattice_height) {
+            return Err(Error::Stream(format!(
+                "header claims {} vertices, more than the {}x{} lattice has pixels",
+                h.vertices, h.lattice_width, h.lattice_height
             )));
         }
         if !(1..=32).contains(&h.affine_bits)

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Seeds for the fuzz targets, made from media/ by the mcgv-video binary given as $1 into folder $2:
+#   $2/decode_stream/  small real streams of both codecs (64x64 lattice: fast to decode per execution)
+#   $2/read_mesh/      a kind byte (0 OBJ, 1 OBJ + NUL + PC2, 2 glTF) followed by a real file
+# Regenerated every run (cheap) so that they follow the current stream format.
+set -euo pipefail
+bin=$1
+out=$2
+media=$(dirname "$0")/../media
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p "$out/decode_stream" "$out/read_mesh"
+small=(--lattice 64x64 --clusters 4 --fps 6 --quiet)
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg.mcgv" --codec jpeg "${small[@]}"
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/mpeg4.mcgv" --codec mpeg4 --gop 3 "${small[@]}"
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-reorder.mcgv" --codec jpeg --reorder \
+	--lattice 64x64 --clusters 2 --fps 2 --quality 10 --quiet
+# Mesh readers: the decoded stream as OBJ and PC2, and two of the glTF samples.
+"$bin" decode "$out/decode_stream/jpeg.mcgv" -o "$tmp/obj" --quiet
+"$bin" decode "$out/decode_stream/jpeg.mcgv" -o "$tmp/anim.pc2" --quiet
+{ printf '\x00'; cat "$tmp/obj/frame_0000.obj"; } >"$out/read_mesh/obj"
+{ printf '\x01'; cat "$tmp/obj/frame_0000.obj"; printf '\x00'; cat "$tmp/anim.pc2"; } >"$out/read_mesh/pc2"
+printf '\x00# a quad, a fan and negative indices\nv 0 0 0\nv 1 0 0\nv 1 1 0 1\nv 0 1 0\nf 1 2 3 4\nf -1 -2 -4\n' \
+	>"$out/read_mesh/quad-obj"
+for name in RiggedSimple RiggedFigure; do
+	{ printf '\x02'; cat "$media/$name.glb"; } >"$out/read_mesh/$name"
+done
+ls -l "$out"/*/

@@ -1,0 +1,159 @@
+//! `encode -o` never damages what is there: no half-written output, no overwritten input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
+}
+
+fn media(name: &str) -> String {
+    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn refused(out: &Output) {
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("refusing to overwrite the input"), "{err}");
+}
+
+/// Names in `dir` that a failed write could have left: temporary files of `write_atomic`.
+fn leftovers(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".mcgv-partial-"))
+        .collect()
+}
+
+/// Two OBJ frames of a square in `dir`.
+fn obj_frames(dir: &Path) {
+    std::fs::create_dir_all(dir).unwrap();
+    for f in 0..2 {
+        let text = format!(
+            "v 0 0 0\nv 1 0 {}\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+            f as f32 * 0.1
+        );
+        std::fs::write(dir.join(format!("frame_{f}.obj")), text).unwrap();
+    }
+}
+
+#[test]
+fn no_input_file_can_be_the_output() {
+    let d = tempfile::tempdir().unwrap();
+    let frames = d.path().join("frames");
+    obj_frames(&frames);
+    let frame1 = frames.join("frame_1.obj");
+    let before = std::fs::read(&frame1).unwrap();
+    let dir = frames.to_str().unwrap();
+    let pattern = format!("{dir}/*.obj");
+    // A frame of the folder, named directly or through `..`, and of a glob.
+    let sneaky = frames.join("../frames/./frame_1.obj");
+    for (input, output) in [
+        (dir, frame1.to_str().unwrap()),
+        (dir, sneaky.to_str().unwrap()),
+        (pattern.as_str(), frame1.to_str().unwrap()),
+    ] {
+        refused(&run(&["encode", input, "-o", output, "--quiet"]));
+    }
+    assert_eq!(std::fs::read(&frame1).unwrap(), before);
+    // The base OBJ of a PC2 cache.
+    let pc2 = d.path().join("anim.pc2");
+    let ok = run(&[
+        "decode",
+        &{
+            let s = d.path().join("s.mcgv");
+            let out = run(&[
+                "encode",
+                dir,
+                "-o",
+                s.to_str().unwrap(),
+                "--lattice",
+                "16x16",
+                "--clusters",
+                "1",
+                "--quiet",
+            ]);
+            assert!(out.status.success(), "{out:?}");
+            s.to_str().unwrap().to_string()
+        },
+        "-o",
+        pc2.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok.status.success(), "{ok:?}");
+    let base = d.path().join("anim.obj");
+    std::fs::copy(frames.join("frame_0.obj"), &base).unwrap();
+    let base_before = std::fs::read(&base).unwrap();
+    refused(&run(&[
+        "encode",
+        pc2.to_str().unwrap(),
+        "-o",
+        base.to_str().unwrap(),
+    ]));
+    assert_eq!(std::fs::read(&base).unwrap(), base_before);
+    assert!(leftovers(d.path()).is_empty());
+}
+
+#[test]
+fn a_failing_encode_leaves_the_target_as_it_was() {
+    let d = tempfile::tempdir().unwrap();
+    // RiggedSimple has more vertices than a 16x16 lattice has pixels: the atlas fails after reading.
+    let fresh = d.path().join("fresh.mcgv");
+    let out = run(&[
+        "encode",
+        &media("RiggedSimple.glb"),
+        "-o",
+        fresh.to_str().unwrap(),
+        "--lattice",
+        "16x16",
+        "--quiet",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    assert!(!fresh.exists(), "a failed encode created its output");
+    let old = d.path().join("old.mcgv");
+    std::fs::write(&old, b"the previous output").unwrap();
+    let out = run(&[
+        "encode",
+        &media("RiggedSimple.glb"),
+        "-o",
+        old.to_str().unwrap(),
+        "--lattice",
+        "16x16",
+        "--quiet",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    assert_eq!(std::fs::read(&old).unwrap(), b"the previous output");
+    assert!(leftovers(d.path()).is_empty(), "{:?}", leftovers(d.path()));
+}
+
+#[cfg(unix)]
+#[test]
+fn outputs_get_ordinary_file_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = tempfile::tempdir().unwrap();
+    let frames = d.path().join("frames");
+    obj_frames(&frames);
+    let s = d.path().join("s.mcgv");
+    let out = run(&[
+        "encode",
+        frames.to_str().unwrap(),
+        "-o",
+        s.to_str().unwrap(),
+        "--lattice",
+        "16x16",
+        "--clusters",
+        "1",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    // A file written directly in the same folder gets the mode the umask allows.
+    let plain = d.path().join("plain");
+    std::fs::write(&plain, b"x").unwrap();
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode(&s), mode(&plain));
+}

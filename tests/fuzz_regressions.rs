@@ -1,0 +1,173 @@
+//! Hostile streams and meshes: every input the fuzzers once crashed on (tests/data/fuzz/TARGET/),
+//! replayed through the fuzz targets' own code, and forged headers that claim absurd sizes.
+
+#[path = "../fuzz/src/harness.rs"]
+mod harness;
+
+use mcgv_video::decoder::Decoder;
+use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
+use mcgv_video::mesh::AnimatedMesh;
+use mcgv_video::stream::container::{ContainerReader, FILE_HEADER_LEN, PART_HEADER_LEN};
+use mcgv_video::stream::header::CodecKind;
+use mcgv_video::Error;
+use std::io::Cursor;
+use std::path::PathBuf;
+
+fn crashers(target: &str) -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/fuzz")
+        .join(target);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    files.sort();
+    files
+}
+
+/// A panic fails the test; an error is the right answer to these inputs.
+#[test]
+fn stream_crashers_are_errors_now() {
+    for path in crashers("decode_stream") {
+        let bytes = std::fs::read(&path).unwrap();
+        if let Err(e) = harness::decode_stream(&bytes) {
+            assert!(!e.to_string().is_empty(), "{}", path.display());
+        }
+    }
+}
+
+#[test]
+fn mesh_crashers_are_errors_now() {
+    for path in crashers("read_mesh") {
+        let bytes = std::fs::read(&path).unwrap();
+        // Each of these is malformed: it must be refused with a message, not read.
+        match harness::read_mesh(&bytes) {
+            Err(e) => assert!(!e.to_string().is_empty(), "{}", path.display()),
+            Ok(()) => panic!("{} was accepted", path.display()),
+        }
+    }
+}
+
+/// A real two-frame stream of two triangles, small enough to forge quickly.
+fn tiny_stream(codec: CodecKind) -> Vec<u8> {
+    let square = |t: f32| {
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, t],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, -t],
+        ]
+    };
+    let mesh =
+        AnimatedMesh::new(vec![[0, 1, 2], [0, 2, 3]], vec![square(0.0), square(0.1)]).unwrap();
+    let opts = EncodeOptions {
+        codec,
+        clusters: 1,
+        lattice: Lattice::Fixed(16, 16),
+        padding: Some(padding::Method::Cg),
+        ..EncodeOptions::default()
+    };
+    encode(&mesh, &opts, &indicatif::ProgressBar::hidden())
+        .unwrap()
+        .container
+        .to_bytes()
+}
+
+/// Offset of the header part's payload: the header is the first part.
+const HEAD: usize = FILE_HEADER_LEN + PART_HEADER_LEN;
+
+/// The stream with one header field (`u32` at `offset` in the header payload) replaced, every
+/// checksum made right again so that only the size checks can refuse it.
+fn forged(codec: CodecKind, offset: usize, value: u32) -> Vec<u8> {
+    let mut bytes = tiny_stream(codec);
+    assert_eq!(&bytes[FILE_HEADER_LEN..FILE_HEADER_LEN + 4], b"HEAD");
+    bytes[HEAD + offset..HEAD + offset + 4].copy_from_slice(&value.to_le_bytes());
+    harness::fix_checksums(&mut bytes);
+    bytes
+}
+
+fn open(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
+    Decoder::new(ContainerReader::new(Cursor::new(bytes))?)
+}
+
+fn stream_error(bytes: Vec<u8>) -> String {
+    match open(bytes) {
+        Err(Error::Stream(m)) => m,
+        Err(other) => panic!("not a stream error: {other}"),
+        Ok(_) => panic!("a forged header was accepted"),
+    }
+}
+
+#[test]
+fn the_forgery_helper_keeps_an_honest_stream_valid() {
+    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+        let mut bytes = tiny_stream(codec);
+        harness::fix_checksums(&mut bytes);
+        assert_eq!(
+            bytes,
+            tiny_stream(codec),
+            "fixing right checksums changes nothing"
+        );
+        assert!(harness::decode_stream(&bytes).is_ok());
+    }
+}
+
+#[test]
+fn a_billion_vertices_or_frames_is_refused_before_allocating() {
+    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+        // Header layout: vertices, frames, triangles, clusters (u32 each), then the lattice.
+        for (offset, what) in [
+            (0, "vertices"),
+            (4, "frames"),
+            (8, "triangles"),
+            (12, "clusters"),
+        ] {
+            let msg = stream_error(forged(codec, offset, 1_000_000_000));
+            assert!(
+                msg.contains("1000000000") && msg.contains(what),
+                "{what}: {msg}"
+            );
+        }
+    }
+}
+
+#[test]
+fn counts_under_the_header_limit_are_checked_against_the_bytes() {
+    // 2^27 passes the header's own limit; the parts' real sizes must refuse it, quickly.
+    let start = std::time::Instant::now();
+    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+        for offset in [4, 8] {
+            let msg = stream_error(forged(codec, offset, 1 << 27));
+            assert!(!msg.is_empty());
+        }
+        // More vertices than a 16x16 lattice has pixels.
+        let msg = stream_error(forged(codec, 0, 257));
+        assert!(msg.contains("lattice"), "{msg}");
+    }
+    assert!(
+        start.elapsed().as_secs() < 30,
+        "refusals must not do the work first"
+    );
+}
+
+#[test]
+fn a_huge_lattice_is_refused() {
+    let mut bytes = tiny_stream(CodecKind::Jpeg);
+    // Lattice width and height are u16 at offset 16 and 18 of the header.
+    bytes[HEAD + 16..HEAD + 20].copy_from_slice(&[0xF0, 0xFF, 0xF0, 0xFF]);
+    harness::fix_checksums(&mut bytes);
+    let msg = stream_error(bytes);
+    assert!(msg.contains("65520x65520"), "{msg}");
+}
+
+#[test]
+fn a_glb_claiming_4_gb_is_refused_without_allocating_it() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz/glb-claims-4gb.glb");
+    assert_eq!(std::fs::metadata(&path).unwrap().len(), 12);
+    let err = mcgv_video::mesh::read_animation(path.to_str().unwrap(), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("GLB header gives a length of 4294967280 bytes"),
+        "{err}"
+    );
+}
