@@ -11,8 +11,8 @@ mod obj;
 mod pc2;
 
 pub use io::{
-    parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_sequence, write_pc2,
-    ReadOptions,
+    parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_sequence,
+    write_pc2, ReadOptions,
 };
 
 use crate::error::{Error, Result};
