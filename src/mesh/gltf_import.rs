@@ -74,6 +74,25 @@ fn from_slice(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
             }
         }
     }
+    // Nor does it check an animation channel's target (gltf 1.4 unwraps an unknown `path` and
+    // indexes the node unchecked; found by the read_mesh fuzzer).
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let target = &channel.target;
+            if target.node.value() >= root.nodes.len() {
+                return Err(fail(format!(
+                    "animation {a} channel {c}: target node {} does not exist ({} nodes)",
+                    target.node.value(),
+                    root.nodes.len()
+                )));
+            }
+            if matches!(target.path, gltf::json::validation::Checked::Invalid) {
+                return Err(fail(format!(
+                    "animation {a} channel {c}: unknown target path"
+                )));
+            }
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         errors.push(format!("{}: {error}", path()))
