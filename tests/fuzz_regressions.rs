@@ -47,6 +47,20 @@ fn mesh_crashers_are_errors_now() {
     }
 }
 
+#[test]
+fn mesh_crashers_that_are_valid_meshes_now_read() {
+    let found = crashers("read_mesh_valid");
+    assert!(!found.is_empty());
+    for path in found {
+        let bytes = std::fs::read(&path).unwrap();
+        // Well-formed but extreme (e.g. one edge shared by 256+ triangles, which overflowed a use
+        // count in the first-frame coder): read, coded, and the connectivity comes back.
+        if let Err(e) = harness::read_mesh(&bytes) {
+            panic!("{}: {e}", path.display());
+        }
+    }
+}
+
 /// A real two-frame stream of two triangles, small enough to forge quickly.
 fn tiny_stream(codec: CodecKind) -> Vec<u8> {
     let square = |t: f32| {

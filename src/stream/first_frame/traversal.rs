@@ -234,7 +234,9 @@ impl Traversal {
             if let Some(list) = self.incoming.get_mut(q as usize) {
                 list.push(p);
             }
-            *self.edge_use.entry(undirected(p, q)).or_insert(0) += 1;
+            // Only 0, 1, 2 and "more" matter; an edge of 256+ triangles must not overflow the count.
+            let uses = self.edge_use.entry(undirected(p, q)).or_insert(0);
+            *uses = uses.saturating_add(1);
         }
         // Start from the entry edge so that the edge after it is explored first (pushed last).
         let start = (0..3)
