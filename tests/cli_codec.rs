@@ -1,38 +1,16 @@
 //! The encode / decode / inspect / eval commands through the binary, as a user runs them.
 
+mod common;
+
+use common::{json, media_path, ok, run};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
-}
-
-fn media(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_str(ok(out).trim()).expect("one JSON object")
-}
 
 #[test]
 fn encode_inspect_decode_eval_a_sample() {
     let dir = tempfile::tempdir().unwrap();
     let stream = dir.path().join("fig.mcgv");
     let s = stream.to_str().unwrap();
-    let sample = media("RiggedFigure.glb");
+    let sample = media_path("RiggedFigure.glb");
     let enc = json(&run(&[
         "encode", &sample, "-o", s, "--codec", "mpeg4", "--quiet", "--json",
     ]));
@@ -108,7 +86,7 @@ fn inspect_writes_pngs_a_user_can_open() {
     let dir = tempfile::tempdir().unwrap();
     let stream = dir.path().join("s.mcgv");
     let s = stream.to_str().unwrap();
-    let sample = media("RiggedSimple.glb");
+    let sample = media_path("RiggedSimple.glb");
     ok(&run(&[
         "encode",
         &sample,
@@ -171,7 +149,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     let s = stream.to_str().unwrap();
     ok(&run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--quiet",
@@ -190,7 +168,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--frame 9999"));
     // Overwriting the input is refused and the input is untouched.
     let copy = d.join("in.glb");
-    std::fs::copy(media("RiggedSimple.glb"), &copy).unwrap();
+    std::fs::copy(media_path("RiggedSimple.glb"), &copy).unwrap();
     let before = std::fs::read(&copy).unwrap();
     let out = run(&[
         "encode",
@@ -205,7 +183,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     let missing = d.join("no/such/dir/out.mcgv");
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         missing.to_str().unwrap(),
         "--quiet",
@@ -215,7 +193,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     // Nonsense options.
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--lattice",
@@ -225,7 +203,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("multiples of 16"));
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--padding",

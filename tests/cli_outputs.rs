@@ -1,18 +1,10 @@
 //! `encode -o` never damages what is there: no half-written output, no overwritten input.
 
+mod common;
+
+use common::{media_path, run};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
-}
-
-fn media(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
-}
+use std::process::Output;
 
 fn refused(out: &Output) {
     assert_eq!(out.status.code(), Some(1), "{out:?}");
@@ -106,7 +98,7 @@ fn a_failing_encode_leaves_the_target_as_it_was() {
     let fresh = d.path().join("fresh.mcgv");
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         fresh.to_str().unwrap(),
         "--lattice",
@@ -119,7 +111,7 @@ fn a_failing_encode_leaves_the_target_as_it_was() {
     std::fs::write(&old, b"the previous output").unwrap();
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         old.to_str().unwrap(),
         "--lattice",
