@@ -61,6 +61,12 @@ impl<R: Read + Seek> Decoder<R> {
         let lattice = (header.lattice_width, header.lattice_height);
         let pixels =
             side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, &triangles)?;
+        // The ranges take 24 bytes a frame, so reading them first proves the header's frame count
+        // before the affine track allocates 12 coefficients per frame and cluster.
+        let ranges_bytes = reader.part(Tag::RANGES)?;
+        let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
+        let ranges = quantise::read_ranges(&mut r, f)?;
+        r.finish()?;
         let track = side_info::decode_affine(
             &reader.part(Tag::AFFINE)?,
             f,
@@ -80,10 +86,6 @@ impl<R: Read + Seek> Decoder<R> {
                 &triangles,
             )?),
         };
-        let ranges_bytes = reader.part(Tag::RANGES)?;
-        let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
-        let ranges = quantise::read_ranges(&mut r, f)?;
-        r.finish()?;
         let codec_setup = reader.part(Tag::CODEC_SETUP)?;
         let images_len = reader.entry(Tag::FRAMES)?.len;
         let index = FrameIndex::from_bytes(&reader.part(Tag::FRAME_INDEX)?, f, images_len)?;

@@ -3,11 +3,14 @@
 
 mod common;
 
-use common::{canonical, decode_all, decoder, encode_bytes, json, media_path, ok, read_media, run};
+use common::{
+    canonical, decode_all, decoder, encode_bytes, json, media_path, ok, parts, read_media, rebuild,
+    run,
+};
 use mcgv_video::encoder::{analyse, EncodeOptions};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{self, PredictorKind};
-use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
+use mcgv_video::stream::container::{Checksum, ContainerReader, Tag};
 use mcgv_video::stream::header::CodecKind;
 use std::io::Cursor;
 
@@ -21,27 +24,6 @@ fn opts(codec: CodecKind, quality: u8, predictor: PredictorKind) -> EncodeOption
         predictor,
         ..EncodeOptions::default()
     }
-}
-
-/// The parts of a stream as (tag, payload, checksum kind), to rebuild it altered.
-fn parts(bytes: &[u8]) -> Vec<(Tag, Vec<u8>, Checksum)> {
-    let reader = ContainerReader::new(Cursor::new(bytes.to_vec())).unwrap();
-    reader
-        .parts()
-        .iter()
-        .map(|p| {
-            let (o, l) = (p.offset as usize, p.len as usize);
-            (p.tag, bytes[o..o + l].to_vec(), p.checksum)
-        })
-        .collect()
-}
-
-fn rebuild(parts: Vec<(Tag, Vec<u8>, Checksum)>) -> Vec<u8> {
-    let mut w = ContainerWriter::new();
-    for (tag, payload, checksum) in parts {
-        w.add(tag, payload, checksum);
-    }
-    w.to_bytes()
 }
 
 #[test]

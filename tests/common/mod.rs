@@ -8,7 +8,7 @@
 use mcgv_video::decoder::Decoder;
 use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, Point, ReadOptions, Triangle};
-use mcgv_video::stream::container::ContainerReader;
+use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
 use std::io::Cursor;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -79,6 +79,28 @@ pub fn decoder(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
 /// Decodes every frame of in-memory stream bytes.
 pub fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
     decoder(bytes)?.decode_all(&indicatif::ProgressBar::hidden())
+}
+
+/// The parts of a stream as (tag, payload, checksum kind), to rebuild it altered.
+pub fn parts(bytes: &[u8]) -> Vec<(Tag, Vec<u8>, Checksum)> {
+    let reader = ContainerReader::new(Cursor::new(bytes.to_vec())).expect("a valid container");
+    reader
+        .parts()
+        .iter()
+        .map(|p| {
+            let (o, l) = (p.offset as usize, p.len as usize);
+            (p.tag, bytes[o..o + l].to_vec(), p.checksum)
+        })
+        .collect()
+}
+
+/// A stream of `parts`, with checksums made for their payloads.
+pub fn rebuild(parts: Vec<(Tag, Vec<u8>, Checksum)>) -> Vec<u8> {
+    let mut w = ContainerWriter::new();
+    for (tag, payload, checksum) in parts {
+        w.add(tag, payload, checksum);
+    }
+    w.to_bytes()
 }
 
 /// A closed-around tube along x from `x0` to `x1`, `rings` rings of `ring_size` vertices, appended
