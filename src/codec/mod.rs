@@ -8,7 +8,7 @@
 //! Three coordinate images per frame, measured on smooth synthetic 256×256 planes (see
 //! `measure_rate_distortion_and_speed` in `tests/codec.rs`): tiling them into one 768×256 picture
 //! saves JPEG ≈ 460 bytes a frame with full headers (2–4 %) but only ≈ 100–130 bytes (< 1 %) in the
-//! compact form ([`jpeg::encode_compact`]), while MPEG-4 codes three separate streams 2–4 % smaller
+//! abbreviated form the stream stores ([`abbreviated`]), while MPEG-4 codes three separate streams 2–4 % smaller
 //! than the tiled picture. Chroma is flat and costs nothing measurable
 //! (the GRAY flag changes no byte).
 
