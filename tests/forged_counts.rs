@@ -4,9 +4,7 @@
 
 mod common;
 
-use common::{parts, rebuild};
-use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
-use mcgv_video::mesh::AnimatedMesh;
+use common::{parts, rebuild, tiny_stream};
 use mcgv_video::stream::container::{ContainerReader, Tag};
 use mcgv_video::stream::entropy::max_symbols;
 use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
@@ -138,12 +136,25 @@ fn forged_first_frame(
     bytes
 }
 
-fn first_frame_error(bytes: &[u8]) -> (String, usize) {
-    let (result, peak) = peak_of(|| first_frame::decode(bytes));
-    match result {
+/// Pads a stream of a real first frame (as [`forged_first_frame`]), sets the header's u32 at
+/// `field` to `claim(padded bytes)`, decodes, and returns the claim and the error, checking that the
+/// refusal allocated little.
+fn refused(
+    reorder: bool,
+    pad_at: usize,
+    extra: usize,
+    field: usize,
+    claim: impl Fn(&[u8]) -> u32,
+) -> (u32, String) {
+    let claim = claim(&forged_first_frame(reorder, pad_at, extra, |_| {}));
+    let bytes = forged_first_frame(reorder, pad_at, extra, |b| set_word(b, field, claim));
+    let (result, peak) = peak_of(|| first_frame::decode(&bytes));
+    let msg = match result {
         Ok(_) => panic!("a forged first frame was accepted"),
-        Err(e) => (e.to_string(), peak),
-    }
+        Err(e) => e.to_string(),
+    };
+    assert!(peak < SMALL, "refusing took {peak} bytes: {msg}");
+    (claim, msg)
 }
 
 #[test]
@@ -159,80 +170,38 @@ fn the_forgery_keeps_an_honest_first_frame_valid() {
 fn vertices_past_what_the_geometry_stream_holds_are_refused_before_allocating() {
     // 4 KB of geometry hold at most max_symbols / 3 vertices (three residuals each); the whole
     // payload, which the old check used, holds three times as many symbols as that needs.
-    let bytes = forged_first_frame(true, GEOMETRY_LEN, 4000, |_| {});
-    let lg = word(&bytes, GEOMETRY_LEN) as usize;
-    let claim = (max_symbols(lg) / 3 + 1) as u32;
-    assert!(
-        u64::from(claim) > 7_000_000,
-        "a claim worth refusing: {claim}"
-    );
-    let bytes = forged_first_frame(true, GEOMETRY_LEN, 4000, |b| {
-        set_word(b, VERTEX_COUNT, claim)
+    let (claim, msg) = refused(true, GEOMETRY_LEN, 4000, VERTEX_COUNT, |b| {
+        (max_symbols(word(b, GEOMETRY_LEN) as usize) / 3 + 1) as u32
     });
-    let (msg, peak) = first_frame_error(&bytes);
+    assert!(claim > 7_000_000, "a claim worth refusing: {claim}");
     assert!(
         msg.contains(&format!("{claim} vertices")) && msg.contains("geometry stream"),
         "{msg}"
     );
-    assert!(peak < SMALL, "refusing took {peak} bytes");
 }
 
 #[test]
 fn vertices_past_what_the_order_stream_holds_are_refused() {
     // Plenty of geometry, but the stored order takes at least four decisions a vertex.
-    let bytes = forged_first_frame(false, GEOMETRY_LEN, 40_000, |_| {});
-    let lo = bytes.len()
-        - FIRST_FRAME_HEADER_LEN
-        - word(&bytes, CONNECTIVITY_LEN) as usize
-        - word(&bytes, GEOMETRY_LEN) as usize;
-    let claim = (max_symbols(lo) / 4 + 1) as u32;
-    let bytes = forged_first_frame(false, GEOMETRY_LEN, 40_000, |b| {
-        set_word(b, VERTEX_COUNT, claim)
+    let (_, msg) = refused(false, GEOMETRY_LEN, 40_000, VERTEX_COUNT, |b| {
+        let lo = b.len()
+            - FIRST_FRAME_HEADER_LEN
+            - word(b, CONNECTIVITY_LEN) as usize
+            - word(b, GEOMETRY_LEN) as usize;
+        (max_symbols(lo) / 4 + 1) as u32
     });
-    let (msg, peak) = first_frame_error(&bytes);
     assert!(msg.contains("order stream"), "{msg}");
-    assert!(peak < SMALL, "refusing took {peak} bytes");
 }
 
 #[test]
 fn triangles_past_what_the_connectivity_stream_holds_are_refused() {
-    let bytes = forged_first_frame(true, CONNECTIVITY_LEN, 4000, |_| {});
-    let lc = word(&bytes, CONNECTIVITY_LEN) as usize;
-    let claim = (max_symbols(lc) / 3 + 1) as u32;
-    let bytes = forged_first_frame(true, CONNECTIVITY_LEN, 4000, |b| {
-        set_word(b, TRAVERSED, claim)
+    let (claim, msg) = refused(true, CONNECTIVITY_LEN, 4000, TRAVERSED, |b| {
+        (max_symbols(word(b, CONNECTIVITY_LEN) as usize) / 3 + 1) as u32
     });
-    let (msg, peak) = first_frame_error(&bytes);
     assert!(
         msg.contains(&format!("{claim} triangles")) && msg.contains("connectivity stream"),
         "{msg}"
     );
-    assert!(peak < SMALL, "refusing took {peak} bytes");
-}
-
-/// A real two-frame stream of a square (one cluster), as `tests/fuzz_regressions.rs` forges.
-fn tiny_stream() -> Vec<u8> {
-    let square = |t: f32| {
-        vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, t],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, -t],
-        ]
-    };
-    let mesh = AnimatedMesh::new(vec![[0, 1, 2], [0, 2, 3]], vec![square(0.0), square(0.1)])
-        .expect("a valid animation");
-    let opts = EncodeOptions {
-        codec: CodecKind::Jpeg,
-        clusters: 1,
-        lattice: Lattice::Fixed(16, 16),
-        padding: Some(padding::Method::Cg),
-        ..EncodeOptions::default()
-    };
-    encode(&mesh, &opts, &indicatif::ProgressBar::hidden())
-        .expect("encodes")
-        .container
-        .to_bytes()
 }
 
 #[test]
@@ -241,7 +210,7 @@ fn frames_past_what_the_ranges_hold_are_refused_before_the_affine_track() {
     // many (each at the coder's floor), so the affine part alone cannot refuse the claim. The
     // residual ranges take 24 bytes a frame and are read first.
     const FRAMES: u32 = 1 << 22;
-    let mut forged = parts(&tiny_stream());
+    let mut forged = parts(&tiny_stream(CodecKind::Jpeg));
     for (tag, payload, _) in forged.iter_mut() {
         if *tag == Tag::HEADER {
             let mut header = Header::from_bytes(payload).expect("a valid header");

@@ -6,16 +6,18 @@
 #![allow(dead_code)]
 
 use mcgv_video::decoder::Decoder;
-use mcgv_video::encoder::{encode, EncodeOptions};
+use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, Point, ReadOptions, Triangle};
 use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
+use mcgv_video::stream::header::CodecKind;
 use std::io::Cursor;
 use std::path::Path;
 use std::process::{Command, Output};
 
-// The fuzz targets compare connectivity the same way: one definition serves both.
+/// The fuzz targets' bodies, for replaying their inputs; they compare connectivity the way the
+/// tests do, so `canonical` has one definition for both.
 #[path = "../../fuzz/src/harness.rs"]
-mod harness;
+pub mod harness;
 // Like the items above, unused in the test files that compare no connectivity.
 #[allow(unused_imports)]
 pub use harness::canonical;
@@ -79,6 +81,31 @@ pub fn decoder(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
 /// Decodes every frame of in-memory stream bytes.
 pub fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
     decoder(bytes)?.decode_all(&indicatif::ProgressBar::hidden())
+}
+
+/// A real two-frame stream of a square (two triangles, one cluster), small enough to forge quickly.
+pub fn tiny_stream(codec: CodecKind) -> Vec<u8> {
+    let square = |t: f32| {
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, t],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, -t],
+        ]
+    };
+    let mesh = AnimatedMesh::new(vec![[0, 1, 2], [0, 2, 3]], vec![square(0.0), square(0.1)])
+        .expect("a valid animation");
+    let opts = EncodeOptions {
+        codec,
+        clusters: 1,
+        lattice: Lattice::Fixed(16, 16),
+        padding: Some(padding::Method::Cg),
+        ..EncodeOptions::default()
+    };
+    encode(&mesh, &opts, &indicatif::ProgressBar::hidden())
+        .expect("encodes")
+        .container
+        .to_bytes()
 }
 
 /// The parts of a stream as (tag, payload, checksum kind), to rebuild it altered.
