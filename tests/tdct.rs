@@ -32,7 +32,10 @@ fn encode_bytes(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<u8> {
         .to_bytes()
 }
 
-fn decoder(bytes: Vec<u8>, max_bands: Option<usize>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
+fn decoder(
+    bytes: Vec<u8>,
+    max_bands: Option<usize>,
+) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
     Decoder::with_options(
         ContainerReader::new(Cursor::new(bytes))?,
         &DecodeOptions { max_bands },
@@ -101,7 +104,10 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
     let decoded = dec.decode_all(&indicatif::ProgressBar::hidden()).unwrap();
     assert_eq!(decoded.vertex_count(), mesh.vertex_count());
     assert_eq!(decoded.frame_count(), mesh.frame_count());
-    assert_eq!(oriented_set(decoded.triangles()), oriented_set(mesh.triangles()));
+    assert_eq!(
+        oriented_set(decoded.triangles()),
+        oriented_set(mesh.triangles())
+    );
     let m = compare(&mesh, &decoded).unwrap();
     eprintln!("q50 RMSE {} vertex {:?}", m.rmse, m.vertex_rmse);
     assert!(m.rmse < 1e-4, "RMSE {}", m.rmse);
@@ -115,7 +121,10 @@ fn skinning_predictor_and_decimation_round_trip() {
         ..tdct(75)
     };
     let decoded = decode_all(encode_bytes(&mesh, &skin), None).unwrap();
-    assert_eq!(oriented_set(decoded.triangles()), oriented_set(mesh.triangles()));
+    assert_eq!(
+        oriented_set(decoded.triangles()),
+        oriented_set(mesh.triangles())
+    );
     let e = vertex_rmse(&mesh, &decoded);
     eprintln!("skinning q75 vertex {e}");
     assert!(e < 1e-4, "skinning: vertex RMSE {e}");
@@ -126,7 +135,10 @@ fn skinning_predictor_and_decimation_round_trip() {
         ..tdct(75)
     };
     let decoded = decode_all(encode_bytes(&simple, &decimation), None).unwrap();
-    assert_eq!(oriented_set(decoded.triangles()), oriented_set(simple.triangles()));
+    assert_eq!(
+        oriented_set(decoded.triangles()),
+        oriented_set(simple.triangles())
+    );
     let e = vertex_rmse(&simple, &decoded);
     eprintln!("decimation q75 vertex {e}");
     assert!(e < 1e-4, "decimation: vertex RMSE {e}");
@@ -159,7 +171,11 @@ fn a_stream_cut_inside_the_coefficients_decodes_coarser() {
     let cut = bytes[..offset + len / 2].to_vec();
     let dec = decoder(cut.clone(), None).unwrap();
     assert!(dec.truncated());
-    assert!(dec.bands_decoded() < dec.bands_total(), "{}", dec.bands_decoded());
+    assert!(
+        dec.bands_decoded() < dec.bands_total(),
+        "{}",
+        dec.bands_decoded()
+    );
     let coarse = vertex_rmse(&mesh, &decode_all(cut, None).unwrap());
     eprintln!("full {full} cut {coarse} ({} bands)", dec.bands_decoded());
     assert!(coarse > full, "cut {coarse} vs full {full}");
@@ -179,12 +195,18 @@ fn cuts_before_the_coefficients_and_damaged_bands_are_errors() {
         .step_by(step)
         .chain(offset - PART_HEADER_LEN..offset)
     {
-        assert!(decoder(bytes[..cut].to_vec(), None).is_err(), "cut at {cut} decoded");
+        assert!(
+            decoder(bytes[..cut].to_vec(), None).is_err(),
+            "cut at {cut} decoded"
+        );
     }
     // A flipped byte inside a complete band fails that band's CRC.
     let mut bad = bytes.clone();
     bad[offset + 1] ^= 0x10;
-    let err = decoder(bad, None).err().expect("damaged band refused").to_string();
+    let err = decoder(bad, None)
+        .err()
+        .expect("damaged band refused")
+        .to_string();
     assert!(err.contains("checksum"), "{err}");
 }
 

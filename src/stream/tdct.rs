@@ -31,6 +31,10 @@ const CLASSES: usize = 8;
 /// Magnitude classes of the same vertex/axis's level in the previous band: 0, 1, 2+.
 const PREVIOUS: usize = 3;
 
+/// Contexts per frequency class: previous-band magnitude × whether an earlier axis of the same
+/// vertex is non-zero in this band.
+const CONTEXTS: usize = PREVIOUS * 2;
+
 /// Largest level magnitude the encoder writes: far above any sensible step, far below where the
 /// f64 → i64 conversion or the decoder's dequantisation lose meaning.
 const MAX_LEVEL: f64 = (1u64 << 40) as f64;
@@ -147,6 +151,15 @@ pub fn quantise(coefficients: &[Vec<f64>], step: f64, dead_zone: f64) -> Result<
 }
 
 /// The adaptive models of the coefficient coder, carried from band to band.
+///
+/// A level is coded with one of [`CONTEXTS`] signed-integer models per frequency class, chosen by
+/// what the decoder already has: the same vertex/axis's level in the previous band (0, 1, 2+), and
+/// whether an earlier axis of the same vertex is non-zero in this band. Coefficient bytes at
+/// θ = 0.15, steps 4e-4..5e-3 of the diagonal (`measure_dead_zone`): one model for everything
+/// → + previous-band magnitude saves 6–9 % on CesiumMan, 9–17 % on Fox, 5–26 % on RiggedFigure;
+/// + the sibling axis saves a further 1–2 % / 1.5–5 % / 0–3 %. The frequency class alone changed
+/// nothing measurable (the models carried over already follow the bands' drift); it is kept as it
+/// costs nothing and separates the DC band, whose statistics differ.
 #[derive(Clone)]
 pub struct BandCoder {
     models: Vec<IntModel>,
@@ -158,7 +171,7 @@ impl BandCoder {
     /// Fresh models for `vertices` vertices.
     pub fn new(vertices: usize) -> Self {
         Self {
-            models: vec![IntModel::default(); CLASSES * PREVIOUS],
+            models: vec![IntModel::default(); CLASSES * CONTEXTS],
             previous: vec![0; 3 * vertices],
         }
     }
@@ -166,11 +179,18 @@ impl BandCoder {
     /// Codes band `k` in either direction: `levels` is read by an encoder, filled by a decoder.
     fn code<C: SymbolCoder>(&mut self, coder: &mut C, k: usize, levels: &mut [i64]) -> Result<()> {
         let class = ((k + 1).ilog2() as usize).min(CLASSES - 1);
-        let models = &mut self.models[class * PREVIOUS..(class + 1) * PREVIOUS];
-        for (level, prev) in levels.iter_mut().zip(self.previous.iter_mut()) {
-            let m = &mut models[usize::from(*prev)];
-            *level = coder.signed(*level, m)?;
-            *prev = level.unsigned_abs().min(2) as u8;
+        let models = &mut self.models[class * CONTEXTS..(class + 1) * CONTEXTS];
+        for (vertex, prev) in levels
+            .chunks_exact_mut(3)
+            .zip(self.previous.chunks_exact_mut(3))
+        {
+            let mut sibling = 0;
+            for (level, prev) in vertex.iter_mut().zip(prev.iter_mut()) {
+                let m = &mut models[usize::from(*prev) * 2 + sibling];
+                *level = coder.signed(*level, m)?;
+                *prev = level.unsigned_abs().min(2) as u8;
+                sibling |= usize::from(*level != 0);
+            }
         }
         Ok(())
     }
