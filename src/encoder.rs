@@ -556,6 +556,10 @@ pub fn analyse_partition(
     })
 }
 
+/// The quantised affine track, the skinning weights (skinning predictor only) and every frame's
+/// residuals against them (`[frame][vertex]`).
+pub type Prediction = (AffineTrack, Option<SkinningWeights>, Vec<Vec<[f32; 3]>>);
+
 /// The quantised predictor (affine track, skinning weights) and every frame's residuals against
 /// it: the motion half of the analysis, all that the temporal DCT needs.
 pub fn predict_residuals(
@@ -563,7 +567,7 @@ pub fn predict_residuals(
     reference: &[Point],
     partition: &Partition,
     opts: &EncodeOptions,
-) -> Result<(AffineTrack, Option<SkinningWeights>, Vec<Vec<[f32; 3]>>)> {
+) -> Result<Prediction> {
     let track = AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_bits)?;
     let weights = match opts.predictor {
         PredictorKind::Affine => None,

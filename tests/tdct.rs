@@ -109,7 +109,7 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
         oriented_set(mesh.triangles())
     );
     let m = compare(&mesh, &decoded).unwrap();
-    eprintln!("q50 RMSE {} vertex {:?}", m.rmse, m.vertex_rmse);
+    // Measured 4.6e-5 of the diagonal (vertex RMSE 9.6e-5) at quality 50; the bound is about twice.
     assert!(m.rmse < 1e-4, "RMSE {}", m.rmse);
 }
 
@@ -125,9 +125,10 @@ fn skinning_predictor_and_decimation_round_trip() {
         oriented_set(decoded.triangles()),
         oriented_set(mesh.triangles())
     );
+    // Vertex RMSE measured 3.2e-5 (skinning, quality 75) and 6.7e-5 (decimation on the two-bone
+    // cylinder); the bounds are about twice.
     let e = vertex_rmse(&mesh, &decoded);
-    eprintln!("skinning q75 vertex {e}");
-    assert!(e < 1e-4, "skinning: vertex RMSE {e}");
+    assert!(e < 7e-5, "skinning: vertex RMSE {e}");
 
     let simple = media("RiggedSimple.glb");
     let decimation = EncodeOptions {
@@ -140,8 +141,7 @@ fn skinning_predictor_and_decimation_round_trip() {
         oriented_set(simple.triangles())
     );
     let e = vertex_rmse(&simple, &decoded);
-    eprintln!("decimation q75 vertex {e}");
-    assert!(e < 1e-4, "decimation: vertex RMSE {e}");
+    assert!(e < 1.4e-4, "decimation: vertex RMSE {e}");
 }
 
 #[test]
@@ -158,7 +158,7 @@ fn error_falls_as_more_bands_are_decoded() {
             vertex_rmse(&mesh, &decode_all(bytes.clone(), Some(n)).unwrap())
         })
         .collect();
-    eprintln!("bands 1, F/4, F: {errors:?}");
+    // Measured 3.0e-4, 1.50e-5, 1.48e-5: band 0 (the mean residual) alone is a coarse animation.
     assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
 }
 
@@ -177,7 +177,6 @@ fn a_stream_cut_inside_the_coefficients_decodes_coarser() {
         dec.bands_decoded()
     );
     let coarse = vertex_rmse(&mesh, &decode_all(cut, None).unwrap());
-    eprintln!("full {full} cut {coarse} ({} bands)", dec.bands_decoded());
     assert!(coarse > full, "cut {coarse} vs full {full}");
     // No coefficient bytes at all: the prediction alone, still a decodable animation.
     let bare = decoder(bytes[..offset].to_vec(), None).unwrap();

@@ -155,10 +155,10 @@ pub fn quantise(coefficients: &[Vec<f64>], step: f64, dead_zone: f64) -> Result<
 /// A level is coded with one of [`CONTEXTS`] signed-integer models per frequency class, chosen by
 /// what the decoder already has: the same vertex/axis's level in the previous band (0, 1, 2+), and
 /// whether an earlier axis of the same vertex is non-zero in this band. Coefficient bytes at
-/// θ = 0.15, steps 4e-4..5e-3 of the diagonal (`measure_dead_zone`): one model for everything
-/// → + previous-band magnitude saves 6–9 % on CesiumMan, 9–17 % on Fox, 5–26 % on RiggedFigure;
-/// + the sibling axis saves a further 1–2 % / 1.5–5 % / 0–3 %. The frequency class alone changed
-/// nothing measurable (the models carried over already follow the bands' drift); it is kept as it
+/// θ = 0.15, steps 4e-4..5e-3 of the diagonal (`measure_dead_zone`): against one model for
+/// everything, the previous-band magnitude saves 6–9 % on CesiumMan, 9–17 % on Fox and 5–26 % on
+/// RiggedFigure, and the sibling axis a further 1–2 %, 1.5–5 % and 0–3 %. The frequency class
+/// alone changed nothing measurable (the models carried over already follow the bands' drift); it is kept as it
 /// costs nothing and separates the DC band, whose statistics differ.
 #[derive(Clone)]
 pub struct BandCoder {
