@@ -61,9 +61,9 @@ pub struct Header {
     pub triangles: u32,
     /// Motion clusters `K`.
     pub clusters: u32,
-    /// Geometry-image lattice width in pixels.
+    /// Geometry-image lattice width in pixels (0 for tdct, which has no images).
     pub lattice_width: u16,
-    /// Geometry-image lattice height in pixels.
+    /// Geometry-image lattice height in pixels (0 for tdct).
     pub lattice_height: u16,
     /// The residual image codec.
     pub codec: CodecKind,
