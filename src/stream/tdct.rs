@@ -237,6 +237,13 @@ impl BandCoder {
         let mut levels = vec![0i64; n];
         self.code(&mut dec, k, &mut levels)
             .map_err(|e| Error::Stream(format!("temporal-DCT band {k}: {e}")))?;
+        // The encoder never writes more: a larger level would dequantise to a meaningless (even
+        // infinite) coordinate.
+        if levels.iter().any(|l| l.unsigned_abs() as f64 > MAX_LEVEL) {
+            return Err(Error::Stream(format!(
+                "temporal-DCT band {k} holds a level beyond ±2^40"
+            )));
+        }
         Ok(Some(levels))
     }
 }
@@ -401,6 +408,10 @@ mod tests {
             let got = dec.decode(k, bytes).unwrap().unwrap_or_else(|| vec![0; 90]);
             assert_eq!(got, levels[k], "band {k}");
         }
+        // Levels the encoder never writes are refused; so are more coefficients than bytes can hold.
+        let huge = BandCoder::new(1).encode(1, &[1 << 50, 0, 0]).unwrap();
+        assert!(BandCoder::new(1).decode(1, &huge).is_err());
+        assert!(BandCoder::new(100_000).decode(0, &[0; 4]).is_err());
         assert!(
             BandIndex::from_bytes(&index.to_bytes().unwrap(), 8, payload.len() as u64).is_err()
         );
