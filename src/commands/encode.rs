@@ -47,6 +47,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         codec: match args.codec {
             CodecChoice::Jpeg => CodecKind::Jpeg,
             CodecChoice::Mpeg4 => CodecKind::Mpeg4,
+            CodecChoice::Tdct => CodecKind::Tdct,
         },
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
         qscale: args.qscale,
@@ -62,6 +63,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             PredictorChoice::Skinning => PredictorKind::Skinning,
         },
         weight_bits: args.weight_bits,
+        step: args.step,
         ..defaults
     })
 }
