@@ -219,7 +219,7 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
     let dir = tempfile::tempdir().unwrap();
     let stream = dir.path().join("fig.mcgv");
     let s = stream.to_str().unwrap();
-    let sample = media("RiggedFigure.glb");
+    let sample = media_path("RiggedFigure.glb");
     let enc = json(&run(&[
         "encode",
         &sample,

@@ -2,9 +2,12 @@
 //! both segmentations, progressive decoding of a band prefix or a truncated file, random access,
 //! and damaged or forged streams.
 
+mod common;
+
+use common::{encode_bytes, read_media};
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
-use mcgv_video::mesh::{read_animation, AnimatedMesh, ReadOptions, Triangle};
+use mcgv_video::mesh::{AnimatedMesh, Triangle};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::PredictorKind;
 use mcgv_video::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
@@ -12,24 +15,12 @@ use mcgv_video::stream::header::{CodecKind, Header};
 use std::collections::BTreeSet;
 use std::io::Cursor;
 
-fn media(name: &str) -> AnimatedMesh {
-    let path = format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"));
-    read_animation(&path, &ReadOptions::default()).expect("media sample reads")
-}
-
 fn tdct(quality: u8) -> EncodeOptions {
     EncodeOptions {
         codec: CodecKind::Tdct,
         quality,
         ..EncodeOptions::default()
     }
-}
-
-fn encode_bytes(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<u8> {
-    encode(mesh, opts, &indicatif::ProgressBar::hidden())
-        .expect("encodes")
-        .container
-        .to_bytes()
 }
 
 fn decoder(
@@ -79,7 +70,7 @@ fn part(bytes: &[u8], tag: Tag) -> (usize, usize) {
 
 #[test]
 fn round_trip_keeps_connectivity_and_bounds_error() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let bytes = encode_bytes(&mesh, &tdct(50));
     let reader = ContainerReader::new(Cursor::new(bytes.clone())).unwrap();
     let tags: Vec<Tag> = reader.parts().iter().map(|p| p.tag).collect();
@@ -115,7 +106,7 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
 
 #[test]
 fn skinning_predictor_and_decimation_round_trip() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let skin = EncodeOptions {
         predictor: PredictorKind::Skinning,
         ..tdct(75)
@@ -130,7 +121,7 @@ fn skinning_predictor_and_decimation_round_trip() {
     let e = vertex_rmse(&mesh, &decoded);
     assert!(e < 7e-5, "skinning: vertex RMSE {e}");
 
-    let simple = media("RiggedSimple.glb");
+    let simple = read_media("RiggedSimple.glb");
     let decimation = EncodeOptions {
         segmentation: Segmentation::Decimation { e0: 0.003 },
         ..tdct(75)
@@ -146,7 +137,7 @@ fn skinning_predictor_and_decimation_round_trip() {
 
 #[test]
 fn error_falls_as_more_bands_are_decoded() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let bytes = encode_bytes(&mesh, &tdct(95));
     let f = mesh.frame_count();
     let errors: Vec<f64> = [1, f / 4, f]
@@ -164,7 +155,7 @@ fn error_falls_as_more_bands_are_decoded() {
 
 #[test]
 fn a_stream_cut_inside_the_coefficients_decodes_coarser() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let bytes = encode_bytes(&mesh, &tdct(95));
     let full = vertex_rmse(&mesh, &decode_all(bytes.clone(), None).unwrap());
     let (offset, len) = part(&bytes, Tag::TDCT);
@@ -185,7 +176,7 @@ fn a_stream_cut_inside_the_coefficients_decodes_coarser() {
 
 #[test]
 fn cuts_before_the_coefficients_and_damaged_bands_are_errors() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let bytes = encode_bytes(&mesh, &tdct(95));
     let (offset, _) = part(&bytes, Tag::TDCT);
     // Every cut before the coefficients' payload (part headers included) is an error.
@@ -211,7 +202,7 @@ fn cuts_before_the_coefficients_and_damaged_bands_are_errors() {
 
 #[test]
 fn a_frame_decoded_alone_equals_the_full_decode() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let bytes = encode_bytes(&mesh, &tdct(90));
     for bands in [None, Some(3)] {
         let all = decode_all(bytes.clone(), bands).unwrap();
@@ -232,7 +223,7 @@ fn a_frame_decoded_alone_equals_the_full_decode() {
 /// refused by the checks against the parts' real contents, before anything of that size exists.
 #[test]
 fn forged_counts_are_refused_before_allocating() {
-    let mesh = media("RiggedSimple.glb");
+    let mesh = read_media("RiggedSimple.glb");
     let bytes = encode_bytes(&mesh, &tdct(50));
     let head = FILE_HEADER_LEN + PART_HEADER_LEN;
     let (_, head_len) = part(&bytes, Tag::HEADER);
@@ -270,7 +261,7 @@ fn forged_counts_are_refused_before_allocating() {
 
 #[test]
 fn step_overrides_quality_and_is_checked() {
-    let mesh = media("RiggedSimple.glb");
+    let mesh = read_media("RiggedSimple.glb");
     let coarse = encode_bytes(
         &mesh,
         &EncodeOptions {
@@ -316,7 +307,7 @@ fn measure_dead_zone() {
     use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
     use mcgv_video::stream::tdct::{forward, quantise, BandCoder};
     for name in ["CesiumMan.glb", "Fox.glb", "RiggedFigure.glb"] {
-        let mesh = media(name);
+        let mesh = read_media(name);
         let opts = tdct(50);
         let ff = first_frame::encode(
             mesh.frame(0),
