@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # `make bench`: the motion bench (segmentation + prediction speed and residual energy), then a rate
 # sweep of mcgv-video (JPEG and MPEG-4) and of the peer codecs (Draco, zstd, PCA, Dynapack-style) over
-# media/ and, when present, ../shared/media, then one RD plot per sequence and the README tables:
-#   bench-out/motion.txt, sweep.csv, peers.csv, plots/SEQUENCE.png, table.md
-# MCGV_PYTHON is the virtualenv's python (`make bench` passes it).
+# media/ and, when present, ../shared/media, then a shorter sweep of the encoder variants (skinning
+# predictor, decimation segmentation, both; JPEG q 10 and 50, MPEG-4 qscale 4 and 16, TDCT q 10 and 50
+# when the binary has it), then one RD plot per sequence and the README tables:
+#   bench-out/motion.txt, sweep.csv, sweep-variants.csv, peers.csv, plots/SEQUENCE.png, table.md
+# MCGV_PYTHON is the virtualenv's python (`make bench` passes it). BENCH_VARIANTS overrides the
+# variants (scripts/sweep.sh VARIANTS); empty skips the variant sweep.
 set -euo pipefail
 py=${MCGV_PYTHON:-.venv/bin/python}
 mkdir -p bench-out
@@ -16,13 +19,25 @@ if [ -d "$shared" ]; then
         [ -d "$unpacked/$name" ] || { mkdir -p "$unpacked" && tar xJf "$tarball" -C "$unpacked"; }
         inputs+=("$unpacked/$name")
     done
-    [ -d "$shared/walking_cat/OBJ" ] && inputs+=("$shared/walking_cat/OBJ")
+    # Linked under its own name: sweep.sh names a sequence after its folder, and this one is "OBJ".
+    if [ -d "$shared/walking_cat/OBJ" ]; then
+        mkdir -p "$unpacked" && ln -sfn "$(realpath "$shared/walking_cat/OBJ")" "$unpacked/walking_cat"
+        inputs+=("$unpacked/walking_cat")
+    fi
     for glb in "$shared"/threejs_*/*.glb; do inputs+=("$glb"); done
 fi
 cargo bench --quiet --bench motion -- "${inputs[@]}" | tee bench-out/motion.txt
-rm -f bench-out/sweep.csv bench-out/peers.csv
-bash scripts/sweep.sh bench-out/sweep.csv "${inputs[@]}"
+rm -f bench-out/sweep.csv bench-out/sweep-variants.csv bench-out/peers.csv
+VARIANTS=default bash scripts/sweep.sh bench-out/sweep.csv "${inputs[@]}"
+csvs=(bench-out/sweep.csv)
+variants=${BENCH_VARIANTS-"skinning decimation skinning+decimation"}
+if [ -n "$variants" ]; then
+    VARIANTS=$variants JPEG_QUALITIES="10 50" QSCALES="4 16" TDCT_QUALITIES="10 50" \
+        bash scripts/sweep.sh bench-out/sweep-variants.csv "${inputs[@]}"
+    csvs+=(bench-out/sweep-variants.csv)
+fi
 MCGV_BIN=target/release/mcgv-video "$py" scripts/peers.py run bench-out/peers.csv "${inputs[@]}"
-cargo run --release --quiet --example rd_plot -- bench-out/plots bench-out/sweep.csv bench-out/peers.csv
-"$py" scripts/rd_table.py bench-out/sweep.csv bench-out/peers.csv > bench-out/table.md
-echo "results: bench-out/motion.txt, sweep.csv, peers.csv, plots/, table.md"
+csvs+=(bench-out/peers.csv)
+cargo run --release --quiet --example rd_plot -- bench-out/plots "${csvs[@]}"
+"$py" scripts/rd_table.py "${csvs[@]}" > bench-out/table.md
+echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md"

@@ -8,7 +8,13 @@ Per sequence: for each codec, the RMSE (x 1e-4 of the bbox diagonal) at the MCGV
 at a lower or equal rate) by linear interpolation in log(bpvf)-log(RMSE); "—" outside the measured
 range, never extrapolated. Then one line naming the rates at which mcgv-video (the better of its JPEG
 and MPEG-4 frontiers) has the lowest RMSE of all codecs measured there, and the peers that beat it
-elsewhere with the largest factor (rates where no peer was measured are left out). Last, speed and peak memory for the largest sequence (V x F),
+elsewhere with the largest factor (rates where no peer was measured are left out).
+mcgv-video's encoder variants (scripts/sweep.sh VARIANTS: codec column CODEC+VARIANT, e.g.
+mpeg4+skinning) are series of their own, all counted as mcgv-video. When a sequence has any, two more
+things follow: which mcgv-video series has the lowest RMSE at equal rate, over which rates (on the
+same log grid), and a table of bpvf / RMSE per image-codec setting with one column per variant
+(default = affine predictor, k-means segmentation), so that variants are compared at the same settings.
+Last, speed and peak memory for the largest sequence (V x F),
 or for --speed SEQUENCE: whole-process figures as the CSV records them.
 Only standard-library Python, so it also runs outside the virtualenv.
 """
@@ -18,7 +24,8 @@ import sys
 from collections import defaultdict
 
 PAPER_RATES = (2.2, 4.0, 8.0)
-OURS = ("jpeg", "mpeg4")
+OURS = ("jpeg", "mpeg4", "tdct")   # mcgv-video's image codecs; a variant is CODEC+VARIANT
+VARIANTS = ("", "skinning", "decimation", "skinning+decimation")   # column order of the variant table
 GRID = 200  # rates per sequence at which codecs are compared for the closing line
 
 
@@ -69,8 +76,27 @@ def e4(value):
     return "—" if value is None else f"{value * 1e4:.3g}"
 
 
+def split(codec):
+    """(image codec, variant) of an mcgv-video series, variant "" for the default encoder."""
+    base, _, variant = codec.partition("+")
+    return base, variant
+
+
+def ours(codec):
+    return split(codec)[0] in OURS
+
+
+def order(codec):
+    """Sort key: mcgv-video's series first, by image codec then variant, then the peers."""
+    if not ours(codec):
+        return (1, 0, 0, codec)
+    base, variant = split(codec)
+    v = VARIANTS.index(variant) if variant in VARIANTS else len(VARIANTS)
+    return (0, OURS.index(base), v, variant)
+
+
 def label(codec):
-    return f"mcgv-video {codec}" if codec in OURS else codec
+    return f"mcgv-video {codec}" if ours(codec) else codec
 
 
 def sequence_section(name, rows):
@@ -82,7 +108,7 @@ def sequence_section(name, rows):
            "| codec | points | bpvf measured | RMSE ×1e-4 at 2.2 | at 4 | at 8 | lowest RMSE ×1e-4 (at bpvf) |",
            "|---|---|---|---|---|---|---|"]
     fronts = {}
-    for codec in sorted(by_codec, key=lambda c: (c not in OURS, c)):
+    for codec in sorted(by_codec, key=order):
         pts = by_codec[codec]
         lo, hi = min(p[0] for p in pts), max(p[0] for p in pts)
         if all(e == 0 for _, e in pts):
@@ -97,20 +123,91 @@ def sequence_section(name, rows):
                    f"{e4(best_e)} (at {best_b:.3g}) |")
     lossless = min((b for c, pts in by_codec.items() for b, e in pts if e == 0), default=None)
     out += ["", closing_line(fronts, lossless), ""]
+    if any(ours(c) and split(c)[1] for c in by_codec):
+        out += [best_series_line(fronts), ""] + variant_table(rows) + [""]
     return out
 
 
+def log_grid(lo, hi):
+    return [math.exp(math.log(lo) + (math.log(hi) - math.log(lo)) * i / GRID) for i in range(GRID + 1)]
+
+
+def spans_of(rates, lo, hi):
+    """Contiguous runs of grid rates, as (first, last) pairs."""
+    step = math.exp((math.log(hi) - math.log(lo)) / GRID) * 1.0001
+    spans, start, prev = [], rates[0], rates[0]
+    for r in rates[1:]:
+        if r > prev * step:
+            spans.append((start, prev))
+            start = r
+        prev = r
+    spans.append((start, prev))
+    return spans
+
+
+def best_series_line(fronts):
+    """Which mcgv-video series (image codec and variant) has the lowest RMSE at each rate where at
+    least two of them are measured, as spans of rates."""
+    mine = {c: f for c, f in fronts.items() if ours(c)}
+    lo = min(f[0][0] for f in mine.values())
+    hi = max(f[-1][0] for f in mine.values())
+    winners = defaultdict(list)
+    for rate in log_grid(lo, hi):
+        there = {c: at_rate(f, rate) for c, f in mine.items()}
+        there = {c: v for c, v in there.items() if v is not None}
+        if len(there) >= 2:
+            winners[min(there, key=lambda c: (there[c], order(c)))].append(rate)
+    if not winners:
+        return "Best mcgv-video series: no rate where two of them were measured."
+    parts = []
+    for codec in sorted(winners, key=lambda c: winners[c][0]):
+        spans = spans_of(winners[codec], lo, hi)
+        parts.append(f"{codec} at " + ", ".join(f"{a:.3g}–{b:.3g}" for a, b in spans))
+    return ("Best mcgv-video series (lowest RMSE at equal rate, where two or more are measured): "
+            + "; ".join(parts) + " bpvf.")
+
+
+def variant_table(rows):
+    """bpvf / RMSE x 1e-4 of each mcgv-video setting, one column per encoder variant."""
+    cells, variants = defaultdict(dict), set()
+    for r in rows:
+        if ours(r["codec"]):
+            base, variant = split(r["codec"])
+            cells[(base, r["setting"])][variant] = r
+            variants.add(variant)
+    cols = sorted(variants, key=lambda v: (VARIANTS.index(v) if v in VARIANTS else len(VARIANTS), v))
+    # Only the settings measured with a variant: the default sweep has more rates than the variants'.
+    keys = [k for k in cells if any(v for v in cells[k])]
+
+    def setting_key(k):
+        number = k[1].split()[-1]
+        try:
+            number = float(number)
+        except ValueError:
+            number = 0.0
+        return (OURS.index(k[0]) if k[0] in OURS else len(OURS), k[1].split()[0], number)
+    names = {"": "default (affine, k-means)"}
+    out = ["| codec, setting | " + " | ".join(names.get(v, v) for v in cols) + " |",
+           "|---|" + "---|" * len(cols), ]
+    for k in sorted(keys, key=setting_key):
+        row = []
+        for v in cols:
+            r = cells[k].get(v)
+            row.append("—" if r is None else f"{r['bpvf']:.3g} / {r['rmse'] * 1e4:.3g}")
+        out.append(f"| {k[0]} {k[1]} | " + " | ".join(row) + " |")
+    return ["bpvf / RMSE ×1e-4 per variant at the same settings:", ""] + out
+
+
 def closing_line(fronts, lossless):
-    ours = {c: f for c, f in fronts.items() if c in OURS}
-    peers = {c: f for c, f in fronts.items() if c not in OURS}
-    if not ours:
+    mine_fronts = {c: f for c, f in fronts.items() if ours(c)}
+    peers = {c: f for c, f in fronts.items() if not ours(c)}
+    if not mine_fronts:
         return "No mcgv-video rows for this sequence."
-    lo = min(f[0][0] for f in ours.values())
-    hi = max(f[-1][0] for f in ours.values())
+    lo = min(f[0][0] for f in mine_fronts.values())
+    hi = max(f[-1][0] for f in mine_fronts.values())
     wins, losses = [], defaultdict(lambda: (0.0, None))   # peer -> (largest factor, at rate)
-    for i in range(GRID + 1):
-        rate = math.exp(math.log(lo) + (math.log(hi) - math.log(lo)) * i / GRID)
-        mine = [v for v in (at_rate(f, rate) for f in ours.values()) if v is not None]
+    for rate in log_grid(lo, hi):
+        mine = [v for v in (at_rate(f, rate) for f in mine_fronts.values()) if v is not None]
         if not mine:
             continue
         mine = min(mine)
@@ -125,16 +222,8 @@ def closing_line(fronts, lossless):
                 losses[p] = (mine / v, rate)
     text = []
     if wins:
-        spans, start, prev = [], wins[0], wins[0]
-        step = math.exp((math.log(hi) - math.log(lo)) / GRID) * 1.0001
-        for r in wins[1:]:
-            if r > prev * step:
-                spans.append((start, prev))
-                start = r
-            prev = r
-        spans.append((start, prev))
         text.append("mcgv-video has the lowest RMSE of all codecs at "
-                    + ", ".join(f"{a:.3g}–{b:.3g}" for a, b in spans) + " bpvf")
+                    + ", ".join(f"{a:.3g}–{b:.3g}" for a, b in spans_of(wins, lo, hi)) + " bpvf")
     else:
         text.append(f"mcgv-video ({lo:.3g}–{hi:.3g} bpvf measured) never has the lowest RMSE where a "
                     "peer is measured at the same rate")
@@ -153,7 +242,7 @@ def speed_section(name, rows):
            "| codec | setting | bpvf | encode frames/s | decode frames/s | encode CPU s | decode CPU s "
            "| encode peak MB | decode peak MB |", "|---|---|---|---|---|---|---|---|---|"]
     frames = float(rows[0]["frames"])
-    for r in sorted(rows, key=lambda r: (r["codec"] not in OURS, r["codec"], r["bpvf"])):
+    for r in sorted(rows, key=lambda r: (order(r["codec"]), r["bpvf"])):
         def rate(key):
             s = float(r[key]) if r.get(key) else 0
             return f"{frames / s:.1f}" if s > 0 else "—"

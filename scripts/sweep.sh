@@ -4,13 +4,46 @@
 # papers' surface measure, as a fraction of the bbox diagonal). Times are whole-process figures from
 # GNU time: wall seconds, CPU seconds (user + system, steadier than wall on a shared machine) and
 # peak resident memory.
-#   scripts/sweep.sh OUT.csv INPUT...        (env: JPEG_QUALITIES, QSCALES, MCGV_BIN)
+#   scripts/sweep.sh OUT.csv INPUT...
+# env: JPEG_QUALITIES, QSCALES, TDCT_QUALITIES, VARIANTS, MCGV_BIN
+#   VARIANTS   space-separated encoder variants, each a '+'-joined list of
+#              skinning (--predictor skinning) and decimation (--segmentation decimation), or
+#              `default` (no extra flag). Unset: the default encoder only. A variant's rows are
+#              labelled in the codec column as CODEC+VARIANT (mpeg4+skinning, jpeg+skinning+decimation),
+#              so plots and tables treat each as its own series; the CSV columns stay the same.
+#   JPEG_QUALITIES, QSCALES  unset: the defaults below; set but empty: no run of that codec.
+#   TDCT_QUALITIES  --quality values of `--codec tdct` runs, made only when the binary's
+#              `encode --help` mentions tdct (default: the JPEG qualities); empty: none.
 set -euo pipefail
 bin=${MCGV_BIN:-target/release/mcgv-video}
 out=$1; shift
-qualities=${JPEG_QUALITIES:-"5 10 20 35 50 75"}
-qscales=${QSCALES:-"2 3 4 8 16 31"}
+qualities=${JPEG_QUALITIES-"5 10 20 35 50 75"}
+qscales=${QSCALES-"2 3 4 8 16 31"}
+tdct_qualities=${TDCT_QUALITIES-$qualities}
+variants=${VARIANTS:-default}
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+# Encoder flags of a variant; fails on an unknown name, before anything is encoded.
+variant_flags() {
+    local part flags=() parts
+    [ "$1" = default ] && return 0
+    IFS=+ read -ra parts <<<"$1"
+    for part in "${parts[@]}"; do
+        case $part in
+            skinning) flags+=(--predictor skinning) ;;
+            decimation) flags+=(--segmentation decimation) ;;
+            *) echo "sweep.sh: unknown variant part '$part' in '$1' (skinning, decimation, default)" >&2
+               return 1 ;;
+        esac
+    done
+    echo "${flags[*]}"
+}
+for variant in $variants; do variant_flags "$variant" >/dev/null; done
+tdct=no
+if [ -n "$tdct_qualities" ] && "$bin" encode --help | grep -qw tdct; then
+    tdct=yes
+elif [ -n "${TDCT_QUALITIES:-}" ]; then
+    echo "sweep.sh: $bin has no tdct codec; TDCT_QUALITIES ignored" >&2
+fi
 [ -s "$out" ] || echo "sequence,codec,setting,bytes,bpvf,rmse,vertex_rmse,kg_error,hausdorff,encode_s,decode_s,encode_cpu_s,decode_cpu_s,encode_rss_kb,decode_rss_kb,frames,vertices" > "$out"
 field() { sed -E "s/.*\"$1\":([0-9.eE+-]+).*/\1/" <<<"$2"; }
 # Runs a command under GNU time; prints "wall cpu max_rss_kb".
@@ -23,16 +56,24 @@ for input in "$@"; do
     runs=()
     for q in $qualities; do runs+=("jpeg --quality $q"); done
     for q in $qscales; do runs+=("mpeg4 --qscale $q"); done
-    for run in "${runs[@]}"; do
-        read -r codec flag value <<<"$run"
-        stream="$tmp/$name.mcgv"
-        read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" --codec "$codec" "$flag" "$value" --quiet)
-        read -r dw dc dm < <(measure "$bin" decode "$stream" -o "$tmp/dec.pc2" --quiet)
-        m=$("$bin" eval "$input" "$stream" --json --quiet)
-        printf '%s,%s,%s,%d,%.4f,%.6e,%.6e,%.5f,%.6e,%s,%s,%s,%s,%s,%s,%d,%d\n' \
-            "$name" "$codec" "${flag#--} $value" "$(stat -c %s "$stream")" "$(field bpvf "$m")" \
-            "$(field rmse "$m")" "$(field vertex_rmse "$m")" "$(field kg_error "$m")" \
-            "$(field hausdorff "$m")" "$ew" "$dw" "$ec" "$dc" "$em" "$dm" \
-            "$(field frames "$m")" "$(field vertices "$m")" | tee -a "$out"
+    if [ "$tdct" = yes ]; then
+        for q in $tdct_qualities; do runs+=("tdct --quality $q"); done
+    fi
+    for variant in $variants; do
+        read -ra extra <<<"$(variant_flags "$variant")"
+        suffix=""; [ "$variant" = default ] || suffix="+$variant"
+        for run in "${runs[@]}"; do
+            read -r codec flag value <<<"$run"
+            stream="$tmp/$name.mcgv"
+            read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" --codec "$codec" "$flag" "$value" \
+                ${extra[@]+"${extra[@]}"} --quiet)
+            read -r dw dc dm < <(measure "$bin" decode "$stream" -o "$tmp/dec.pc2" --quiet)
+            m=$("$bin" eval "$input" "$stream" --json --quiet)
+            printf '%s,%s,%s,%d,%.4f,%.6e,%.6e,%.5f,%.6e,%s,%s,%s,%s,%s,%s,%d,%d\n' \
+                "$name" "$codec$suffix" "${flag#--} $value" "$(stat -c %s "$stream")" "$(field bpvf "$m")" \
+                "$(field rmse "$m")" "$(field vertex_rmse "$m")" "$(field kg_error "$m")" \
+                "$(field hausdorff "$m")" "$ew" "$dw" "$ec" "$dc" "$em" "$dm" \
+                "$(field frames "$m")" "$(field vertices "$m")" | tee -a "$out"
+        done
     done
 done
