@@ -132,6 +132,11 @@ impl<R: Read + Seek> Decoder<R> {
         &self.pixels
     }
 
+    /// The residual range of every frame and coordinate.
+    pub fn ranges(&self) -> &[FrameRanges] {
+        &self.ranges
+    }
+
     /// The part table, for bit budgets.
     pub fn container(&self) -> &ContainerReader<R> {
         &self.reader

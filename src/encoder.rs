@@ -43,6 +43,9 @@ pub struct EncodeOptions {
     pub predictor: PredictorKind,
     /// Bits per skinning weight, sign included (the paper's 16 by default).
     pub weight_bits: u8,
+    /// Residual ranges narrower than this fraction of the sequence's widest are widened to it, so
+    /// frames with small residuals get coarser levels instead of the full 0..255 (0 = off).
+    pub range_floor: f32,
 }
 
 impl Default for EncodeOptions {
@@ -61,6 +64,7 @@ impl Default for EncodeOptions {
             reorder: false,
             predictor: PredictorKind::Affine,
             weight_bits: motion::WEIGHT_BITS,
+            range_floor: 0.0,
         }
     }
 }
@@ -358,6 +362,12 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
             "--weight-bits must be between 2 and 31".into(),
         ));
     }
+    if !(0.0..=1.0).contains(&opts.range_floor) {
+        return Err(Error::Usage(format!(
+            "--range-floor must be between 0 and 1, not {}",
+            opts.range_floor
+        )));
+    }
     if opts.gop == 0 {
         return Err(Error::Usage("--gop must be at least 1".into()));
     }
@@ -482,7 +492,8 @@ pub fn analyse_partition(
         CodecKind::Jpeg => RangeMode::PerFrame,
         CodecKind::Mpeg4 => RangeMode::PerGroup(opts.gop),
     };
-    let ranges = quantise::frame_ranges(&residuals, mode);
+    let mut ranges = quantise::frame_ranges(&residuals, mode);
+    quantise::widen(&mut ranges, opts.range_floor);
     Ok(Analysis {
         reference,
         partition,

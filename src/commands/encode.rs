@@ -62,6 +62,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             PredictorChoice::Skinning => PredictorKind::Skinning,
         },
         weight_bits: args.weight_bits,
+        range_floor: args.range_floor,
         ..defaults
     })
 }
