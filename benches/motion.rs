@@ -1,19 +1,24 @@
-//! Segmentation and prediction on real sequences: K, residual energy against raw motion energy,
-//! largest residual, and the time of each stage, for the piecewise affine predictor and the
-//! skinning predictor (follow-up paper eq. 7–10; its per-frame mean and max residual energy against
-//! the affine one's, and the bits of its coded weights).
+//! Segmentation and prediction on real sequences, one row per segmentation method: k-means (K = 20)
+//! and decimation (K found from E0 = 0.003). Each row gives K, residual energy against raw motion
+//! energy, largest residual and the time of each stage for the piecewise affine predictor, then the
+//! skinning predictor fitted to the same partition (follow-up paper eq. 7–10; its per-frame mean and
+//! max residual energy against the affine one's, and the bits of its coded weights).
 //!
 //! `cargo bench --bench motion [-- INPUT ...]` (any input `read_animation` takes); with no arguments,
 //! every sequence found under
 //! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
-//! variables `REFINE`, `FEATURE_FRAMES` and `KMEANS_ITERATIONS` override the matching `SegmentOptions`,
-//! `SKIN_RIDGE` and `SKIN_BITS` the relative ridge and bits per weight of the skinning fits;
-//! `PICTURES=DIR` writes each partition's picture (frame 0 coloured by cluster) there.
+//! variables `REFINE`, `FEATURE_FRAMES`, `KMEANS_ITERATIONS` and `CLUSTERS` override the matching
+//! `SegmentOptions`, `E0` and `DECIMATE_REFINE` decimation's threshold and border refinement rounds,
+//! and `SEGMENTATION=kmeans|decimation` runs one method only; `SKIN_RIDGE` and `SKIN_BITS` set the
+//! relative ridge and bits per weight of the skinning fits; `PICTURES=DIR` writes each partition's
+//! picture (frame 0 coloured by cluster) there.
+//! The `E_l` column is decimation's RMS affine-fit error per vertex and frame over the bbox diagonal;
+//! `K0` is the K its collapses alone left, before border refinement (NaN and 0 on k-means rows).
 
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
-    energy, render_partition_png, residuals, segment, AffineTrack, SegmentOptions, SkinningWeights,
-    DEFAULT_AFFINE_BITS, DEFAULT_RIDGE, WEIGHT_BITS,
+    decimate, energy, render_partition_png, residuals, segment, AffineTrack, DecimateOptions,
+    Partition, SegmentOptions, SkinningWeights, DEFAULT_AFFINE_BITS, DEFAULT_RIDGE, WEIGHT_BITS,
 };
 use mcgv_video::stream::side_info::encode_weights;
 use mcgv_video::AnimatedMesh;
@@ -31,11 +36,14 @@ fn main() {
         args.iter().map(PathBuf::from).collect()
     };
     println!(
-        "{:<22} {:>6} {:>5} {:>3} {:>12} {:>10} {:>11} {:>9} {:>9} {:>12} {:>10} {:>9} {:>9} {:>10} {:>7} {:>7}",
+        "{:<22} {:<10} {:>6} {:>5} {:>4} {:>4} {:>8} {:>12} {:>10} {:>11} {:>9} {:>9} {:>12} {:>10} {:>9} {:>9} {:>10} {:>7} {:>7}",
         "sequence",
+        "method",
         "V",
         "F",
         "K",
+        "K0",
+        "E_l",
         "resid/motion",
         "max % diag",
         "quant % diag",
@@ -60,8 +68,16 @@ fn main() {
             || input.display().to_string(),
             |n| n.to_string_lossy().into(),
         );
+        let which = std::env::var("SEGMENTATION").unwrap_or_default();
         match load(&input) {
-            Ok(mesh) => measure(&name, &mesh),
+            Ok(mesh) => {
+                if which.is_empty() || which == "kmeans" {
+                    measure(&name, &mesh, Method::KMeans);
+                }
+                if which.is_empty() || which == "decimation" {
+                    measure(&name, &mesh, Method::Decimation);
+                }
+            }
             Err(e) => println!("{name:<22} skipped: {e}"),
         }
     }
@@ -102,22 +118,55 @@ fn knob<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
 
-fn measure(name: &str, mesh: &AnimatedMesh) {
-    let start = Instant::now();
-    let defaults = SegmentOptions::default();
-    let opts = SegmentOptions {
-        refine_passes: knob("REFINE").unwrap_or(defaults.refine_passes),
-        feature_frames: knob("FEATURE_FRAMES").unwrap_or(defaults.feature_frames),
-        max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
-        ..defaults
+#[derive(Clone, Copy)]
+enum Method {
+    KMeans,
+    Decimation,
+}
+
+/// The partition of one method, with decimation's E_l and K before refinement (NaN, 0 for k-means).
+fn partition_by(
+    mesh: &AnimatedMesh,
+    method: Method,
+) -> mcgv_video::Result<(Partition, f64, usize)> {
+    match method {
+        Method::KMeans => {
+            let defaults = SegmentOptions::default();
+            let opts = SegmentOptions {
+                clusters: knob("CLUSTERS").unwrap_or(defaults.clusters),
+                refine_passes: knob("REFINE").unwrap_or(defaults.refine_passes),
+                feature_frames: knob("FEATURE_FRAMES").unwrap_or(defaults.feature_frames),
+                max_iterations: knob("KMEANS_ITERATIONS").unwrap_or(defaults.max_iterations),
+                ..defaults
+            };
+            Ok((segment(mesh, &opts)?, f64::NAN, 0))
+        }
+        Method::Decimation => {
+            let defaults = DecimateOptions::default();
+            let opts = DecimateOptions {
+                e0: knob("E0").unwrap_or(defaults.e0),
+                refine_passes: knob("DECIMATE_REFINE").unwrap_or(defaults.refine_passes),
+                ..defaults
+            };
+            let d = decimate(mesh, &opts)?;
+            Ok((d.partition, d.error, d.decimated_clusters))
+        }
+    }
+}
+
+fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
+    let label = match method {
+        Method::KMeans => "kmeans",
+        Method::Decimation => "decimation",
     };
-    let partition = match segment(mesh, &opts) {
+    let start = Instant::now();
+    let (partition, fit_error, plain_k) = match partition_by(mesh, method) {
         Ok(p) => p,
-        Err(e) => return println!("{name:<22} segmentation failed: {e}"),
+        Err(e) => return println!("{name:<22} {label:<10} segmentation failed: {e}"),
     };
     let segment_time = start.elapsed().as_secs_f64();
     if let Ok(dir) = std::env::var("PICTURES") {
-        let path = Path::new(&dir).join(format!("{name}.png"));
+        let path = Path::new(&dir).join(format!("{name}-{label}.png"));
         let (frame0, labels) = (mesh.frame(0), partition.labels());
         if let Err(e) = render_partition_png(frame0, mesh.triangles(), labels, 512, &path) {
             println!("{name}: picture not written: {e}");
@@ -129,7 +178,7 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
     let reference = mesh.frame(0);
     let track = match AffineTrack::fit(mesh.frames(), reference, &partition, DEFAULT_AFFINE_BITS) {
         Ok(t) => t,
-        Err(e) => return println!("{name:<22} prediction failed: {e}"),
+        Err(e) => return println!("{name:<22} {label:<10} prediction failed: {e}"),
     };
     let mut residual_energy = 0.0;
     let mut motion_energy = 0.0;
@@ -141,23 +190,19 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
         affine_frames.push(energy(&e));
         residual_energy += energy(&e);
         motion_energy += energy(&residuals(mesh.frame(f), reference));
-        largest = e
-            .iter()
-            .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
-            .fold(largest, f64::max);
+        largest = largest.max(longest(&e));
     }
     let predict_time = start.elapsed().as_secs_f64();
     // What quantisation alone costs: the 17-bit prediction against a (nearly) unquantised one.
     let quantisation =
         AffineTrack::fit(mesh.frames(), reference, &partition, 30).map_or(f64::NAN, |fine| {
             (0..mesh.frame_count())
-                .flat_map(|f| {
-                    residuals(
+                .map(|f| {
+                    longest(&residuals(
                         &track.predict(f, reference, &partition),
                         &fine.predict(f, reference, &partition),
-                    )
+                    ))
                 })
-                .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
                 .fold(0.0, f64::max)
         });
 
@@ -173,21 +218,18 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
         knob("SKIN_BITS").unwrap_or(WEIGHT_BITS),
     ) {
         Ok(w) => w,
-        Err(e) => return println!("{name:<22} skinning failed: {e}"),
+        Err(e) => return println!("{name:<22} {label:<10} skinning failed: {e}"),
     };
     let mut skin_frames = Vec::with_capacity(mesh.frame_count());
     let mut skin_largest = 0f64;
     for f in 0..mesh.frame_count() {
         let predicted = match weights.try_predict(f, &track, reference, &partition) {
             Ok(p) => p,
-            Err(e) => return println!("{name:<22} skinning failed: {e}"),
+            Err(e) => return println!("{name:<22} {label:<10} skinning failed: {e}"),
         };
         let e = residuals(mesh.frame(f), &predicted);
         skin_frames.push(energy(&e));
-        skin_largest = e
-            .iter()
-            .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
-            .fold(skin_largest, f64::max);
+        skin_largest = skin_largest.max(longest(&e));
     }
     let skin_time = start.elapsed().as_secs_f64();
     let weight_bits = encode_weights(&weights, &partition, mesh.triangles())
@@ -196,10 +238,12 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
     let max = |e: &[f64]| e.iter().copied().fold(0f64, f64::max);
     let change = |skin: f64, affine: f64| 100.0 * (skin / affine.max(f64::MIN_POSITIVE) - 1.0);
     println!(
-        "{name:<22} {:>6} {:>5} {:>3} {:>12.5} {:>10.3} {:>11.5} {:>9.3} {:>9.3} {:>12.5} {:>10.3} {:>8.1}% {:>8.1}% {:>10.0} {:>7.3} {:>7.2}",
+        "{name:<22} {label:<10} {:>6} {:>5} {:>4} {:>4} {:>8.5} {:>12.4e} {:>10.3} {:>11.5} {:>9.3} {:>9.3} {:>12.5} {:>10.3} {:>8.1}% {:>8.1}% {:>10.0} {:>7.3} {:>7.2}",
         mesh.vertex_count(),
         mesh.frame_count(),
         partition.clusters(),
+        plain_k,
+        fit_error,
         residual_energy / motion_energy.max(f64::MIN_POSITIVE),
         100.0 * largest / mesh.bbox_diagonal(),
         100.0 * quantisation / mesh.bbox_diagonal(),
@@ -213,6 +257,13 @@ fn measure(name: &str, mesh: &AnimatedMesh) {
         weight_bits / (mesh.vertex_count() * mesh.frame_count()) as f64,
         skin_time
     );
+}
+
+/// The length of the longest residual vector.
+fn longest(e: &[[f32; 3]]) -> f64 {
+    e.iter()
+        .map(|d| d.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max)
 }
 
 fn load(input: &Path) -> mcgv_video::Result<AnimatedMesh> {

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Seeds for the fuzz targets, made from media/ by the mcgv-video binary given as $1 into folder $2:
-#   $2/decode_stream/  small real streams of both codecs (64x64 lattice: fast to decode per execution)
+#   $2/decode_stream/  small real streams of both codecs (64x64 lattice: fast to decode per execution),
+#                      and of the skinning predictor and the decimation segmentation (parts and
+#                      header fields the k-means/affine seeds never reach)
 #   $2/read_mesh/      a kind byte (0 OBJ, 1 OBJ + NUL + PC2, 2 glTF) followed by a real file
 # Regenerated every run (cheap) so that they follow the current stream format.
 set -euo pipefail
@@ -15,6 +17,11 @@ small=(--lattice 64x64 --clusters 4 --fps 6 --quiet)
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/mpeg4.mcgv" --codec mpeg4 --gop 3 "${small[@]}"
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-reorder.mcgv" --codec jpeg --reorder \
 	--lattice 64x64 --clusters 2 --fps 2 --quality 10 --quiet
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-skinning.mcgv" --codec jpeg \
+	--predictor skinning "${small[@]}"
+# Decimation finds K itself, so it takes no --clusters.
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-decimation.mcgv" --codec jpeg \
+	--segmentation decimation --lattice 64x64 --fps 6 --quiet
 # Mesh readers: the decoded stream as OBJ and PC2, and two of the glTF samples.
 "$bin" decode "$out/decode_stream/jpeg.mcgv" -o "$tmp/obj" --quiet
 "$bin" decode "$out/decode_stream/jpeg.mcgv" -o "$tmp/anim.pc2" --quiet

@@ -64,6 +64,10 @@ pub struct EncodeArgs {
     /// MPEG-4 quantiser 1..31 (lower = better); overrides --quality for mpeg4.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=31))]
     pub qscale: Option<u8>,
+    /// Temporal-DCT quantiser step as a fraction of the first frame's bounding-box diagonal
+    /// (e.g. 0.001); overrides --quality for tdct.
+    #[arg(long)]
+    pub step: Option<f64>,
     /// Number of motion clusters K for k-means (default 20).
     #[arg(long)]
     pub clusters: Option<usize>,
@@ -101,7 +105,8 @@ pub struct EncodeArgs {
     pub weight_bits: u8,
     /// Widen each frame's residual range to at least this fraction (0..1) of the sequence's widest,
     /// so frames with small residuals take coarser levels: fewer bits for a more even error
-    /// (0 = every frame's tightest range).
+    /// (0 = every frame's tightest range). Measured at equal rate: 12-14 % lower RMSE on Chicken
+    /// (JPEG and MPEG-4), 4-6 % on Cow with JPEG, none with MPEG-4.
     #[arg(long, default_value_t = 0.0)]
     pub range_floor: f32,
     /// Print the result as one JSON object.
@@ -128,6 +133,9 @@ pub enum CodecChoice {
     Jpeg,
     /// MPEG-4 Part 2: an I-frame, then P-frames.
     Mpeg4,
+    /// No images: each vertex's residuals as a temporal DCT, coded low to high frequency (a
+    /// truncated stream still decodes a coarser animation).
+    Tdct,
 }
 
 /// The motion predictors.
@@ -150,6 +158,9 @@ pub struct DecodeArgs {
     /// Decode only this frame (numbered from 0).
     #[arg(long)]
     pub frame: Option<usize>,
+    /// tdct streams: decode only the first N temporal-DCT bands (a coarser, progressive preview).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub bands: Option<u64>,
 }
 
 /// `inspect` arguments.
@@ -182,6 +193,9 @@ pub struct EvalArgs {
     pub original: String,
     /// The animation to compare with it (any input form, or a .mcgv).
     pub decoded: String,
+    /// tdct streams: decode only the first N temporal-DCT bands before comparing.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub bands: Option<u64>,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,

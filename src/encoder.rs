@@ -10,7 +10,7 @@ use crate::motion::{
 use crate::stream::container::{Checksum, ContainerWriter, Tag};
 use crate::stream::frame_index::{FrameChunk, FrameIndex};
 use crate::stream::header::{CodecKind, Header};
-use crate::stream::{first_frame, side_info};
+use crate::stream::{first_frame, side_info, tdct};
 use indicatif::ProgressBar;
 use std::time::Instant;
 
@@ -46,6 +46,9 @@ pub struct EncodeOptions {
     /// Residual ranges narrower than this fraction of the sequence's widest are widened to it, so
     /// frames with small residuals get coarser levels instead of the full 0..255 (0 = off).
     pub range_floor: f32,
+    /// Temporal-DCT quantiser step as a fraction of the first frame's bounding-box diagonal;
+    /// `None` derives it from `quality` (tdct only).
+    pub step: Option<f64>,
 }
 
 impl Default for EncodeOptions {
@@ -65,6 +68,7 @@ impl Default for EncodeOptions {
             predictor: PredictorKind::Affine,
             weight_bits: motion::WEIGHT_BITS,
             range_floor: 0.0,
+            step: None,
         }
     }
 }
@@ -161,13 +165,13 @@ pub struct EncodeReport {
     pub bytes: u64,
     /// Bits per vertex per frame.
     pub bpvf: f64,
-    /// Charts in the atlas.
+    /// Charts in the atlas (0 for tdct, which has no atlas).
     pub charts: usize,
-    /// Chart pixels / lattice pixels.
+    /// Chart pixels / lattice pixels (0 without an atlas).
     pub packing_efficiency: f64,
-    /// Vertices moved to resolve lattice collisions.
+    /// Vertices moved to resolve lattice collisions (0 without an atlas).
     pub moved_vertices: usize,
-    /// Area-weighted L2 stretch of the charts (1 = none).
+    /// Area-weighted L2 stretch of the charts (1 = none; 0 without an atlas).
     pub l2_stretch: f64,
     /// Seconds per stage.
     pub stage_seconds: Vec<(String, f64)>,
@@ -176,6 +180,21 @@ pub struct EncodeReport {
     /// If the first-frame coder reordered vertices: new index → input index.
     #[serde(skip)]
     pub permutation: Option<Vec<u32>>,
+}
+
+/// What the residual coder of an encoding produced, before the container is assembled.
+struct Coded {
+    partition: Partition,
+    track: AffineTrack,
+    weights: Option<SkinningWeights>,
+    /// Lattice size, (0, 0) without images.
+    lattice: (u16, u16),
+    /// The atlas's figures, when there is an atlas.
+    stats: Option<atlas::AtlasStats>,
+    /// Parts between the partition and the affine coefficients.
+    before_affine: Vec<(Tag, Vec<u8>, Checksum)>,
+    /// Parts after the predictor's.
+    after_affine: Vec<(Tag, Vec<u8>, Checksum)>,
 }
 
 /// The encoded stream in memory, and what it took.
@@ -244,38 +263,88 @@ pub fn encode(
     lap("segmentation", &mut seconds);
 
     progress.set_message("motion");
-    let analysis = analyse_partition(mesh, ff.decoded_positions, partition, opts)?;
-    lap("motion + atlas", &mut seconds);
-
-    progress.set_message("images");
-    let (setup, chunks) = code_images(&analysis, opts, progress)?;
-    lap("images", &mut seconds);
+    let coded = if opts.codec.has_images() {
+        let analysis = analyse_partition(mesh, ff.decoded_positions, partition, opts)?;
+        lap("motion + atlas", &mut seconds);
+        progress.set_message("images");
+        let (setup, chunks) = code_images(&analysis, opts, progress)?;
+        lap("images", &mut seconds);
+        let mut w = crate::stream::bytes::ByteWriter::new();
+        quantise::write_ranges(&analysis.ranges, &mut w);
+        let (index, payload) = FrameIndex::build(chunks);
+        let lattice = side_info::encode_lattice(
+            analysis.atlas.vertex_pixels(),
+            analysis.lattice,
+            mesh.triangles(),
+        )?;
+        let stats = analysis.atlas.stats().clone();
+        Coded {
+            lattice: analysis.lattice,
+            stats: Some(stats),
+            // The lattice coordinates come before the predictor, the rest after it (file order).
+            before_affine: vec![(Tag::LATTICE, lattice, Checksum::Whole)],
+            after_affine: vec![
+                (Tag::RANGES, w.into_bytes(), Checksum::Whole),
+                (Tag::CODEC_SETUP, setup, Checksum::Whole),
+                (Tag::FRAME_INDEX, index.to_bytes(), Checksum::Whole),
+                (Tag::FRAMES, payload, Checksum::Chunked),
+            ],
+            partition: analysis.partition,
+            track: analysis.track,
+            weights: analysis.weights,
+        }
+    } else {
+        // No atlas, no images: the temporal DCT needs the residuals only (and skips xatlas).
+        let (track, weights, residuals) =
+            predict_residuals(mesh, &ff.decoded_positions, &partition, opts)?;
+        lap("motion", &mut seconds);
+        progress.set_message("temporal DCT");
+        let (index, payload) = code_tdct(mesh, &residuals, opts)?;
+        progress.inc(mesh.frame_count() as u64);
+        lap("temporal DCT", &mut seconds);
+        Coded {
+            lattice: (0, 0),
+            stats: None,
+            before_affine: Vec::new(),
+            after_affine: vec![
+                (Tag::TDCT_INDEX, index, Checksum::Whole),
+                // Last, so that a stream cut inside it still decodes the bands before the cut.
+                (Tag::TDCT, payload, Checksum::Progressive),
+            ],
+            partition,
+            track,
+            weights,
+        }
+    };
 
     let header = Header {
         vertices: mesh.vertex_count() as u32,
         frames: mesh.frame_count() as u32,
         triangles: mesh.triangles().len() as u32,
-        clusters: analysis.partition.clusters() as u32,
-        lattice_width: analysis.lattice.0,
-        lattice_height: analysis.lattice.1,
+        clusters: coded.partition.clusters() as u32,
+        lattice_width: coded.lattice.0,
+        lattice_height: coded.lattice.1,
         codec: opts.codec,
         quality: opts.quality,
         qscale: qscale(opts),
         gop: match opts.codec {
-            CodecKind::Jpeg => 1,
+            CodecKind::Jpeg | CodecKind::Tdct => 1,
             CodecKind::Mpeg4 => opts.gop as u32,
         },
         affine_bits: opts.affine_bits,
         first_frame_bits: opts.first_frame_bits,
-        padding: padding_method(opts).to_string(),
+        padding: match opts.codec {
+            CodecKind::Tdct => "none".to_string(),
+            _ => padding_method(opts).to_string(),
+        },
         // Decimation asks for no K: the header then records the K it found.
         requested_clusters: match opts.segmentation {
             Segmentation::KMeans => opts.clusters as u32,
-            Segmentation::Decimation { .. } => analysis.partition.clusters() as u32,
+            Segmentation::Decimation { .. } => coded.partition.clusters() as u32,
         },
         reorder: opts.reorder,
-        charts: analysis.atlas.stats().charts as u32,
-        chart_pixels: analysis.atlas.stats().chart_pixels as u32,
+        charts: coded.stats.as_ref().map_or(0, |s| s.charts as u32),
+        chart_pixels: coded.stats.as_ref().map_or(0, |s| s.chart_pixels as u32),
         predictor: opts.predictor,
     };
     let mut container = ContainerWriter::new();
@@ -284,53 +353,43 @@ pub fn encode(
     container.add(
         Tag::PARTITION,
         side_info::encode_partition(
-            analysis.partition.labels(),
-            analysis.partition.clusters(),
+            coded.partition.labels(),
+            coded.partition.clusters(),
             mesh.triangles(),
         )?,
         Checksum::Whole,
     );
-    container.add(
-        Tag::LATTICE,
-        side_info::encode_lattice(
-            analysis.atlas.vertex_pixels(),
-            analysis.lattice,
-            mesh.triangles(),
-        )?,
-        Checksum::Whole,
-    );
+    for (tag, bytes, checksum) in coded.before_affine {
+        container.add(tag, bytes, checksum);
+    }
     container.add(
         Tag::AFFINE,
-        side_info::encode_affine(&analysis.track)?,
+        side_info::encode_affine(&coded.track)?,
         Checksum::Whole,
     );
-    if let Some(weights) = &analysis.weights {
+    if let Some(weights) = &coded.weights {
         container.add(
             Tag::WEIGHTS,
-            side_info::encode_weights(weights, &analysis.partition, mesh.triangles())?,
+            side_info::encode_weights(weights, &coded.partition, mesh.triangles())?,
             Checksum::Whole,
         );
     }
-    let mut w = crate::stream::bytes::ByteWriter::new();
-    quantise::write_ranges(&analysis.ranges, &mut w);
-    container.add(Tag::RANGES, w.into_bytes(), Checksum::Whole);
-    container.add(Tag::CODEC_SETUP, setup, Checksum::Whole);
-    let (index, payload) = FrameIndex::build(chunks);
-    container.add(Tag::FRAME_INDEX, index.to_bytes(), Checksum::Whole);
-    container.add(Tag::FRAMES, payload, Checksum::Chunked);
+    for (tag, bytes, checksum) in coded.after_affine {
+        container.add(tag, bytes, checksum);
+    }
     lap("side information", &mut seconds);
 
     let bytes = container.to_bytes().len() as u64;
-    let stats = analysis.atlas.stats();
+    let stats = coded.stats.as_ref();
     let report = EncodeReport {
         parts: container.part_sizes(),
         bpvf: bytes as f64 * 8.0 / (header.vertices as f64 * header.frames as f64),
         header,
         bytes,
-        charts: stats.charts,
-        packing_efficiency: stats.packing_efficiency,
-        moved_vertices: stats.moved_vertices,
-        l2_stretch: stats.l2_stretch,
+        charts: stats.map_or(0, |s| s.charts),
+        packing_efficiency: stats.map_or(0.0, |s| s.packing_efficiency),
+        moved_vertices: stats.map_or(0, |s| s.moved_vertices),
+        l2_stretch: stats.map_or(0.0, |s| s.l2_stretch),
         stage_seconds: seconds,
         segmentation,
         permutation: ff.permutation,
@@ -371,6 +430,33 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
     if opts.gop == 0 {
         return Err(Error::Usage("--gop must be at least 1".into()));
     }
+    if let Some(step) = opts.step {
+        if opts.codec != CodecKind::Tdct {
+            return Err(Error::Usage("--step applies to --codec tdct only".into()));
+        }
+        if !(step.is_finite() && step > 0.0 && step <= 1.0) {
+            return Err(Error::Usage(format!(
+                "--step {step}: expected a fraction of the bounding-box diagonal in (0, 1]"
+            )));
+        }
+    }
+    if opts.codec == CodecKind::Tdct {
+        if let Lattice::Fixed(..) = opts.lattice {
+            return Err(Error::Usage(
+                "--lattice applies to the image codecs: tdct has no geometry images".into(),
+            ));
+        }
+        if opts.range_floor > 0.0 {
+            return Err(Error::Usage(
+                "--range-floor applies to the image codecs: tdct has no residual ranges".into(),
+            ));
+        }
+        if opts.padding.is_some() {
+            return Err(Error::Usage(
+                "--padding applies to the image codecs: tdct has no geometry images".into(),
+            ));
+        }
+    }
     if mesh.triangles().is_empty() {
         return Err(Error::Mesh(
             "the mesh has no triangles: nothing to parameterize".into(),
@@ -395,14 +481,15 @@ fn check_lattice(w: u16, h: u16) -> Result<()> {
 pub fn padding_method(opts: &EncodeOptions) -> padding::Method {
     opts.padding.unwrap_or(match opts.codec {
         CodecKind::Jpeg => padding::Method::Snap,
-        CodecKind::Mpeg4 => padding::Method::Biharmonic,
+        // tdct pads nothing; the image codecs' choice keeps `inspect`'s re-analysis total.
+        CodecKind::Mpeg4 | CodecKind::Tdct => padding::Method::Biharmonic,
     })
 }
 
-/// The MPEG-4 quantiser an encoding uses (0 for JPEG).
+/// The MPEG-4 quantiser an encoding uses (0 for JPEG and tdct).
 pub fn qscale(opts: &EncodeOptions) -> u8 {
     match opts.codec {
-        CodecKind::Jpeg => 0,
+        CodecKind::Jpeg | CodecKind::Tdct => 0,
         CodecKind::Mpeg4 => opts
             .qscale
             .unwrap_or_else(|| codec::quality_to_qscale(opts.quality)),
@@ -465,31 +552,10 @@ pub fn analyse_partition(
     partition: Partition,
     opts: &EncodeOptions,
 ) -> Result<Analysis> {
-    let track = AffineTrack::fit(mesh.frames(), &reference, &partition, opts.affine_bits)?;
-    let weights = match opts.predictor {
-        PredictorKind::Affine => None,
-        PredictorKind::Skinning => Some(SkinningWeights::fit_with(
-            mesh.frames(),
-            &reference,
-            &partition,
-            mesh.triangles(),
-            &track,
-            motion::DEFAULT_RIDGE,
-            opts.weight_bits,
-        )?),
-    };
+    let (track, weights, residuals) = predict_residuals(mesh, &reference, &partition, opts)?;
     let (lattice, atlas) = build_atlas(&reference, mesh.triangles(), &partition, opts.lattice)?;
-    // Against the quantised predictor the decoder will rebuild: closed loop.
-    let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
-        .map(|f| {
-            Ok(motion::residuals(
-                mesh.frame(f),
-                &motion::predict_frame(&track, weights.as_ref(), f, &reference, &partition)?,
-            ))
-        })
-        .collect::<Result<_>>()?;
     let mode = match opts.codec {
-        CodecKind::Jpeg => RangeMode::PerFrame,
+        CodecKind::Jpeg | CodecKind::Tdct => RangeMode::PerFrame,
         CodecKind::Mpeg4 => RangeMode::PerGroup(opts.gop),
     };
     let mut ranges = quantise::frame_ranges(&residuals, mode);
@@ -504,6 +570,81 @@ pub fn analyse_partition(
         residuals,
         ranges,
     })
+}
+
+/// The quantised affine track, the skinning weights (skinning predictor only) and every frame's
+/// residuals against them (`[frame][vertex]`).
+pub type Prediction = (AffineTrack, Option<SkinningWeights>, Vec<Vec<[f32; 3]>>);
+
+/// The quantised predictor (affine track, skinning weights) and every frame's residuals against
+/// it: the motion half of the analysis, all that the temporal DCT needs.
+pub fn predict_residuals(
+    mesh: &AnimatedMesh,
+    reference: &[Point],
+    partition: &Partition,
+    opts: &EncodeOptions,
+) -> Result<Prediction> {
+    let track = AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_bits)?;
+    let weights = match opts.predictor {
+        PredictorKind::Affine => None,
+        PredictorKind::Skinning => Some(SkinningWeights::fit_with(
+            mesh.frames(),
+            reference,
+            partition,
+            mesh.triangles(),
+            &track,
+            motion::DEFAULT_RIDGE,
+            opts.weight_bits,
+        )?),
+    };
+    // Against the quantised predictor the decoder will rebuild: closed loop.
+    let residuals: Vec<Vec<[f32; 3]>> = (0..mesh.frame_count())
+        .map(|f| {
+            Ok(motion::residuals(
+                mesh.frame(f),
+                &motion::predict_frame(&track, weights.as_ref(), f, reference, partition)?,
+            ))
+        })
+        .collect::<Result<_>>()?;
+    Ok((track, weights, residuals))
+}
+
+/// The absolute temporal-DCT quantiser step of an encoding: `--step` (a fraction of the first
+/// frame's bounding-box diagonal) or the one `--quality` maps to, rounded to the `f32` the stream
+/// stores, so that the encoder quantises with exactly the step the decoder reads.
+pub fn tdct_step(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<f32> {
+    let diagonal = mesh.bbox_diagonal();
+    let step = match opts.step {
+        Some(fraction) => diagonal * fraction,
+        None => tdct::step_for_quality(opts.quality, diagonal),
+    };
+    let stored = step as f32;
+    if !(stored.is_normal() && stored > 0.0) {
+        return Err(Error::Mesh(format!(
+            "the temporal-DCT step is {step} (first frame's bounding-box diagonal {diagonal}): \
+             a degenerate first frame gives no scale to quantise against"
+        )));
+    }
+    Ok(stored)
+}
+
+/// Transforms, quantises and codes the residuals band by band: the index part and the coefficients part.
+fn code_tdct(
+    mesh: &AnimatedMesh,
+    residuals: &[Vec<[f32; 3]>],
+    opts: &EncodeOptions,
+) -> Result<(Vec<u8>, Vec<u8>)> {
+    let step = tdct_step(mesh, opts)?;
+    let coefficients = tdct::forward(residuals)?;
+    let levels = tdct::quantise(&coefficients, f64::from(step), tdct::DEAD_ZONE)?;
+    let mut coder = tdct::BandCoder::new(mesh.vertex_count());
+    let chunks = levels
+        .iter()
+        .enumerate()
+        .map(|(k, band)| coder.encode(k, band))
+        .collect::<Result<Vec<_>>>()?;
+    let (index, payload) = tdct::BandIndex::build(step, chunks);
+    Ok((index.to_bytes()?, payload))
 }
 
 /// Builds the atlas on the requested lattice, or for `Lattice::Auto` on the smallest lattice from
@@ -669,6 +810,9 @@ fn code_images(
             }));
             Ok((Vec::new(), chunks))
         }
+        CodecKind::Tdct => Err(Error::Codec(
+            "the temporal-DCT codec codes no images".into(),
+        )),
     }
 }
 

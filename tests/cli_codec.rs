@@ -1,38 +1,16 @@
 //! The encode / decode / inspect / eval commands through the binary, as a user runs them.
 
+mod common;
+
+use common::{json, media_path, ok, run};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
-}
-
-fn media(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_str(ok(out).trim()).expect("one JSON object")
-}
 
 #[test]
 fn encode_inspect_decode_eval_a_sample() {
     let dir = tempfile::tempdir().unwrap();
     let stream = dir.path().join("fig.mcgv");
     let s = stream.to_str().unwrap();
-    let sample = media("RiggedFigure.glb");
+    let sample = media_path("RiggedFigure.glb");
     let enc = json(&run(&[
         "encode", &sample, "-o", s, "--codec", "mpeg4", "--quiet", "--json",
     ]));
@@ -108,7 +86,7 @@ fn inspect_writes_pngs_a_user_can_open() {
     let dir = tempfile::tempdir().unwrap();
     let stream = dir.path().join("s.mcgv");
     let s = stream.to_str().unwrap();
-    let sample = media("RiggedSimple.glb");
+    let sample = media_path("RiggedSimple.glb");
     ok(&run(&[
         "encode",
         &sample,
@@ -171,7 +149,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     let s = stream.to_str().unwrap();
     ok(&run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--quiet",
@@ -190,7 +168,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--frame 9999"));
     // Overwriting the input is refused and the input is untouched.
     let copy = d.join("in.glb");
-    std::fs::copy(media("RiggedSimple.glb"), &copy).unwrap();
+    std::fs::copy(media_path("RiggedSimple.glb"), &copy).unwrap();
     let before = std::fs::read(&copy).unwrap();
     let out = run(&[
         "encode",
@@ -205,7 +183,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     let missing = d.join("no/such/dir/out.mcgv");
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         missing.to_str().unwrap(),
         "--quiet",
@@ -215,7 +193,7 @@ fn bad_input_and_outputs_are_clear_errors() {
     // Nonsense options.
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--lattice",
@@ -225,11 +203,125 @@ fn bad_input_and_outputs_are_clear_errors() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("multiples of 16"));
     let out = run(&[
         "encode",
-        &media("RiggedSimple.glb"),
+        &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--padding",
         "magic",
     ]);
     assert_eq!(out.status.code(), Some(1));
+}
+
+/// `--codec tdct` through the binary: encode, inspect (band table, no PNGs), decode, eval, a
+/// `--bands` preview, and a truncated stream that decodes with a warning on stderr.
+#[test]
+fn tdct_encode_inspect_decode_eval_and_truncation() {
+    let dir = tempfile::tempdir().unwrap();
+    let stream = dir.path().join("fig.mcgv");
+    let s = stream.to_str().unwrap();
+    let sample = media_path("RiggedFigure.glb");
+    let enc = json(&run(&[
+        "encode",
+        &sample,
+        "-o",
+        s,
+        "--codec",
+        "tdct",
+        "--quality",
+        "90",
+        "--quiet",
+        "--json",
+    ]));
+    assert_eq!(enc["header"]["codec"], "tdct");
+    assert_eq!(enc["charts"], 0);
+
+    let info = json(&run(&["inspect", s, "--json"]));
+    assert_eq!(info["codec"], "tdct");
+    let bands = info["band_bytes"].as_array().expect("band byte lengths");
+    assert_eq!(bands.len(), 38);
+    assert!(info["parts"]["temporal DCT coefficients"].as_u64().unwrap() > 0);
+    let text = ok(&run(&["inspect", s]));
+    assert!(
+        text.contains("temporal DCT: 38 bands") && text.contains("% of the bytes"),
+        "{text}"
+    );
+    let png = run(&[
+        "inspect",
+        s,
+        "--png",
+        dir.path().join("png").to_str().unwrap(),
+    ]);
+    assert!(!png.status.success());
+    assert!(String::from_utf8_lossy(&png.stderr).contains("no geometry images"));
+
+    let frames = dir.path().join("frames");
+    ok(&run(&[
+        "decode",
+        s,
+        "-o",
+        frames.to_str().unwrap(),
+        "--quiet",
+    ]));
+    assert!(frames.join("frame_0037.obj").exists());
+    let full = json(&run(&["eval", &sample, s, "--json", "--quiet"]));
+    let preview = json(&run(&[
+        "eval", &sample, s, "--json", "--quiet", "--bands", "1",
+    ]));
+    assert!(preview["rmse"].as_f64().unwrap() > full["rmse"].as_f64().unwrap());
+
+    // Cut inside the coefficients part: decodes, coarser, with a warning on stderr.
+    let bytes = std::fs::read(&stream).unwrap();
+    let coefficients = bands.iter().map(|b| b.as_u64().unwrap()).sum::<u64>() as usize;
+    let cut = dir.path().join("cut.mcgv");
+    std::fs::write(&cut, &bytes[..bytes.len() - coefficients / 2]).unwrap();
+    let out = run(&[
+        "decode",
+        cut.to_str().unwrap(),
+        "-o",
+        dir.path().join("cut.pc2").to_str().unwrap(),
+        "--quiet",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("stream truncated: decoded") && stderr.contains("of 38 temporal-DCT bands"),
+        "{stderr}"
+    );
+    let out = run(&["eval", &sample, cut.to_str().unwrap(), "--json", "--quiet"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("stream truncated"));
+    let coarse = json(&out);
+    assert!(coarse["rmse"].as_f64().unwrap() > full["rmse"].as_f64().unwrap());
+
+    // --bands and --step belong to tdct.
+    let jpeg = dir.path().join("fig_jpeg.mcgv");
+    let out = run(&[
+        "encode",
+        &sample,
+        "-o",
+        jpeg.to_str().unwrap(),
+        "--step",
+        "0.001",
+        "--quiet",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--step applies to --codec tdct"));
+    ok(&run(&[
+        "encode",
+        &sample,
+        "-o",
+        jpeg.to_str().unwrap(),
+        "--padding",
+        "cg",
+        "--quiet",
+    ]));
+    let out = run(&[
+        "decode",
+        jpeg.to_str().unwrap(),
+        "-o",
+        frames.to_str().unwrap(),
+        "--bands",
+        "2",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--bands applies to tdct"));
 }

@@ -1,37 +1,14 @@
 //! `mcgv-video eval` end to end: the binary on files, its JSON and human output, its errors.
 
+mod common;
+
+use common::{json, media_path, ok, run};
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn eval(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .arg("eval")
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
-}
-
-fn media(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("media")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "eval failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
-        panic!(
-            "not one JSON object ({e}): {}",
-            String::from_utf8_lossy(&out.stdout)
-        )
-    })
+    run(&[&["eval"], args].concat())
 }
 
 fn number(v: &serde_json::Value, key: &str) -> f64 {
@@ -62,7 +39,7 @@ fn write_sheet(dir: &Path, frames: usize, z: f32) {
 
 #[test]
 fn a_sample_against_itself_has_zero_error() {
-    let sample = media("RiggedSimple.glb");
+    let sample = media_path("RiggedSimple.glb");
     let v = json(&eval(&[&sample, &sample, "--json"]));
     for key in ["rmse", "hausdorff", "vertex_rmse", "kg_error"] {
         assert_eq!(number(&v, key), 0.0, "{key} in {v}");
@@ -89,13 +66,7 @@ fn a_lifted_copy_is_off_by_the_lift_in_both_outputs() {
         );
     }
     assert_eq!((number(&v, "frames"), number(&v, "vertices")), (3.0, 36.0));
-    let out = eval(&[&a, &b]);
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let text = ok(&eval(&[&a, &b]));
     assert!(
         text.contains(&format!("{:.4} ×10⁻⁴", want * 1e4)) && text.contains("RMSE"),
         "{text}"
@@ -104,7 +75,7 @@ fn a_lifted_copy_is_off_by_the_lift_in_both_outputs() {
 
 #[test]
 fn a_missing_mcgv_fails_naming_it() {
-    let out = eval(&[&media("Fox.glb"), "no/such/decoded.mcgv"]);
+    let out = eval(&[&media_path("Fox.glb"), "no/such/decoded.mcgv"]);
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no/such/decoded.mcgv"), "{err}");
@@ -112,7 +83,7 @@ fn a_missing_mcgv_fails_naming_it() {
 
 #[test]
 fn a_missing_input_fails_naming_it() {
-    let out = eval(&["no/such/animation.glb", &media("Fox.glb")]);
+    let out = eval(&["no/such/animation.glb", &media_path("Fox.glb")]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/animation.glb"));
 }

@@ -1,34 +1,22 @@
 //! `mcgv-video info` through the real binary: text, `--json`, and failures.
 
-use std::process::Command;
+mod common;
+
+use common::{media_path, ok, run};
 
 fn info(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .arg("info")
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn media(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
+    run(&[&["info"], args].concat())
 }
 
 #[test]
 fn json_has_the_agreed_keys() {
-    let out = info(&["--json", &media("RiggedSimple.glb")]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8(out.stdout).unwrap();
+    let stdout = ok(&info(&["--json", &media_path("RiggedSimple.glb")]));
     assert_eq!(
         stdout.trim().lines().count(),
         1,
         "one JSON object on one line"
     );
-    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
     assert_eq!(v["vertices"], 160);
     assert_eq!(v["faces"], 188);
     assert_eq!(v["frames"], 49);
@@ -40,13 +28,7 @@ fn json_has_the_agreed_keys() {
 
 #[test]
 fn text_names_every_figure() {
-    let out = info(&["--fps", "12", &media("CesiumMan.glb")]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok(&info(&["--fps", "12", &media_path("CesiumMan.glb")]));
     for expected in [
         "vertices (V)   3273",
         "frames (F)     24",

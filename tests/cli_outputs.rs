@@ -1,18 +1,10 @@
 //! `encode -o` never damages what is there: no half-written output, no overwritten input.
 
+mod common;
+
+use common::{media_path, run};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
-}
-
-fn media(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
-}
+use std::process::Output;
 
 fn refused(out: &Output) {
     assert_eq!(out.status.code(), Some(1), "{out:?}");
@@ -103,31 +95,28 @@ fn no_input_file_can_be_the_output() {
 fn a_failing_encode_leaves_the_target_as_it_was() {
     let d = tempfile::tempdir().unwrap();
     // RiggedSimple has more vertices than a 16x16 lattice has pixels: the atlas fails after reading.
-    let fresh = d.path().join("fresh.mcgv");
-    let out = run(&[
-        "encode",
-        &media("RiggedSimple.glb"),
-        "-o",
-        fresh.to_str().unwrap(),
-        "--lattice",
-        "16x16",
-        "--quiet",
-    ]);
-    assert_eq!(out.status.code(), Some(1), "{out:?}");
-    assert!(!fresh.exists(), "a failed encode created its output");
-    let old = d.path().join("old.mcgv");
-    std::fs::write(&old, b"the previous output").unwrap();
-    let out = run(&[
-        "encode",
-        &media("RiggedSimple.glb"),
-        "-o",
-        old.to_str().unwrap(),
-        "--lattice",
-        "16x16",
-        "--quiet",
-    ]);
-    assert_eq!(out.status.code(), Some(1), "{out:?}");
-    assert_eq!(std::fs::read(&old).unwrap(), b"the previous output");
+    // Once onto a new name (nothing may be created), once onto an old file (it must stay as it was).
+    let old_bytes: &[u8] = b"the previous output";
+    for (name, before) in [("fresh.mcgv", None), ("old.mcgv", Some(old_bytes))] {
+        let target = d.path().join(name);
+        if let Some(bytes) = before {
+            std::fs::write(&target, bytes).unwrap();
+        }
+        let out = run(&[
+            "encode",
+            &media_path("RiggedSimple.glb"),
+            "-o",
+            target.to_str().unwrap(),
+            "--lattice",
+            "16x16",
+            "--quiet",
+        ]);
+        assert_eq!(out.status.code(), Some(1), "{out:?}");
+        match before {
+            None => assert!(!target.exists(), "a failed encode created its output"),
+            Some(bytes) => assert_eq!(std::fs::read(&target).unwrap(), bytes),
+        }
+    }
     assert!(leftovers(d.path()).is_empty(), "{:?}", leftovers(d.path()));
 }
 

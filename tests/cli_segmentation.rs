@@ -1,46 +1,16 @@
 //! `encode --segmentation decimation` through the binary: the report, the stream, `inspect`, and
 //! the options that do not belong together.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
-}
-
-fn media(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_str(ok(out).trim()).expect("one JSON object")
-}
-
-fn grey(path: &Path) -> Vec<u8> {
-    image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_luma8()
-        .into_raw()
-}
+use common::{grey, json, media_path, ok, run};
 
 #[test]
 fn decimation_reports_k_and_time_and_inspect_uses_the_streams_clusters() {
     let dir = tempfile::tempdir().expect("temporary folder");
     let stream = dir.path().join("s.mcgv");
     let s = stream.to_str().expect("utf-8 path");
-    let sample = media("RiggedSimple.glb");
+    let sample = media_path("RiggedSimple.glb");
     let enc = json(&run(&[
         "encode",
         &sample,
@@ -96,7 +66,7 @@ fn options_of_the_other_segmentation_are_refused() {
     let dir = tempfile::tempdir().expect("temporary folder");
     let out = dir.path().join("s.mcgv");
     let o = out.to_str().expect("utf-8 path");
-    let sample = media("RiggedSimple.glb");
+    let sample = media_path("RiggedSimple.glb");
     for (args, needle) in [
         (
             vec!["--segmentation", "decimation", "--clusters", "5"],

@@ -2,7 +2,7 @@
 //! robustness against damaged input.
 
 use mcgv_video::codec::mpeg4::{self, Mpeg4Options, Packet};
-use mcgv_video::codec::{jpeg, quality_to_qscale, Plane};
+use mcgv_video::codec::{abbreviated, jpeg, quality_to_qscale, Plane};
 use mcgv_video::Result;
 use std::f64::consts::TAU;
 use std::process::Command;
@@ -335,10 +335,10 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
         let bytes: usize = coded.iter().map(Vec::len).sum();
         let compact: usize = planes
             .iter()
-            .map(|p| jpeg::encode_compact(p, quality).map(|c| c.len()))
+            .map(|p| stored_len(&jpeg::encode(p, quality)?))
             .sum::<Result<_>>()?;
         println!(
-            "jpeg  q{quality:<3}  compact form {:7.0} B/frame",
+            "jpeg  q{quality:<3}  abbreviated {:7.0} B/frame",
             compact as f64 / f64::from(FRAMES)
         );
         println!(
@@ -432,19 +432,19 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
         .collect();
     let tiled: Vec<Plane> = coords.iter().map(tile).collect();
     for quality in [50, 75, 90] {
-        // [full, compact] bytes for three planes and for the tiled picture.
+        // [full, abbreviated] bytes for three planes and for the tiled picture.
         let (mut separate, mut together) = ([0; 2], [0; 2]);
         for (c, t) in coords.iter().zip(&tiled) {
             for p in c {
                 separate[0] += jpeg::encode(p, quality)?.len();
-                separate[1] += jpeg::encode_compact(p, quality)?.len();
+                separate[1] += stored_len(&jpeg::encode(p, quality)?)?;
             }
             together[0] += jpeg::encode(t, quality)?.len();
-            together[1] += jpeg::encode_compact(t, quality)?.len();
+            together[1] += stored_len(&jpeg::encode(t, quality)?)?;
         }
         let per_frame = |b: usize| b as f64 / f64::from(FRAMES);
         println!(
-            "jpeg  q{quality:<3} three planes {:7.0} B/frame (compact {:7.0}), tiled 768×256 {:7.0} (compact {:7.0})",
+            "jpeg  q{quality:<3} three planes {:7.0} B/frame (abbreviated {:7.0}), tiled 768×256 {:7.0} (abbreviated {:7.0})",
             per_frame(separate[0]),
             per_frame(separate[1]),
             per_frame(together[0]),
@@ -472,6 +472,13 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Bytes a stream stores per picture in the abbreviated form (`codec::abbreviated`): its Huffman
+/// tables and scan; the headers fixed by size and quality are stored once per stream.
+fn stored_len(jpeg: &[u8]) -> Result<usize> {
+    let parts = abbreviated::split(jpeg)?;
+    Ok(parts.tables.len() + parts.scan.len())
 }
 
 /// Bytes before the entropy-coded data: markers, tables, frame and scan headers.
@@ -515,41 +522,6 @@ fn jpeg_scalar_decode_equals_simd_decode() -> Result<()> {
             .decode()
             .map_err(|e| mcgv_video::Error::Codec(format!("{e:?}")))?;
         assert_eq!(ours.data, simd, "quality {quality}");
-    }
-    Ok(())
-}
-
-#[test]
-fn jpeg_compact_form_drops_the_fixed_headers() -> Result<()> {
-    for (w, h, quality) in [(64, 64, 50), (256, 256, 75), (72, 40, 95), (8, 8, 1)] {
-        let plane = smooth_frame(w, h, 1, 0.2);
-        let full = jpeg::encode(&plane, quality)?;
-        let compact = jpeg::encode_compact(&plane, quality)?;
-        assert_eq!(
-            jpeg::decode_compact(&compact, w, h, quality)?,
-            jpeg::decode(&full, w, h)?,
-            "{w}×{h} q{quality}"
-        );
-        let saved = full.len() - compact.len();
-        println!(
-            "{w}×{h} q{quality}: {} → {} bytes",
-            full.len(),
-            compact.len()
-        );
-        // SOI, JFIF, frame header, two quantisation tables, scan header, EOI.
-        assert!(saved >= 150, "{w}×{h} q{quality}: only {saved} bytes saved");
-        // A plain JPEG starts with SOI, not with Huffman tables.
-        assert!(jpeg::decode_compact(&full, w, h, quality).is_err());
-    }
-    let compact = jpeg::encode_compact(&smooth_frame(64, 64, 0, 0.0), 75)?;
-    assert!(jpeg::decode_compact(&[], 64, 64, 75).is_err());
-    assert!(jpeg::decode_compact(&compact, 64, 64, 0).is_err());
-    for cut in [1, 3, 40, compact.len() / 2] {
-        let truncated = compact.get(..cut).unwrap_or_default();
-        assert!(
-            jpeg::decode_compact(truncated, 64, 64, 75).is_err(),
-            "cut at {cut}"
-        );
     }
     Ok(())
 }

@@ -1,39 +1,17 @@
 //! Segmentation by decimation (skinning paper §3.1) on synthetic animations with a known answer.
 
-use mcgv_video::decoder::Decoder;
+mod common;
+
+use common::{canonical, decoder, rand_index, read_media, tube};
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::topology::ManifoldReport;
-use mcgv_video::mesh::{read_animation, Point, ReadOptions, Triangle};
+use mcgv_video::mesh::{Point, Triangle};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{decimate, DecimateOptions, Decimation};
-use mcgv_video::stream::container::ContainerReader;
 use mcgv_video::AnimatedMesh;
-use std::io::Cursor;
 
 const FRAMES: usize = 10;
 const RING_SIZE: usize = 12;
-
-/// A tube along x from `x0` to `x1`, `rings` rings of `RING_SIZE` vertices, appended.
-fn tube(points: &mut Vec<Point>, tris: &mut Vec<Triangle>, x0: f32, x1: f32, rings: usize) {
-    let base = points.len() as u32;
-    for r in 0..rings {
-        let x = x0 + (x1 - x0) * r as f32 / (rings - 1) as f32;
-        for s in 0..RING_SIZE {
-            let a = std::f32::consts::TAU * s as f32 / RING_SIZE as f32;
-            let radius = 1.0 + 0.2 * (x * 1.3).sin();
-            points.push([x, radius * a.cos(), radius * a.sin()]);
-        }
-    }
-    let n = RING_SIZE as u32;
-    for r in 0..rings as u32 - 1 {
-        for s in 0..n {
-            let (a, b) = (base + r * n + s, base + r * n + (s + 1) % n);
-            let (c, d) = (a + n, b + n);
-            tris.push([a, b, d]);
-            tris.push([a, d, c]);
-        }
-    }
-}
 
 /// Rigid motion of part `k` at time `t` ∈ [0, 1]: part 0 stays, part 1 bends up about the joint at
 /// x = 4 and moves along, as a forearm does.
@@ -48,23 +26,13 @@ fn rigid(k: usize, t: f32, p: Point) -> Point {
 }
 
 fn animate(points: &[Point], tris: Vec<Triangle>, part: &[usize]) -> AnimatedMesh {
-    let frames = (0..FRAMES)
-        .map(|f| {
-            let t = f as f32 / (FRAMES - 1) as f32;
-            points
-                .iter()
-                .zip(part)
-                .map(|(&p, &k)| rigid(k, t, p))
-                .collect()
-        })
-        .collect();
-    AnimatedMesh::new(tris, frames).expect("valid animation")
+    common::animate(points, tris, FRAMES, |t, i, p| rigid(part[i], t, p))
 }
 
 /// One tube of 41 rings, x in 0..8: x < 4 is part 0, the rest part 1.
 fn two_rigid_parts() -> (AnimatedMesh, Vec<usize>) {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 8.0, 41);
+    tube(&mut points, &mut tris, 0.0, 8.0, 41, RING_SIZE);
     let part: Vec<usize> = points.iter().map(|p| usize::from(p[0] >= 4.0)).collect();
     (animate(&points, tris, &part), part)
 }
@@ -78,18 +46,6 @@ fn run(mesh: &AnimatedMesh, e0: f64) -> Decimation {
         },
     )
     .expect("decimates")
-}
-
-/// Fraction of vertex pairs on which two labelings agree (same/different): the Rand index.
-fn rand_index(a: &[u32], b: &[usize]) -> f64 {
-    let (mut agree, mut total) = (0u64, 0u64);
-    for i in 0..a.len() {
-        for j in i + 1..a.len() {
-            agree += u64::from((a[i] == a[j]) == (b[i] == b[j]));
-            total += 1;
-        }
-    }
-    agree as f64 / total as f64
 }
 
 #[test]
@@ -109,21 +65,12 @@ fn two_rigid_parts_give_two_clusters() {
 /// fits exactly, so the smaller E0, the more clusters.
 fn bent_tube() -> AnimatedMesh {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 8.0, 41);
-    let frames = (0..FRAMES)
-        .map(|f| {
-            let t = f as f32 / (FRAMES - 1) as f32;
-            points
-                .iter()
-                .map(|p| {
-                    let angle = 0.15 * t * p[0];
-                    let (c, s) = (angle.cos(), angle.sin());
-                    [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]]
-                })
-                .collect()
-        })
-        .collect();
-    AnimatedMesh::new(tris, frames).expect("valid animation")
+    tube(&mut points, &mut tris, 0.0, 8.0, 41, RING_SIZE);
+    common::animate(&points, tris, FRAMES, |t, _, p| {
+        let angle = 0.15 * t * p[0];
+        let (c, s) = (angle.cos(), angle.sin());
+        [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]]
+    })
 }
 
 #[test]
@@ -149,8 +96,8 @@ fn components_are_segmented_on_their_own() {
     // Two tubes moving alike and a lone triangle: three components, so three clusters even when
     // any error is allowed, and the triangle (too small for a determined affine map) is one of them.
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 3.0, 7);
-    tube(&mut points, &mut tris, 4.0, 7.0, 7);
+    tube(&mut points, &mut tris, 0.0, 3.0, 7, RING_SIZE);
+    tube(&mut points, &mut tris, 4.0, 7.0, 7, RING_SIZE);
     let t = points.len() as u32;
     points.extend([[8.0, 0.0, 0.0], [8.5, 0.0, 0.0], [8.0, 0.5, 0.0]]);
     tris.push([t, t + 1, t + 2]);
@@ -171,7 +118,7 @@ fn non_manifold_input_is_segmented() {
     // The two-part tube plus fins: extra triangles on existing edges (three triangles per edge)
     // whose tips move with their part.
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 8.0, 41);
+    tube(&mut points, &mut tris, 0.0, 8.0, 41, RING_SIZE);
     let mut part: Vec<usize> = points.iter().map(|p| usize::from(p[0] >= 4.0)).collect();
     for ring in [5u32, 35] {
         let (a, b) = (ring * RING_SIZE as u32, ring * RING_SIZE as u32 + 1);
@@ -194,7 +141,7 @@ fn a_triangle_soup_is_welded_at_its_seams() {
     // Every triangle with its own vertices: welding copies that move together makes it one
     // component again, so decimation still finds the two parts.
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 8.0, 21);
+    tube(&mut points, &mut tris, 0.0, 8.0, 21, RING_SIZE);
     let soup: Vec<Point> = tris.iter().flatten().map(|&v| points[v as usize]).collect();
     let soup_tris: Vec<Triangle> = (0..tris.len() as u32)
         .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
@@ -236,7 +183,7 @@ fn a_triangle_soup_is_welded_at_its_seams() {
 #[test]
 fn still_and_single_frame_animations_collapse_to_their_components() {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 2.0, 5);
+    tube(&mut points, &mut tris, 0.0, 2.0, 5, RING_SIZE);
     let still = AnimatedMesh::new(tris.clone(), vec![points.clone(); 4]).expect("valid");
     let d = run(&still, 1e-6);
     assert_eq!(d.partition.clusters(), 1);
@@ -295,6 +242,7 @@ fn bad_requests_are_clear_errors() {
             3.0 * k as f32,
             3.0 * k as f32 + 2.0,
             3,
+            RING_SIZE,
         );
     }
     let part = vec![0; points.len()];
@@ -332,8 +280,7 @@ fn the_cap_continues_collapsing_past_e0() {
 /// two-bone cylinder's two parts), and the decoded animation stays within the error bound.
 #[test]
 fn decimation_round_trips_through_the_stream() {
-    let path = format!("{}/media/RiggedSimple.glb", env!("CARGO_MANIFEST_DIR"));
-    let mesh = read_animation(&path, &ReadOptions::default()).expect("media sample reads");
+    let mesh = read_media("RiggedSimple.glb");
     let opts = EncodeOptions {
         segmentation: Segmentation::Decimation { e0: 0.003 },
         // The paper's padding keeps this debug-build test fast.
@@ -348,22 +295,9 @@ fn decimation_round_trips_through_the_stream() {
     assert_eq!(report.header.clusters as usize, k);
     assert!(report.segmentation.error.is_some_and(|e| e <= 0.003));
     let bytes = encoded.container.to_bytes();
-    let mut decoder =
-        Decoder::new(ContainerReader::new(Cursor::new(bytes)).expect("container")).expect("stream");
+    let mut decoder = decoder(bytes).expect("stream");
     assert_eq!(decoder.partition().clusters(), k);
     let decoded = decoder.decode_all(&hidden).expect("decodes");
-    // The first-frame coder may store triangles in another order and rotation, never others.
-    let canonical = |tris: &[Triangle]| {
-        let mut v: Vec<Triangle> = tris
-            .iter()
-            .map(|t| {
-                let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
-                [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
-            })
-            .collect();
-        v.sort_unstable();
-        v
-    };
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     assert_eq!(decoded.frame_count(), mesh.frame_count());
     let m = compare(&mesh, &decoded).expect("comparable");

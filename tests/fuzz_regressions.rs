@@ -1,12 +1,11 @@
 //! Hostile streams and meshes: every input the fuzzers once crashed on (tests/data/fuzz/TARGET/),
 //! replayed through the fuzz targets' own code, and forged headers that claim absurd sizes.
 
-#[path = "../fuzz/src/harness.rs"]
-mod harness;
+mod common;
+
+use common::{harness, tiny_stream};
 
 use mcgv_video::decoder::Decoder;
-use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
-use mcgv_video::mesh::AnimatedMesh;
 use mcgv_video::stream::container::{ContainerReader, FILE_HEADER_LEN, PART_HEADER_LEN};
 use mcgv_video::stream::header::CodecKind;
 use mcgv_video::Error;
@@ -59,31 +58,6 @@ fn mesh_crashers_that_are_valid_meshes_now_read() {
             panic!("{}: {e}", path.display());
         }
     }
-}
-
-/// A real two-frame stream of two triangles, small enough to forge quickly.
-fn tiny_stream(codec: CodecKind) -> Vec<u8> {
-    let square = |t: f32| {
-        vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, t],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, -t],
-        ]
-    };
-    let mesh =
-        AnimatedMesh::new(vec![[0, 1, 2], [0, 2, 3]], vec![square(0.0), square(0.1)]).unwrap();
-    let opts = EncodeOptions {
-        codec,
-        clusters: 1,
-        lattice: Lattice::Fixed(16, 16),
-        padding: Some(padding::Method::Cg),
-        ..EncodeOptions::default()
-    };
-    encode(&mesh, &opts, &indicatif::ProgressBar::hidden())
-        .unwrap()
-        .container
-        .to_bytes()
 }
 
 /// Offset of the header part's payload: the header is the first part.

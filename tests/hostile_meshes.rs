@@ -5,6 +5,9 @@
 //! Case counts are low so that `make test` stays fast; `PROPTEST_CASES=256 cargo test --test
 //! hostile_meshes` runs more.
 
+mod common;
+
+use common::canonical;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
 use mcgv_video::mesh::{AnimatedMesh, Point, Triangle};
@@ -21,19 +24,6 @@ fn cases(default: u32) -> ProptestConfig {
         .and_then(|s| s.parse().ok())
         .unwrap_or(default);
     ProptestConfig::with_cases(n)
-}
-
-/// Triangles rotated to start at their smallest index (orientation kept), sorted; duplicates stay.
-fn canonical(triangles: &[Triangle]) -> Vec<Triangle> {
-    let mut out: Vec<Triangle> = triangles
-        .iter()
-        .map(|t| {
-            let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
-            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
-        })
-        .collect();
-    out.sort_unstable();
-    out
 }
 
 /// What goes into a random test mesh besides its grids.

@@ -1,11 +1,10 @@
 //! Animated-mesh readers and writers through the public API: OBJ sequences, PC2, glTF samples.
 
+mod common;
+
+use common::media_path;
 use mcgv_video::mesh::{read_animation, write_obj_sequence, write_pc2, AnimatedMesh, ReadOptions};
 use std::path::{Path, PathBuf};
-
-fn media(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
-}
 
 fn read(input: &str) -> mcgv_video::Result<AnimatedMesh> {
     read_animation(input, &ReadOptions::default())
@@ -285,7 +284,7 @@ fn glb_samples_read_with_their_published_sizes() {
         ("Fox.glb", 1728, 576),
         ("RiggedFigure.glb", 370, 256),
     ] {
-        let mesh = read(&media(name)).unwrap();
+        let mesh = read(&media_path(name)).unwrap();
         assert_eq!(mesh.vertex_count(), vertices, "{name}");
         assert_eq!(mesh.triangles().len(), faces, "{name}");
         assert!(
@@ -316,7 +315,7 @@ fn largest_step(mesh: &AnimatedMesh) -> f32 {
 /// twice the rate, the largest per-frame step halves (a jump in the motion would not shrink).
 #[test]
 fn cesium_man_is_human_sized_and_moves_continuously() {
-    let mesh = read(&media("CesiumMan.glb")).unwrap();
+    let mesh = read(&media_path("CesiumMan.glb")).unwrap();
     assert_eq!(mesh.frame_count(), 48, "2 s of 24 keys/s");
     for f in 0..mesh.frame_count() {
         let (lo, hi) = mcgv_video::mesh::bounding_box(mesh.frame(f));
@@ -331,7 +330,7 @@ fn cesium_man_is_human_sized_and_moves_continuously() {
         fps: Some(48.0),
         ..Default::default()
     };
-    let denser = largest_step(&read_animation(&media("CesiumMan.glb"), &opts).unwrap());
+    let denser = largest_step(&read_animation(&media_path("CesiumMan.glb"), &opts).unwrap());
     assert!(
         (0.4..0.6).contains(&(denser / step)),
         "{denser} at 48 fps, {step} at 24 fps"
@@ -346,7 +345,7 @@ fn frame_rate_and_clip_are_chosen_by_the_options() {
             clip: clip.map(str::to_owned),
             base: None,
         };
-        read_animation(&media("CesiumMan.glb"), &opts)
+        read_animation(&media_path("CesiumMan.glb"), &opts)
     };
     let (slow, fast) = (at(None, None).unwrap(), at(Some(48.0), None).unwrap());
     assert_eq!(fast.frame_count(), 95);
@@ -366,7 +365,7 @@ fn frame_rate_and_clip_are_chosen_by_the_options() {
             clip: Some(clip.into()),
             ..Default::default()
         };
-        read_animation(&media("Fox.glb"), &opts)
+        read_animation(&media_path("Fox.glb"), &opts)
     };
     assert_eq!(fox("Walk").unwrap().frame_count(), 18);
     assert_eq!(fox("2").unwrap(), fox("Run").unwrap());

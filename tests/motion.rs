@@ -1,5 +1,8 @@
 //! Segmentation and piecewise affine prediction on synthetic animations with a known answer.
 
+mod common;
+
+use common::{animate, rand_index, tube};
 use mcgv_video::mesh::{Point, Triangle};
 use mcgv_video::motion::{
     energy, render_partition_png, residuals, segment, AffineTrack, Partition, SegmentOptions,
@@ -8,29 +11,6 @@ use mcgv_video::AnimatedMesh;
 
 const FRAMES: usize = 12;
 const RING_SIZE: usize = 16;
-
-/// A closed-around tube along x from `x0` to `x1`, `rings` rings of `RING_SIZE` vertices, appended.
-fn tube(points: &mut Vec<Point>, tris: &mut Vec<Triangle>, x0: f32, x1: f32, rings: usize) {
-    let base = points.len() as u32;
-    for r in 0..rings {
-        let x = x0 + (x1 - x0) * r as f32 / (rings - 1) as f32;
-        for s in 0..RING_SIZE {
-            let a = std::f32::consts::TAU * s as f32 / RING_SIZE as f32;
-            // A slight bulge keeps the surface from being a ruled one.
-            let radius = 1.0 + 0.2 * (x * 1.3).sin();
-            points.push([x, radius * a.cos(), radius * a.sin()]);
-        }
-    }
-    let n = RING_SIZE as u32;
-    for r in 0..rings as u32 - 1 {
-        for s in 0..n {
-            let (a, b) = (base + r * n + s, base + r * n + (s + 1) % n);
-            let (c, d) = (a + n, b + n);
-            tris.push([a, b, d]);
-            tris.push([a, d, c]);
-        }
-    }
-}
 
 /// Part `k`'s affine map at time `t` ∈ [0, 1]: a rotation about its own axis, a stretch and a shift.
 fn part_map(k: usize, t: f32) -> impl Fn(Point) -> Point {
@@ -55,23 +35,13 @@ fn part_map(k: usize, t: f32) -> impl Fn(Point) -> Point {
 
 /// An animation whose vertices move exactly by their part's affine map; returns it with the true parts.
 fn piecewise_affine(points: Vec<Point>, tris: Vec<Triangle>, part: &[usize]) -> AnimatedMesh {
-    let frames = (0..FRAMES)
-        .map(|f| {
-            let t = f as f32 / (FRAMES - 1) as f32;
-            points
-                .iter()
-                .zip(part)
-                .map(|(&p, &k)| part_map(k, t)(p))
-                .collect()
-        })
-        .collect();
-    AnimatedMesh::new(tris, frames).unwrap()
+    animate(&points, tris, FRAMES, |t, i, p| part_map(part[i], t)(p))
 }
 
 /// One tube cut into four parts along x.
 fn connected_parts() -> (AnimatedMesh, Vec<usize>) {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 8.0, 81);
+    tube(&mut points, &mut tris, 0.0, 8.0, 81, RING_SIZE);
     let part: Vec<usize> = points
         .iter()
         .map(|p| ((p[0] / 2.0) as usize).min(3))
@@ -83,7 +53,7 @@ fn connected_parts() -> (AnimatedMesh, Vec<usize>) {
 /// write meshes; copies of a vertex move together.
 fn tube_soup() -> (AnimatedMesh, Vec<usize>) {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 8.0, 41);
+    tube(&mut points, &mut tris, 0.0, 8.0, 41, RING_SIZE);
     let soup_points: Vec<Point> = tris.iter().flatten().map(|&v| points[v as usize]).collect();
     let soup_tris: Vec<Triangle> = (0..tris.len() as u32)
         .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
@@ -106,22 +76,11 @@ fn separate_parts() -> (AnimatedMesh, Vec<usize>) {
             2.5 * k as f32,
             2.5 * k as f32 + 2.0,
             9,
+            RING_SIZE,
         );
         part.resize(points.len(), k);
     }
     (piecewise_affine(points, tris, &part), part)
-}
-
-/// Fraction of vertex pairs on which two labelings agree (same/different): the Rand index.
-fn rand_index(a: &[u32], b: &[usize]) -> f64 {
-    let (mut agree, mut total) = (0u64, 0u64);
-    for i in 0..a.len() {
-        for j in i + 1..a.len() {
-            agree += u64::from((a[i] == a[j]) == (b[i] == b[j]));
-            total += 1;
-        }
-    }
-    agree as f64 / total as f64
 }
 
 fn options(clusters: usize) -> SegmentOptions {
@@ -197,24 +156,15 @@ fn plain_k_means_recovers_separate_parts_too() {
 /// A tube twisting about its axis, the angle growing along it: smooth motion no few affine maps fit.
 fn twisted_tube() -> AnimatedMesh {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
-    tube(&mut points, &mut tris, 0.0, 8.0, 41);
-    let frames = (0..FRAMES)
-        .map(|f| {
-            let t = f as f32 / (FRAMES - 1) as f32;
-            points
-                .iter()
-                .map(|p| {
-                    let a = t * 0.4 * p[0] * p[0] / 8.0;
-                    [
-                        p[0],
-                        a.cos() * p[1] - a.sin() * p[2],
-                        a.sin() * p[1] + a.cos() * p[2],
-                    ]
-                })
-                .collect()
-        })
-        .collect();
-    AnimatedMesh::new(tris, frames).unwrap()
+    tube(&mut points, &mut tris, 0.0, 8.0, 41, RING_SIZE);
+    animate(&points, tris, FRAMES, |t, _, p| {
+        let a = t * 0.4 * p[0] * p[0] / 8.0;
+        [
+            p[0],
+            a.cos() * p[1] - a.sin() * p[2],
+            a.sin() * p[1] + a.cos() * p[2],
+        ]
+    })
 }
 
 fn residual_energy(mesh: &AnimatedMesh, partition: &Partition) -> f64 {

@@ -21,6 +21,7 @@ fn a_range_floor_widens_the_streams_ranges_and_saves_bits() -> mcgv_video::Resul
             quality: 50,
             padding: Some(padding::Method::Cg),
             range_floor: floor,
+            step: None,
             ..EncodeOptions::default()
         };
         let bytes = encode(&mesh, &opts, &hidden)?.container.to_bytes();
@@ -33,6 +34,7 @@ fn a_range_floor_widens_the_streams_ranges_and_saves_bits() -> mcgv_video::Resul
             .collect();
         let decoded = decoder.decode_all(&hidden)?;
         let rmse = compare(&mesh, &decoded)?.rmse;
+        println!("range floor {floor}: {size} bytes, RMSE {rmse:.3e}");
         results.push((size, widths, rmse));
     }
     let (tight_size, tight_widths, tight_rmse) = &results[0];
@@ -51,9 +53,10 @@ fn a_range_floor_widens_the_streams_ranges_and_saves_bits() -> mcgv_video::Resul
         floor_size < tight_size,
         "floor 1: {floor_size} bytes, floor 0: {tight_size}"
     );
-    // A wider step costs some accuracy, bounded: measured ×1.9 here.
+    // A wider step costs some accuracy, bounded: measured 3.03e-5 → 3.71e-5 (×1.22) for 27 % fewer
+    // bytes (84 879 → 61 687) in this debug build.
     assert!(
-        *floor_rmse < 4.0 * tight_rmse,
+        *floor_rmse < 2.0 * tight_rmse,
         "RMSE {floor_rmse} vs {tight_rmse}"
     );
     Ok(())

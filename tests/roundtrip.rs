@@ -1,45 +1,14 @@
 //! End-to-end: encode media samples with both codecs, decode, and check connectivity, error bounds,
 //! random access and the handling of damaged streams.
 
-use mcgv_video::decoder::Decoder;
-use mcgv_video::encoder::{encode, EncodeOptions};
-use mcgv_video::mesh::{read_animation, AnimatedMesh, ReadOptions, Triangle};
+mod common;
+
+use common::{canonical, decode_all, decoder, encode_bytes, read_media};
+use mcgv_video::encoder::EncodeOptions;
 use mcgv_video::metrics::compare;
 use mcgv_video::stream::container::{ContainerReader, Tag};
 use mcgv_video::stream::header::CodecKind;
-use std::collections::BTreeSet;
 use std::io::Cursor;
-
-fn media(name: &str) -> AnimatedMesh {
-    let path = format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"));
-    read_animation(&path, &ReadOptions::default()).expect("media sample reads")
-}
-
-fn encode_bytes(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<u8> {
-    let hidden = indicatif::ProgressBar::hidden();
-    encode(mesh, opts, &hidden)
-        .expect("encodes")
-        .container
-        .to_bytes()
-}
-
-fn decoder(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
-    Decoder::new(ContainerReader::new(Cursor::new(bytes))?)
-}
-
-fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
-    decoder(bytes)?.decode_all(&indicatif::ProgressBar::hidden())
-}
-
-/// Triangles as a set, each rotated so its smallest index comes first (orientation kept).
-fn oriented_set(tris: &[Triangle]) -> BTreeSet<Triangle> {
-    tris.iter()
-        .map(|t| {
-            let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
-            [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
-        })
-        .collect()
-}
 
 /// Test settings: CG padding (the paper's) keeps these debug-build tests fast; the default padding
 /// is exercised by the random-access test and the CLI tests.
@@ -58,7 +27,7 @@ fn opts(codec: CodecKind, quality: u8) -> EncodeOptions {
 /// regression in any stage — prediction, quantisation, padding, codec — breaks them.
 #[test]
 fn jpeg_round_trip_keeps_connectivity_and_bounds_error() {
-    let mesh = media("RiggedSimple.glb");
+    let mesh = read_media("RiggedSimple.glb");
     let mut last_rmse = f64::INFINITY;
     let mut last_size = 0;
     for (quality, bound) in [(30u8, 5e-5), (90, 1.8e-5)] {
@@ -67,10 +36,7 @@ fn jpeg_round_trip_keeps_connectivity_and_bounds_error() {
         let decoded = decode_all(bytes).unwrap();
         assert_eq!(decoded.vertex_count(), mesh.vertex_count());
         assert_eq!(decoded.frame_count(), mesh.frame_count());
-        assert_eq!(
-            oriented_set(decoded.triangles()),
-            oriented_set(mesh.triangles())
-        );
+        assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
         let m = compare(&mesh, &decoded).unwrap();
         assert!(
             m.rmse < bound,
@@ -88,7 +54,7 @@ fn jpeg_round_trip_keeps_connectivity_and_bounds_error() {
 
 #[test]
 fn mpeg4_round_trip_keeps_connectivity_and_bounds_error() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let bytes = encode_bytes(
         &mesh,
         &EncodeOptions {
@@ -97,10 +63,7 @@ fn mpeg4_round_trip_keeps_connectivity_and_bounds_error() {
         },
     );
     let decoded = decode_all(bytes.clone()).unwrap();
-    assert_eq!(
-        oriented_set(decoded.triangles()),
-        oriented_set(mesh.triangles())
-    );
+    assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
     // Measured 2.0e-5 (qscale 4); the bound is twice that.
     assert!(m.rmse < 4e-5, "RMSE {}", m.rmse);
@@ -112,7 +75,7 @@ fn mpeg4_round_trip_keeps_connectivity_and_bounds_error() {
 
 #[test]
 fn jpeg_frame_decodes_alone_when_every_other_frame_is_destroyed() {
-    let mesh = media("RiggedSimple.glb");
+    let mesh = read_media("RiggedSimple.glb");
     let bytes = encode_bytes(
         &mesh,
         &EncodeOptions {
@@ -151,7 +114,7 @@ fn jpeg_frame_decodes_alone_when_every_other_frame_is_destroyed() {
 
 #[test]
 fn truncated_and_bit_flipped_streams_are_errors_not_panics() {
-    let mesh = media("RiggedSimple.glb");
+    let mesh = read_media("RiggedSimple.glb");
     let bytes = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50));
     let want = decode_all(bytes.clone()).unwrap();
     // Every cut length in the part headers and a spread of cuts through the payloads.

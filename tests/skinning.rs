@@ -1,44 +1,18 @@
 //! End-to-end tests of the skinning predictor (`--predictor skinning`): round trips through both
 //! image codecs, the stream recording the choice, and damaged or inconsistent weights parts.
 
-use mcgv_video::decoder::Decoder;
-use mcgv_video::encoder::{analyse, encode, EncodeOptions};
-use mcgv_video::mesh::{read_animation, AnimatedMesh, ReadOptions, Triangle};
+mod common;
+
+use common::{
+    canonical, decode_all, decoder, encode_bytes, json, media_path, ok, parts, read_media, rebuild,
+    run,
+};
+use mcgv_video::encoder::{analyse, EncodeOptions};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{self, PredictorKind};
-use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
+use mcgv_video::stream::container::{Checksum, ContainerReader, Tag};
 use mcgv_video::stream::header::CodecKind;
-use std::collections::BTreeSet;
 use std::io::Cursor;
-
-fn media(name: &str) -> AnimatedMesh {
-    let path = format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"));
-    read_animation(&path, &ReadOptions::default()).expect("media sample reads")
-}
-
-fn encode_bytes(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<u8> {
-    encode(mesh, opts, &indicatif::ProgressBar::hidden())
-        .expect("encodes")
-        .container
-        .to_bytes()
-}
-
-fn decoder(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
-    Decoder::new(ContainerReader::new(Cursor::new(bytes))?)
-}
-
-fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
-    decoder(bytes)?.decode_all(&indicatif::ProgressBar::hidden())
-}
-
-fn oriented_set(tris: &[Triangle]) -> BTreeSet<Triangle> {
-    tris.iter()
-        .map(|t| {
-            let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
-            [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
-        })
-        .collect()
-}
 
 /// As in `tests/roundtrip.rs`: CG padding keeps the debug-build tests fast.
 fn opts(codec: CodecKind, quality: u8, predictor: PredictorKind) -> EncodeOptions {
@@ -52,30 +26,9 @@ fn opts(codec: CodecKind, quality: u8, predictor: PredictorKind) -> EncodeOption
     }
 }
 
-/// The parts of a stream as (tag, payload, checksum kind), to rebuild it altered.
-fn parts(bytes: &[u8]) -> Vec<(Tag, Vec<u8>, Checksum)> {
-    let reader = ContainerReader::new(Cursor::new(bytes.to_vec())).unwrap();
-    reader
-        .parts()
-        .iter()
-        .map(|p| {
-            let (o, l) = (p.offset as usize, p.len as usize);
-            (p.tag, bytes[o..o + l].to_vec(), p.checksum)
-        })
-        .collect()
-}
-
-fn rebuild(parts: Vec<(Tag, Vec<u8>, Checksum)>) -> Vec<u8> {
-    let mut w = ContainerWriter::new();
-    for (tag, payload, checksum) in parts {
-        w.add(tag, payload, checksum);
-    }
-    w.to_bytes()
-}
-
 #[test]
 fn jpeg_skinning_round_trip_keeps_connectivity_and_bounds_error() {
-    let mesh = media("RiggedSimple.glb");
+    let mesh = read_media("RiggedSimple.glb");
     let bytes = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50, PredictorKind::Skinning));
     let dec = decoder(bytes.clone()).unwrap();
     assert_eq!(dec.header().predictor, PredictorKind::Skinning);
@@ -84,10 +37,7 @@ fn jpeg_skinning_round_trip_keeps_connectivity_and_bounds_error() {
     let decoded = decode_all(bytes.clone()).unwrap();
     assert_eq!(decoded.vertex_count(), mesh.vertex_count());
     assert_eq!(decoded.frame_count(), mesh.frame_count());
-    assert_eq!(
-        oriented_set(decoded.triangles()),
-        oriented_set(mesh.triangles())
-    );
+    assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
     // Measured 5.1e-6 (release build, `mcgv-video eval`); the bound is about twice that, and half
     // of what the affine predictor reaches at the same settings (2.3e-5).
@@ -102,7 +52,7 @@ fn jpeg_skinning_round_trip_keeps_connectivity_and_bounds_error() {
 
 #[test]
 fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let bytes = encode_bytes(
         &mesh,
         &EncodeOptions {
@@ -111,10 +61,7 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
         },
     );
     let decoded = decode_all(bytes.clone()).unwrap();
-    assert_eq!(
-        oriented_set(decoded.triangles()),
-        oriented_set(mesh.triangles())
-    );
+    assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
     // Measured 2.0e-6 (affine: 2.0e-5 at the same settings); the bound is 2.5 times that.
     assert!(m.rmse < 5e-6, "RMSE {}", m.rmse);
@@ -125,7 +72,7 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
 
 #[test]
 fn damaged_or_inconsistent_weights_are_errors() {
-    let mesh = media("RiggedSimple.glb");
+    let mesh = read_media("RiggedSimple.glb");
     let skin = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50, PredictorKind::Skinning));
     let affine = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50, PredictorKind::Affine));
     let skin_parts = parts(&skin);
@@ -189,7 +136,7 @@ fn damaged_or_inconsistent_weights_are_errors() {
 #[test]
 fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
     // RiggedFigure is skinned with blended joints, the case the skinning predictor is made for.
-    let mesh = media("RiggedFigure.glb");
+    let mesh = read_media("RiggedFigure.glb");
     let reference = mesh.frame(0).to_vec();
     let energy = |predictor| {
         let a = analyse(
@@ -215,18 +162,12 @@ fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
 #[test]
 fn cli_records_the_predictor_and_inspect_reports_the_weights() {
     let dir = tempfile::tempdir().unwrap();
-    let sample = format!("{}/media/RiggedSimple.glb", env!("CARGO_MANIFEST_DIR"));
-    let run = |args: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-            .args(args)
-            .output()
-            .expect("runs mcgv-video")
-    };
+    let sample = media_path("RiggedSimple.glb");
     let mut bits = Vec::new();
     for (predictor, weight_bits) in [("affine", "16"), ("skinning", "16"), ("skinning", "10")] {
         let path = dir.path().join(format!("{predictor}{weight_bits}.mcgv"));
         let s = path.to_str().unwrap();
-        let enc = run(&[
+        ok(&run(&[
             "encode",
             &sample,
             "-o",
@@ -238,15 +179,8 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
             "--padding",
             "cg",
             "--quiet",
-        ]);
-        assert!(
-            enc.status.success(),
-            "{}",
-            String::from_utf8_lossy(&enc.stderr)
-        );
-        let out = run(&["inspect", s, "--json"]);
-        assert!(out.status.success());
-        let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        ]));
+        let info = json(&run(&["inspect", s, "--json"]));
         assert_eq!(info["predictor"], predictor);
         if predictor == "skinning" {
             assert_eq!(info["weight_bits"].to_string(), weight_bits);

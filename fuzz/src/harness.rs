@@ -112,13 +112,7 @@ pub fn fix_checksums(bytes: &mut [u8]) {
         };
         let tag: [u8; 4] = [head[0], head[1], head[2], head[3]];
         let whole = head[4] == 0;
-        let len = u64::from_le_bytes(head[5..13].try_into().unwrap_or_default());
-        let start = pos + PART_HEADER_LEN;
-        let Some(end) = usize::try_from(len)
-            .ok()
-            .and_then(|l| start.checked_add(l))
-            .filter(|&e| e <= bytes.len())
-        else {
+        let Some((start, end)) = payload_span(bytes, pos) else {
             return;
         };
         if &tag == b"MESH" && end - start >= FIRST_FRAME_HEADER_LEN {
@@ -163,17 +157,20 @@ pub fn fix_checksums(bytes: &mut [u8]) {
     refresh_part_crc(bytes, b"INDX");
 }
 
+/// Where the payload of the part whose header starts at `pos` lies, if it lies inside `bytes`.
+fn payload_span(bytes: &[u8], pos: usize) -> Option<(usize, usize)> {
+    let head = bytes.get(pos..pos + PART_HEADER_LEN)?;
+    let len = u64::from_le_bytes(head[5..13].try_into().unwrap_or_default());
+    let start = pos + PART_HEADER_LEN;
+    let end = usize::try_from(len).ok()?.checked_add(start)?;
+    (end <= bytes.len()).then_some((start, end))
+}
+
 /// Recomputes the part CRC of the (first) part tagged `tag`.
 fn refresh_part_crc(bytes: &mut [u8], tag: &[u8; 4]) {
     let mut pos = FILE_HEADER_LEN;
     while let Some(head) = bytes.get(pos..pos + PART_HEADER_LEN) {
-        let len = u64::from_le_bytes(head[5..13].try_into().unwrap_or_default());
-        let start = pos + PART_HEADER_LEN;
-        let Some(end) = usize::try_from(len)
-            .ok()
-            .and_then(|l| start.checked_add(l))
-            .filter(|&e| e <= bytes.len())
-        else {
+        let Some((start, end)) = payload_span(bytes, pos) else {
             return;
         };
         if &head[..4] == tag {

@@ -88,15 +88,7 @@ impl BlockLaplace {
         self.x.resize(self.pixel_of.len(), start);
         let (degree, link_start, links) = (&self.degree, &self.link_start, &self.links);
         let report = cg::solve(
-            |v, out| {
-                for (u, o) in out.iter_mut().enumerate() {
-                    let neighbours: f64 = links[link_start[u]..link_start[u + 1]]
-                        .iter()
-                        .map(|&q| v[q])
-                        .sum();
-                    *o = degree[u] * v[u] - neighbours;
-                }
-            },
+            |v, out| cg::laplacian(degree, link_start, links, v, out),
             &self.rhs,
             &mut self.x,
             limits,

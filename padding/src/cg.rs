@@ -79,6 +79,25 @@ pub(crate) fn solve(
     }
 }
 
+/// `out = A v` for the Laplace system of the padding solvers: unknown `u` has `degree[u]` neighbours
+/// in all, the unknown ones at `links[link_start[u]..link_start[u + 1]]` (the fixed ones are in the
+/// right-hand side). Both Laplace paddings build this layout, so they share the product.
+pub(crate) fn laplacian(
+    degree: &[f64],
+    link_start: &[usize],
+    links: &[usize],
+    v: &[f64],
+    out: &mut [f64],
+) {
+    for (u, o) in out.iter_mut().enumerate() {
+        let neighbours: f64 = links[link_start[u]..link_start[u + 1]]
+            .iter()
+            .map(|&q| v[q])
+            .sum();
+        *o = degree[u] * v[u] - neighbours;
+    }
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

@@ -56,15 +56,7 @@ pub(crate) fn fill(
     link_start.push(links.len());
     let mut x: Vec<f64> = pixel_of.iter().map(|&i| f64::from(image[i])).collect();
     let report = cg::solve(
-        |v, out| {
-            for (u, o) in out.iter_mut().enumerate() {
-                let neighbours: f64 = links[link_start[u]..link_start[u + 1]]
-                    .iter()
-                    .map(|&q| v[q])
-                    .sum();
-                *o = degree[u] * v[u] - neighbours;
-            }
-        },
+        |v, out| cg::laplacian(&degree, &link_start, &links, v, out),
         &rhs,
         &mut x,
         limits,

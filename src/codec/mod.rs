@@ -8,7 +8,7 @@
 //! Three coordinate images per frame, measured on smooth synthetic 256×256 planes (see
 //! `measure_rate_distortion_and_speed` in `tests/codec.rs`): tiling them into one 768×256 picture
 //! saves JPEG ≈ 460 bytes a frame with full headers (2–4 %) but only ≈ 100–130 bytes (< 1 %) in the
-//! compact form ([`jpeg::encode_compact`]), while MPEG-4 codes three separate streams 2–4 % smaller
+//! abbreviated form the stream stores ([`abbreviated`]), while MPEG-4 codes three separate streams 2–4 % smaller
 //! than the tiled picture. Chroma is flat and costs nothing measurable
 //! (the GRAY flag changes no byte).
 
@@ -128,11 +128,24 @@ impl Plane {
 /// within about 1 dB (measured by `measure_rate_distortion_and_speed` in `tests/codec.rs`). So one
 /// `--quality` means roughly the same distortion whichever codec is chosen.
 pub fn quality_to_qscale(quality: u8) -> u8 {
-    let q = u32::from(quality.clamp(1, 100));
-    let scale_percent = if q < 50 { 5000 / q } else { 200 - 2 * q };
+    let scale_percent = ijg_scale_percent(quality);
     // qscale = 4 · scale / 100, rounded to nearest.
     let qscale = (4 * scale_percent + 50) / 100;
     qscale.clamp(1, 31) as u8
+}
+
+/// The IJG quality law (libjpeg's `jpeg_quality_scaling`): the quantiser scale in percent for a
+/// quality 1..100 (clamped), 5000/q below 50 and 200 − 2q from 50 up (0 at 100).
+///
+/// Shared by every codec that follows the one `--quality` scale: MPEG-4's qscale
+/// ([`quality_to_qscale`]) and the temporal-DCT step.
+pub fn ijg_scale_percent(quality: u8) -> u32 {
+    let q = u32::from(quality.clamp(1, 100));
+    if q < 50 {
+        5000 / q
+    } else {
+        200 - 2 * q
+    }
 }
 
 #[cfg(test)]

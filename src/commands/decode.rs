@@ -1,7 +1,7 @@
 //! `mcgv-video decode`.
 
 use crate::cli::DecodeArgs;
-use crate::decoder::Decoder;
+use crate::decoder::{DecodeOptions, Decoder};
 use crate::error::{Error, Result};
 use crate::mesh::io::write_obj_sequence_from;
 use crate::mesh::{write_pc2, AnimatedMesh};
@@ -15,10 +15,32 @@ fn is_pc2(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("pc2"))
 }
 
+/// The decoding options of `--bands`.
+pub fn decode_options(bands: Option<u64>) -> DecodeOptions {
+    DecodeOptions {
+        max_bands: bands.map(|n| usize::try_from(n).unwrap_or(usize::MAX)),
+    }
+}
+
+/// Tells on stderr when a temporal-DCT stream was cut short: it decodes, but coarser.
+pub fn warn_if_truncated<R>(decoder: &Decoder<R>)
+where
+    R: std::io::Read + std::io::Seek,
+{
+    if decoder.truncated() {
+        eprintln!(
+            "mcgv-video: warning: stream truncated: decoded {} of {} temporal-DCT bands, a coarser animation",
+            decoder.bands_decoded(),
+            decoder.bands_total()
+        );
+    }
+}
+
 /// Runs `decode`.
 pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
     let start = Instant::now();
-    let mut decoder = Decoder::open(&args.input)?;
+    let mut decoder = Decoder::open_with(&args.input, &decode_options(args.bands))?;
+    warn_if_truncated(&decoder);
     let frames = decoder.header().frames as usize;
     let mesh = match args.frame {
         Some(f) => {

@@ -47,6 +47,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         codec: match args.codec {
             CodecChoice::Jpeg => CodecKind::Jpeg,
             CodecChoice::Mpeg4 => CodecKind::Mpeg4,
+            CodecChoice::Tdct => CodecKind::Tdct,
         },
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
         qscale: args.qscale,
@@ -63,6 +64,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         },
         weight_bits: args.weight_bits,
         range_floor: args.range_floor,
+        step: args.step,
         ..defaults
     })
 }

@@ -13,13 +13,20 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     let opts: ReadOptions = (&args.input_args).into();
     let original = read_animation(&args.original, &opts)?;
     let measures = if is_mcgv(&args.decoded) {
-        let mut decoder = Decoder::open(Path::new(&args.decoded))?;
+        let options = super::decode::decode_options(args.bands);
+        let mut decoder = Decoder::open_with(Path::new(&args.decoded), &options)?;
+        super::decode::warn_if_truncated(&decoder);
         let bits = decoder.container().file_len() * 8;
         let pb = progress::bar(decoder.header().frames as u64, "decode", quiet);
         let decoded = decoder.decode_all(&pb)?;
         pb.finish_and_clear();
         compare(&original, &decoded)?.with_bits(bits)
     } else {
+        if args.bands.is_some() {
+            return Err(Error::Usage(
+                "--bands applies to a .mcgv stream of codec tdct".into(),
+            ));
+        }
         compare(&original, &read_animation(&args.decoded, &opts)?)?
     };
     if args.json {

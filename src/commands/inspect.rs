@@ -27,8 +27,16 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
     let vf = header.vertices as f64 * header.frames as f64;
     let bpvf = total as f64 * 8.0 / vf;
     if let Some(dir) = &args.png {
+        if !header.codec.has_images() {
+            return Err(Error::Usage(format!(
+                "--png: a {} stream has no geometry images to write (its residuals are \
+                 temporal-DCT bands; the band table is in the plain and --json output)",
+                header.codec.name()
+            )));
+        }
         write_pngs(&mut decoder, args, dir, quiet)?;
     }
+    let bands = decoder.band_lengths().to_vec();
     if args.json {
         let parts_obj: serde_json::Map<String, serde_json::Value> = parts
             .iter()
@@ -52,6 +60,8 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "bytes": total,
             "bpvf": bpvf,
             "parts": parts_obj,
+            "band_bytes": (!bands.is_empty()).then_some(&bands),
+            "step": decoder.band_step(),
         });
         println!("{value}");
         return Ok(());
@@ -79,13 +89,76 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
         100.0,
         bpvf
     );
+    if !bands.is_empty() {
+        print!("{}", band_table(&bands, decoder.bands_decoded()));
+    }
     Ok(())
+}
+
+/// Bands shown one by one in the plain `inspect` output; the rest are summed.
+const BANDS_LISTED: usize = 12;
+
+/// The temporal-DCT bands: bytes of the first bands, and how many bands (low to high, the order a
+/// truncated stream keeps) hold 50, 90, 99 and 100 % of the coefficient bytes.
+fn band_table(bands: &[u64], decoded: usize) -> String {
+    let total: u64 = bands.iter().sum();
+    let mut s = format!(
+        "temporal DCT: {} bands, {} of them empty, {total} bytes; {decoded} decodable\n",
+        bands.len(),
+        bands.iter().filter(|&&b| b == 0).count()
+    );
+    s.push_str(&format!(
+        "{:<10} {:>10} {:>12}\n",
+        "band", "bytes", "cumulative"
+    ));
+    let mut sum = 0u64;
+    for (k, &b) in bands.iter().enumerate().take(BANDS_LISTED) {
+        sum += b;
+        s.push_str(&format!(
+            "{k:<10} {b:>10} {:>11.1}%\n",
+            100.0 * sum as f64 / total.max(1) as f64
+        ));
+    }
+    if bands.len() > BANDS_LISTED {
+        let rest: u64 = bands[BANDS_LISTED..].iter().sum();
+        s.push_str(&format!(
+            "{:<10} {rest:>10} {:>11.1}%\n",
+            format!("{}..{}", BANDS_LISTED, bands.len() - 1),
+            100.0
+        ));
+    }
+    for share in [50.0, 90.0, 99.0, 100.0] {
+        let mut sum = 0u64;
+        let needed = bands
+            .iter()
+            .position(|&b| {
+                sum += b;
+                sum as f64 >= share / 100.0 * total as f64
+            })
+            .map_or(0, |k| k + 1);
+        s.push_str(&format!(
+            "{share:>5.0} % of the bytes in the first {needed} bands\n"
+        ));
+    }
+    s
 }
 
 fn summary(h: &Header, path: &Path) -> String {
     let codec = match h.codec {
         CodecKind::Jpeg => format!("jpeg quality {}", h.quality),
         CodecKind::Mpeg4 => format!("mpeg4 qscale {} gop {}", h.qscale, h.gop),
+        CodecKind::Tdct => {
+            return format!(
+                "{}: {} vertices x {} frames, {} faces; tdct quality {}; {} clusters, {} predictor, no atlas",
+                path.display(),
+                h.vertices,
+                h.frames,
+                h.triangles,
+                h.quality,
+                h.clusters,
+                h.predictor.name()
+            )
+        }
     };
     format!(
         "{}: {} vertices x {} frames, {} faces; {codec}; {} clusters, {} predictor, {} charts in {}x{} (packing {:.1}%), padding {}",
@@ -233,6 +306,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
                 .weights()
                 .map_or(crate::motion::WEIGHT_BITS, |w| w.bits),
             range_floor: 0.0,
+            step: None,
         };
         let ff = first_frame::encode(
             mesh.frame(0),
@@ -271,7 +345,9 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             save_levels(&dir.join(format!("frame_{f:04}_raw.png")), &raw, w, h)?;
             // P-frames pad against the previous frame; re-padding from the group start reproduces it.
             let padded = match header.codec {
-                CodecKind::Jpeg => encoder::residual_images(&analysis, f, &opts, None)?,
+                CodecKind::Jpeg | CodecKind::Tdct => {
+                    encoder::residual_images(&analysis, f, &opts, None)?
+                }
                 CodecKind::Mpeg4 => {
                     let start = f - f % opts.gop;
                     let mut prev = encoder::residual_images(&analysis, start, &opts, None)?;

@@ -180,10 +180,7 @@ mod tests {
 
     #[test]
     fn widening_keeps_each_range_covering_its_values() {
-        let narrow = AxisRange {
-            min: 0.9,
-            max: 1.1,
-        };
+        let narrow = AxisRange { min: 0.9, max: 1.1 };
         let wide = AxisRange {
             min: -2.0,
             max: 2.0,

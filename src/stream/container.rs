@@ -51,6 +51,10 @@ impl Tag {
     pub const FRAME_INDEX: Tag = Tag(*b"INDX");
     /// The coded images, one chunk per frame.
     pub const FRAMES: Tag = Tag(*b"FRMS");
+    /// Temporal-DCT index: quantiser step, and byte length and CRC of each frequency band.
+    pub const TDCT_INDEX: Tag = Tag(*b"TDIX");
+    /// Temporal-DCT coefficients, one chunk per frequency band, low to high.
+    pub const TDCT: Tag = Tag(*b"TDCT");
 
     /// A human-readable name, for reports and errors.
     pub fn name(self) -> &'static str {
@@ -65,6 +69,8 @@ impl Tag {
             b"CSET" => "codec set-up",
             b"INDX" => "frame index",
             b"FRMS" => "images",
+            b"TDIX" => "temporal DCT index",
+            b"TDCT" => "temporal DCT coefficients",
             _ => "unknown part",
         }
     }
@@ -83,6 +89,19 @@ pub enum Checksum {
     Whole,
     /// The payload's chunks are checked through the frame index.
     Chunked,
+    /// Chunked, and any prefix of the chunks is useful: the one kind of part that may be cut short
+    /// by the end of the file, and only when it is the last part (see [`ContainerReader::truncated`]).
+    Progressive,
+}
+
+impl Checksum {
+    fn id(self) -> u8 {
+        match self {
+            Checksum::Whole => 0,
+            Checksum::Chunked => 1,
+            Checksum::Progressive => 2,
+        }
+    }
 }
 
 /// Builds a container in memory; [`ContainerWriter::write_atomic`] puts it on disk.
@@ -125,10 +144,10 @@ impl ContainerWriter {
         for (tag, payload, checksum) in &self.parts {
             let crc = match checksum {
                 Checksum::Whole => crc32fast::hash(payload),
-                Checksum::Chunked => 0,
+                Checksum::Chunked | Checksum::Progressive => 0,
             };
             w.raw(&tag.0)
-                .u8(matches!(checksum, Checksum::Chunked) as u8)
+                .u8(checksum.id())
                 .u64(payload.len() as u64)
                 .u32(crc)
                 .raw(payload);
@@ -152,7 +171,7 @@ pub struct PartEntry {
     pub tag: Tag,
     /// Offset of the payload from the start of the file.
     pub offset: u64,
-    /// Payload length in bytes.
+    /// Payload length in bytes (for a truncated progressive part, what the file still holds).
     pub len: u64,
     /// CRC-32 of the payload (unused for chunked parts).
     pub crc: u32,
@@ -166,6 +185,8 @@ pub struct ContainerReader<R> {
     source: R,
     parts: Vec<PartEntry>,
     file_len: u64,
+    /// The progressive last part cut short by the end of the file, and the length it declared.
+    truncated: Option<(Tag, u64)>,
 }
 
 impl ContainerReader<BufReader<File>> {
@@ -205,6 +226,7 @@ impl<R: Read + Seek> ContainerReader<R> {
         }
         let mut parts = Vec::with_capacity(count as usize);
         let mut pos = 16u64;
+        let mut truncated = None;
         for i in 0..count {
             let mut ph = [0u8; 17];
             read_exact_or(&mut source, &mut ph, "a part header")?;
@@ -214,6 +236,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             let checksum = match r.u8()? {
                 0 => Checksum::Whole,
                 1 => Checksum::Chunked,
+                2 => Checksum::Progressive,
                 other => {
                     return Err(Error::Stream(format!(
                         "part {i}: unknown checksum kind {other}"
@@ -223,15 +246,26 @@ impl<R: Read + Seek> ContainerReader<R> {
             let len = r.u64()?;
             let crc = r.u32()?;
             let offset = pos + 17;
-            let end = offset
-                .checked_add(len)
-                .filter(|&e| e <= file_len)
-                .ok_or_else(|| {
-                    Error::Stream(format!(
-                        "part {} claims {len} bytes but the file ends first (truncated file?)",
-                        Tag(tag)
-                    ))
-                })?;
+            let declared_end = offset.checked_add(len);
+            // A progressive last part may be cut by the end of the file: its prefix still decodes.
+            let (len, declared_end) = match declared_end {
+                Some(e)
+                    if e > file_len
+                        && checksum == Checksum::Progressive
+                        && i + 1 == count
+                        && offset <= file_len =>
+                {
+                    truncated = Some((Tag(tag), len));
+                    (file_len - offset, Some(file_len))
+                }
+                other => (len, other),
+            };
+            let end = declared_end.filter(|&e| e <= file_len).ok_or_else(|| {
+                Error::Stream(format!(
+                    "part {} claims {len} bytes but the file ends first (truncated file?)",
+                    Tag(tag)
+                ))
+            })?;
             parts.push(PartEntry {
                 tag: Tag(tag),
                 offset,
@@ -252,7 +286,16 @@ impl<R: Read + Seek> ContainerReader<R> {
             source,
             parts,
             file_len,
+            truncated,
         })
+    }
+
+    /// The length a part declared, when it is the progressive last part and the file ends inside
+    /// it (its entry then holds only the bytes present); `None` for a complete part.
+    pub fn truncated(&self, tag: Tag) -> Option<u64> {
+        self.truncated
+            .filter(|&(t, _)| t == tag)
+            .map(|(_, declared)| declared)
     }
 
     /// The part table.
@@ -373,5 +416,43 @@ mod tests {
         let mut extra = bytes;
         extra.push(0);
         assert!(ContainerReader::new(Cursor::new(extra)).is_err());
+    }
+
+    fn progressive(last: bool) -> Vec<u8> {
+        let mut w = ContainerWriter::new();
+        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
+        w.add(Tag::TDCT, b"0123456789".to_vec(), Checksum::Progressive);
+        if !last {
+            w.add(Tag::AFFINE, b"abc".to_vec(), Checksum::Whole);
+        }
+        w.to_bytes()
+    }
+
+    #[test]
+    fn only_a_progressive_last_part_may_be_cut_short() {
+        let bytes = progressive(true);
+        let r = ContainerReader::new(Cursor::new(bytes.clone())).unwrap();
+        assert_eq!(r.entry(Tag::TDCT).unwrap().len, 10);
+        assert_eq!(r.truncated(Tag::TDCT), None);
+        let payload = bytes.len() - 10;
+        for cut in payload..bytes.len() {
+            let mut r = ContainerReader::new(Cursor::new(bytes[..cut].to_vec()))
+                .unwrap_or_else(|e| panic!("cut {cut}: {e}"));
+            assert_eq!(r.entry(Tag::TDCT).unwrap().len, (cut - payload) as u64);
+            assert_eq!(r.truncated(Tag::TDCT), Some(10));
+            assert_eq!(r.part(Tag::HEADER).unwrap(), b"hello");
+            let crc = crc32fast::hash(b"01");
+            let whole = r.chunk(Tag::TDCT, 0, 2, crc, "band 0");
+            assert_eq!(whole.is_ok(), cut >= payload + 2, "cut {cut}");
+        }
+        // Inside the part's own header, or before it: still an error.
+        for cut in 0..payload {
+            assert!(ContainerReader::new(Cursor::new(bytes[..cut].to_vec())).is_err());
+        }
+        // Not the last part: a cut is an error like any other.
+        let bytes = progressive(false);
+        for cut in 0..bytes.len() {
+            assert!(ContainerReader::new(Cursor::new(bytes[..cut].to_vec())).is_err());
+        }
     }
 }

@@ -12,6 +12,9 @@ pub enum CodecKind {
     Jpeg,
     /// MPEG-4 Part 2: I-frames every `gop` frames, P-frames between.
     Mpeg4,
+    /// No images: each vertex's residuals as a temporal DCT over all frames, coded from low to high
+    /// frequency, so that a truncated stream still decodes a coarser animation.
+    Tdct,
 }
 
 impl CodecKind {
@@ -19,6 +22,7 @@ impl CodecKind {
         match self {
             CodecKind::Jpeg => 0,
             CodecKind::Mpeg4 => 1,
+            CodecKind::Tdct => 2,
         }
     }
 
@@ -26,6 +30,7 @@ impl CodecKind {
         match id {
             0 => Ok(CodecKind::Jpeg),
             1 => Ok(CodecKind::Mpeg4),
+            2 => Ok(CodecKind::Tdct),
             _ => Err(Error::Stream(format!("unknown codec id {id}"))),
         }
     }
@@ -35,7 +40,13 @@ impl CodecKind {
         match self {
             CodecKind::Jpeg => "jpeg",
             CodecKind::Mpeg4 => "mpeg4",
+            CodecKind::Tdct => "tdct",
         }
+    }
+
+    /// Whether the codec codes geometry images on a lattice (and so has an atlas).
+    pub fn has_images(self) -> bool {
+        !matches!(self, CodecKind::Tdct)
     }
 }
 
@@ -50,9 +61,9 @@ pub struct Header {
     pub triangles: u32,
     /// Motion clusters `K`.
     pub clusters: u32,
-    /// Geometry-image lattice width in pixels.
+    /// Geometry-image lattice width in pixels (0 for tdct, which has no images).
     pub lattice_width: u16,
-    /// Geometry-image lattice height in pixels.
+    /// Geometry-image lattice height in pixels (0 for tdct).
     pub lattice_height: u16,
     /// The residual image codec.
     pub codec: CodecKind,
@@ -104,9 +115,14 @@ const MAX_COUNT: u32 = 1 << 28;
 pub const MAX_LATTICE_SIDE: u16 = 4096;
 
 impl Header {
-    /// Packing efficiency of the atlas: chart pixels / lattice pixels.
+    /// Packing efficiency of the atlas: chart pixels / lattice pixels (0 without a lattice).
     pub fn packing_efficiency(&self) -> f64 {
-        self.chart_pixels as f64 / (self.lattice_width as f64 * self.lattice_height as f64)
+        let pixels = self.lattice_width as f64 * self.lattice_height as f64;
+        if pixels > 0.0 {
+            self.chart_pixels as f64 / pixels
+        } else {
+            0.0
+        }
     }
 
     /// Serialises the header.
@@ -184,7 +200,18 @@ impl Header {
                 h.vertices, h.frames, h.clusters
             )));
         }
-        if h.lattice_width == 0
+        if !h.codec.has_images() {
+            // No images, so no lattice: a lattice here means the header is not what it claims.
+            if h.lattice_width != 0 || h.lattice_height != 0 || h.charts != 0 {
+                return Err(Error::Stream(format!(
+                    "a {} stream has no lattice, but the header gives {}x{} with {} charts",
+                    h.codec.name(),
+                    h.lattice_width,
+                    h.lattice_height,
+                    h.charts
+                )));
+            }
+        } else if h.lattice_width == 0
             || h.lattice_height == 0
             || h.lattice_width % 16 != 0
             || h.lattice_height % 16 != 0
@@ -197,7 +224,9 @@ impl Header {
             )));
         }
         // Every vertex has its own lattice pixel.
-        if u64::from(h.vertices) > u64::from(h.lattice_width) * u64::from(h.lattice_height) {
+        if h.codec.has_images()
+            && u64::from(h.vertices) > u64::from(h.lattice_width) * u64::from(h.lattice_height)
+        {
             return Err(Error::Stream(format!(
                 "header claims {} vertices, more than the {}x{} lattice has pixels",
                 h.vertices, h.lattice_width, h.lattice_height
@@ -258,6 +287,62 @@ mod tests {
             *last = 7;
         }
         assert!(Header::from_bytes(&unknown).is_err());
+    }
+
+    fn tdct() -> Header {
+        Header {
+            lattice_width: 0,
+            lattice_height: 0,
+            codec: CodecKind::Tdct,
+            qscale: 0,
+            gop: 1,
+            padding: "none".into(),
+            charts: 0,
+            chart_pixels: 0,
+            ..sample()
+        }
+    }
+
+    #[test]
+    fn lattice_checks_follow_the_codec() {
+        let t = tdct();
+        assert_eq!(Header::from_bytes(&t.to_bytes()).unwrap(), t);
+        assert_eq!(t.packing_efficiency(), 0.0);
+        // tdct has no lattice: any lattice (or chart) is refused …
+        for bad in [
+            Header {
+                lattice_width: 256,
+                lattice_height: 256,
+                ..tdct()
+            },
+            Header {
+                lattice_height: 16,
+                ..tdct()
+            },
+            Header {
+                charts: 3,
+                ..tdct()
+            },
+        ] {
+            assert!(Header::from_bytes(&bad.to_bytes()).is_err());
+        }
+        // … and the image codecs still need one that holds every vertex.
+        for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+            let none = Header {
+                codec,
+                lattice_width: 0,
+                lattice_height: 0,
+                ..sample()
+            };
+            assert!(Header::from_bytes(&none.to_bytes()).is_err());
+            let small = Header {
+                codec,
+                lattice_width: 16,
+                lattice_height: 16,
+                ..sample()
+            };
+            assert!(Header::from_bytes(&small.to_bytes()).is_err());
+        }
     }
 
     #[test]

@@ -7,3 +7,4 @@ pub mod first_frame;
 pub mod frame_index;
 pub mod header;
 pub mod side_info;
+pub mod tdct;

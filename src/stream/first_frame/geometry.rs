@@ -2,9 +2,8 @@
 //! from every parallelogram its already-coded neighbourhood offers (multi-parallelogram), as
 //! Draco does, rather than from the single triangle it was reached through.
 
-use std::collections::HashMap;
-
 use super::quantise::{Cell, Grid};
+use super::traversal::{by_edge, undirected};
 use crate::error::{Error, Result};
 use crate::mesh::Triangle;
 use crate::stream::entropy::{IntModel, SymbolCoder};
@@ -22,10 +21,6 @@ struct Models {
 
 fn corrupt(what: &str) -> Error {
     Error::Stream(format!("first frame geometry: {what}"))
-}
-
-fn undirected(a: u32, b: u32) -> u64 {
-    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
 }
 
 /// Rounded mean of `sum / n` on each axis, clamped to the grid.
@@ -69,15 +64,7 @@ pub(super) fn code_positions<C: SymbolCoder>(
             fill[v as usize] += 1;
         }
     }
-    let mut by_edge: HashMap<u64, Vec<u32>> = HashMap::new();
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            by_edge
-                .entry(undirected(tri[k], tri[(k + 1) % 3]))
-                .or_default()
-                .push(t as u32);
-        }
-    }
+    let by_edge = by_edge(triangles);
 
     let mut models = Models::default();
     let mut cells: Vec<Cell> = Vec::with_capacity(vertex_count);

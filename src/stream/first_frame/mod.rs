@@ -337,17 +337,31 @@ impl Header {
             grid: Grid { bits, lo, hi },
             lengths: [word(40), word(44), word(48)],
         };
-        // Each vertex and triangle costs at least one coded symbol.
-        let limit = max_symbols(bytes.len() - HEADER_LEN).min(MAX_ELEMENTS);
-        for (what, n) in [
-            ("vertices", header.vertex_count),
-            ("triangles", header.traversed),
-            ("degenerate triangles", header.degenerate),
+        // What each stream must hold, in adaptive-coded symbols (each at least 1/710 bit, see
+        // `max_symbols`): every vertex is three coded residuals in the geometry stream and, when the
+        // order is stored, a choice among 8 guesses (3 binary decisions) and a difference in the
+        // order stream; every triangle is at least three decisions in the connectivity stream (a
+        // seed: three new/old bits; a gate: more, flipped and the 5-way kind of its third vertex; a
+        // degenerate one: three indices). Checked per stream, before the decoders allocate anything
+        // per vertex or triangle.
+        let [lc, lg, lo] = header.lengths;
+        let vertices = u64::from(header.vertex_count);
+        let triangles = u64::from(header.traversed) + u64::from(header.degenerate);
+        if vertices > MAX_ELEMENTS || triangles > MAX_ELEMENTS {
+            return Err(Error::Stream(format!(
+                "first frame: {vertices} vertices and {triangles} triangles are past the limit of \
+                 {MAX_ELEMENTS}"
+            )));
+        }
+        let ordered = if header.has_order { vertices } else { 0 };
+        for (what, n, per, stream, len) in [
+            ("vertices", vertices, 3, "geometry", lg),
+            ("triangles", triangles, 3, "connectivity", lc),
+            ("vertices", ordered, 4, "order", lo),
         ] {
-            if u64::from(n) > limit {
+            if n * per > max_symbols(len as usize) {
                 return Err(Error::Stream(format!(
-                    "first frame: {n} {what} cannot fit in {} bytes",
-                    bytes.len()
+                    "first frame: {n} {what} cannot fit in a {stream} stream of {len} bytes"
                 )));
             }
         }

@@ -98,18 +98,9 @@ pub(super) struct Oracle<'a> {
 impl<'a> Oracle<'a> {
     /// `triangles` must have three distinct indices below `vertex_count` each.
     pub(super) fn new(triangles: &'a [Triangle], vertex_count: usize) -> Self {
-        let mut by_edge: HashMap<u64, Vec<u32>> = HashMap::new();
-        for (t, tri) in triangles.iter().enumerate() {
-            for k in 0..3 {
-                by_edge
-                    .entry(undirected(tri[k], tri[(k + 1) % 3]))
-                    .or_default()
-                    .push(t as u32);
-            }
-        }
         Self {
             triangles,
-            by_edge,
+            by_edge: by_edge(triangles),
             coded: vec![false; triangles.len()],
             next_seed: 0,
             to_traversal: vec![UNASSIGNED; vertex_count],
@@ -149,8 +140,23 @@ impl<'a> Oracle<'a> {
     }
 }
 
-fn undirected(a: u32, b: u32) -> u64 {
+/// The key of edge {a, b} whichever way round.
+pub(super) fn undirected(a: u32, b: u32) -> u64 {
     directed(a.min(b), a.max(b))
+}
+
+/// The triangles on each undirected edge, by [`undirected`] key, in triangle order.
+pub(super) fn by_edge(triangles: &[Triangle]) -> HashMap<u64, Vec<u32>> {
+    let mut by_edge: HashMap<u64, Vec<u32>> = HashMap::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            by_edge
+                .entry(undirected(tri[k], tri[(k + 1) % 3]))
+                .or_default()
+                .push(t as u32);
+        }
+    }
+    by_edge
 }
 
 fn directed(a: u32, b: u32) -> u64 {
@@ -398,21 +404,30 @@ fn code_third_vertex<C: SymbolCoder>(
                 .and_then(|s| walk.get(s).copied())
                 .ok_or_else(|| corrupt("border walk too short"))?
         }
-        _ => {
-            let newest = t.vertices as u64;
-            let distance = known.map_or(0, |v| newest - 1 - u64::from(v));
-            let distance = coder.unsigned(distance, &mut models.explicit)?;
-            newest
-                .checked_sub(1)
-                .and_then(|n| n.checked_sub(distance))
-                .and_then(|v| u32::try_from(v).ok())
-                .ok_or_else(|| corrupt("vertex reference out of range"))?
-        }
+        _ => explicit_reference(coder, known, t, models)?,
     };
     if x == a || x == b {
         return Err(corrupt("degenerate triangle"));
     }
     Ok(x)
+}
+
+/// An already-numbered vertex coded as its distance back from the newest one; `known` is the
+/// encoder's vertex (the decoder passes `None` and reads the distance).
+fn explicit_reference<C: SymbolCoder>(
+    coder: &mut C,
+    known: Option<u32>,
+    t: &Traversal,
+    models: &mut Models,
+) -> Result<u32> {
+    let newest = t.vertices as u64;
+    let distance = known.map_or(0, |v| newest - 1 - u64::from(v));
+    let distance = coder.unsigned(distance, &mut models.explicit)?;
+    newest
+        .checked_sub(1)
+        .and_then(|n| n.checked_sub(distance))
+        .and_then(|v| u32::try_from(v).ok())
+        .ok_or_else(|| corrupt("vertex reference out of range"))
 }
 
 /// Starts a new component with the next uncoded triangle.
@@ -445,14 +460,7 @@ fn seed<C: SymbolCoder>(
         tri[k] = if coder.bit(known.is_none(), &mut models.seed_new)? {
             new_vertex(oracle.as_deref_mut(), x, t, vertex_limit)?
         } else {
-            let newest = t.vertices as u64;
-            let distance = known.map_or(0, |v| newest - 1 - u64::from(v));
-            let distance = coder.unsigned(distance, &mut models.explicit)?;
-            newest
-                .checked_sub(1)
-                .and_then(|n| n.checked_sub(distance))
-                .and_then(|v| u32::try_from(v).ok())
-                .ok_or_else(|| corrupt("vertex reference out of range"))?
+            explicit_reference(coder, known, t, models)?
         };
     }
     if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {

@@ -1,0 +1,195 @@
+//! Helpers shared by the integration tests: running the binary, reading its output, the media
+//! samples, encoding and decoding in memory, and synthetic meshes.
+//!
+//! Each test file is its own crate and pulls this in with `mod common;`; most use only part of it,
+//! so unused items are not warnings here.
+#![allow(dead_code)]
+
+use mcgv_video::decoder::Decoder;
+use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
+use mcgv_video::mesh::{read_animation, AnimatedMesh, Point, ReadOptions, Triangle};
+use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
+use mcgv_video::stream::header::CodecKind;
+use std::io::Cursor;
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// The fuzz targets' bodies, for replaying their inputs; they compare connectivity the way the
+/// tests do, so `canonical` has one definition for both.
+#[path = "../../fuzz/src/harness.rs"]
+pub mod harness;
+// Like the items above, unused in the test files that compare no connectivity.
+#[allow(unused_imports)]
+pub use harness::canonical;
+
+/// Runs the `mcgv-video` binary built for these tests; its status is the caller's to check.
+pub fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
+}
+
+/// Asserts the run succeeded (showing its stderr when not) and returns its stdout.
+pub fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The single JSON object a successful `--json` run prints.
+pub fn json(out: &Output) -> serde_json::Value {
+    let stdout = ok(out);
+    serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("not one JSON object ({e}): {stdout}"))
+}
+
+/// The path of a sample in `media/`.
+pub fn media_path(name: &str) -> String {
+    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A sample in `media/`, read with the default options.
+pub fn read_media(name: &str) -> AnimatedMesh {
+    read_animation(&media_path(name), &ReadOptions::default()).expect("media sample reads")
+}
+
+/// The grey levels of an image file (a PNG the binary wrote).
+pub fn grey(path: &Path) -> Vec<u8> {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_luma8()
+        .into_raw()
+}
+
+/// Encodes in memory to the bytes of a `.mcgv` file.
+pub fn encode_bytes(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<u8> {
+    encode(mesh, opts, &indicatif::ProgressBar::hidden())
+        .expect("encodes")
+        .container
+        .to_bytes()
+}
+
+/// A decoder over in-memory stream bytes; damaged bytes are its error, not a panic.
+pub fn decoder(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
+    Decoder::new(ContainerReader::new(Cursor::new(bytes))?)
+}
+
+/// Decodes every frame of in-memory stream bytes.
+pub fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
+    decoder(bytes)?.decode_all(&indicatif::ProgressBar::hidden())
+}
+
+/// A real two-frame stream of a square (two triangles, one cluster), small enough to forge quickly.
+pub fn tiny_stream(codec: CodecKind) -> Vec<u8> {
+    let square = |t: f32| {
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, t],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, -t],
+        ]
+    };
+    let mesh = AnimatedMesh::new(vec![[0, 1, 2], [0, 2, 3]], vec![square(0.0), square(0.1)])
+        .expect("a valid animation");
+    let opts = EncodeOptions {
+        codec,
+        clusters: 1,
+        lattice: Lattice::Fixed(16, 16),
+        padding: Some(padding::Method::Cg),
+        ..EncodeOptions::default()
+    };
+    encode(&mesh, &opts, &indicatif::ProgressBar::hidden())
+        .expect("encodes")
+        .container
+        .to_bytes()
+}
+
+/// The parts of a stream as (tag, payload, checksum kind), to rebuild it altered.
+pub fn parts(bytes: &[u8]) -> Vec<(Tag, Vec<u8>, Checksum)> {
+    let reader = ContainerReader::new(Cursor::new(bytes.to_vec())).expect("a valid container");
+    reader
+        .parts()
+        .iter()
+        .map(|p| {
+            let (o, l) = (p.offset as usize, p.len as usize);
+            (p.tag, bytes[o..o + l].to_vec(), p.checksum)
+        })
+        .collect()
+}
+
+/// A stream of `parts`, with checksums made for their payloads.
+pub fn rebuild(parts: Vec<(Tag, Vec<u8>, Checksum)>) -> Vec<u8> {
+    let mut w = ContainerWriter::new();
+    for (tag, payload, checksum) in parts {
+        w.add(tag, payload, checksum);
+    }
+    w.to_bytes()
+}
+
+/// A closed-around tube along x from `x0` to `x1`, `rings` rings of `ring_size` vertices, appended
+/// to `points` and `tris`.
+pub fn tube(
+    points: &mut Vec<Point>,
+    tris: &mut Vec<Triangle>,
+    x0: f32,
+    x1: f32,
+    rings: usize,
+    ring_size: usize,
+) {
+    let base = points.len() as u32;
+    for r in 0..rings {
+        let x = x0 + (x1 - x0) * r as f32 / (rings - 1) as f32;
+        for s in 0..ring_size {
+            let a = std::f32::consts::TAU * s as f32 / ring_size as f32;
+            // A slight bulge keeps the surface from being a ruled one.
+            let radius = 1.0 + 0.2 * (x * 1.3).sin();
+            points.push([x, radius * a.cos(), radius * a.sin()]);
+        }
+    }
+    let n = ring_size as u32;
+    for r in 0..rings as u32 - 1 {
+        for s in 0..n {
+            let (a, b) = (base + r * n + s, base + r * n + (s + 1) % n);
+            let (c, d) = (a + n, b + n);
+            tris.push([a, b, d]);
+            tris.push([a, d, c]);
+        }
+    }
+}
+
+/// An animation of `frames` frames over `tris`: vertex `i` of a frame at time `t` ∈ [0, 1] (frame 0
+/// at 0, the last at 1) is `motion(t, i, p)`, `p` being its place in `points`.
+pub fn animate(
+    points: &[Point],
+    tris: Vec<Triangle>,
+    frames: usize,
+    motion: impl Fn(f32, usize, Point) -> Point,
+) -> AnimatedMesh {
+    let frames = (0..frames)
+        .map(|f| {
+            let t = f as f32 / (frames - 1) as f32;
+            points
+                .iter()
+                .enumerate()
+                .map(|(i, &p)| motion(t, i, p))
+                .collect()
+        })
+        .collect();
+    AnimatedMesh::new(tris, frames).expect("valid animation")
+}
+
+/// Fraction of vertex pairs on which two labelings agree (same/different): the Rand index.
+pub fn rand_index(a: &[u32], b: &[usize]) -> f64 {
+    let (mut agree, mut total) = (0u64, 0u64);
+    for i in 0..a.len() {
+        for j in i + 1..a.len() {
+            agree += u64::from((a[i] == a[j]) == (b[i] == b[j]));
+            total += 1;
+        }
+    }
+    agree as f64 / total as f64
+}

@@ -1,0 +1,241 @@
+//! Forged streams whose counts fit the header's limits but not the bytes that should carry them:
+//! refused with a clear error before anything is allocated per claimed element. A counting
+//! allocator measures the peak memory of each refusal on its own thread.
+
+mod common;
+
+use common::{parts, rebuild, tiny_stream};
+use mcgv_video::stream::container::{ContainerReader, Tag};
+use mcgv_video::stream::entropy::max_symbols;
+use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
+use mcgv_video::stream::header::{CodecKind, Header};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::io::Cursor;
+
+/// The system allocator, counting the bytes live on each thread and their peak.
+struct Counting;
+
+thread_local! {
+    static LIVE: Cell<usize> = const { Cell::new(0) };
+    static PEAK: Cell<usize> = const { Cell::new(0) };
+}
+
+fn grow(bytes: usize) {
+    // `try_with`: the allocator also runs while thread-locals are torn down.
+    let _ = LIVE.try_with(|live| {
+        let now = live.get() + bytes;
+        live.set(now);
+        let _ = PEAK.try_with(|peak| peak.set(peak.get().max(now)));
+    });
+}
+
+fn shrink(bytes: usize) {
+    let _ = LIVE.try_with(|live| live.set(live.get().saturating_sub(bytes)));
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        grow(layout.size());
+        // SAFETY: the caller's contract is passed on unchanged.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        grow(layout.size());
+        // SAFETY: as above.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        shrink(layout.size());
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        shrink(layout.size());
+        grow(new_size);
+        // SAFETY: as above.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Runs `f`, returning what it returns and the most memory it had allocated at once (bytes).
+fn peak_of<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    let base = LIVE.with(Cell::get);
+    PEAK.with(|p| p.set(base));
+    let out = f();
+    (out, PEAK.with(Cell::get) - base)
+}
+
+/// What a refusal may allocate: the input's copies and small tables, never per claimed element.
+const SMALL: usize = 1 << 20;
+
+/// Byte offsets in the first frame's header: counts, then the three stream lengths, then the CRC.
+const VERTEX_COUNT: usize = 4;
+const TRAVERSED: usize = 8;
+const CONNECTIVITY_LEN: usize = 40;
+const GEOMETRY_LEN: usize = 44;
+const FIRST_FRAME_HEADER_LEN: usize = 56;
+
+fn word(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(bytes[at..at + 4].try_into().expect("four bytes"))
+}
+
+fn set_word(bytes: &mut [u8], at: usize, value: u32) {
+    bytes[at..at + 4].copy_from_slice(&value.to_le_bytes());
+}
+
+/// A real first frame (a 3×3 grid of squares, two triangles each) with `extra` zero bytes added to
+/// its connectivity or geometry stream, then `forge` applied to its header and the checksum made
+/// right, so that only the count checks stand in the way. Zero bytes are what decode cheapest:
+/// each symbol from them costs the coder's floor.
+fn forged_first_frame(
+    reorder: bool,
+    pad_at: usize,
+    extra: usize,
+    forge: impl Fn(&mut [u8]),
+) -> Vec<u8> {
+    let mut positions = Vec::new();
+    for y in 0..4 {
+        for x in 0..4 {
+            positions.push([x as f32, y as f32, (x * y) as f32 * 0.1]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for y in 0..3u32 {
+        for x in 0..3u32 {
+            let v = 4 * y + x;
+            triangles.push([v, v + 1, v + 5]);
+            triangles.push([v, v + 5, v + 4]);
+        }
+    }
+    let opts = FirstFrameOptions { bits: 12, reorder };
+    let mut bytes = first_frame::encode(&positions, &triangles, &opts)
+        .expect("encodes")
+        .bytes;
+    // Streams follow the header in the order connectivity, geometry, order.
+    let lc = word(&bytes, CONNECTIVITY_LEN) as usize;
+    let end = match pad_at {
+        CONNECTIVITY_LEN => FIRST_FRAME_HEADER_LEN + lc,
+        _ => FIRST_FRAME_HEADER_LEN + lc + word(&bytes, GEOMETRY_LEN) as usize,
+    };
+    bytes.splice(end..end, vec![0u8; extra]);
+    let grown = word(&bytes, pad_at) + extra as u32;
+    set_word(&mut bytes, pad_at, grown);
+    forge(&mut bytes);
+    let mut hasher = crc32fast::Hasher::new();
+    hasher.update(&bytes[..FIRST_FRAME_HEADER_LEN - 4]);
+    hasher.update(&bytes[FIRST_FRAME_HEADER_LEN..]);
+    let crc = hasher.finalize();
+    set_word(&mut bytes, FIRST_FRAME_HEADER_LEN - 4, crc);
+    bytes
+}
+
+/// Pads a stream of a real first frame (as [`forged_first_frame`]), sets the header's u32 at
+/// `field` to `claim(padded bytes)`, decodes, and returns the claim and the error, checking that the
+/// refusal allocated little.
+fn refused(
+    reorder: bool,
+    pad_at: usize,
+    extra: usize,
+    field: usize,
+    claim: impl Fn(&[u8]) -> u32,
+) -> (u32, String) {
+    let claim = claim(&forged_first_frame(reorder, pad_at, extra, |_| {}));
+    let bytes = forged_first_frame(reorder, pad_at, extra, |b| set_word(b, field, claim));
+    let (result, peak) = peak_of(|| first_frame::decode(&bytes));
+    let msg = match result {
+        Ok(_) => panic!("a forged first frame was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(peak < SMALL, "refusing took {peak} bytes: {msg}");
+    (claim, msg)
+}
+
+#[test]
+fn the_forgery_keeps_an_honest_first_frame_valid() {
+    for reorder in [false, true] {
+        let bytes = forged_first_frame(reorder, GEOMETRY_LEN, 4000, |_| {});
+        let (triangles, positions) = first_frame::decode(&bytes).expect("padding decodes");
+        assert_eq!((triangles.len(), positions.len()), (18, 16));
+    }
+}
+
+#[test]
+fn vertices_past_what_the_geometry_stream_holds_are_refused_before_allocating() {
+    // 4 KB of geometry hold at most max_symbols / 3 vertices (three residuals each); the whole
+    // payload, which the old check used, holds three times as many symbols as that needs.
+    let (claim, msg) = refused(true, GEOMETRY_LEN, 4000, VERTEX_COUNT, |b| {
+        (max_symbols(word(b, GEOMETRY_LEN) as usize) / 3 + 1) as u32
+    });
+    assert!(claim > 7_000_000, "a claim worth refusing: {claim}");
+    assert!(
+        msg.contains(&format!("{claim} vertices")) && msg.contains("geometry stream"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn vertices_past_what_the_order_stream_holds_are_refused() {
+    // Plenty of geometry, but the stored order takes at least four decisions a vertex.
+    let (_, msg) = refused(false, GEOMETRY_LEN, 40_000, VERTEX_COUNT, |b| {
+        let lo = b.len()
+            - FIRST_FRAME_HEADER_LEN
+            - word(b, CONNECTIVITY_LEN) as usize
+            - word(b, GEOMETRY_LEN) as usize;
+        (max_symbols(lo) / 4 + 1) as u32
+    });
+    assert!(msg.contains("order stream"), "{msg}");
+}
+
+#[test]
+fn triangles_past_what_the_connectivity_stream_holds_are_refused() {
+    let (claim, msg) = refused(true, CONNECTIVITY_LEN, 4000, TRAVERSED, |b| {
+        (max_symbols(word(b, CONNECTIVITY_LEN) as usize) / 3 + 1) as u32
+    });
+    assert!(
+        msg.contains(&format!("{claim} triangles")) && msg.contains("connectivity stream"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn frames_past_what_the_ranges_hold_are_refused_before_the_affine_track() {
+    // 4M frames of one cluster are 48M affine coefficients: 12 KB of zero bytes decode as that
+    // many (each at the coder's floor), so the affine part alone cannot refuse the claim. The
+    // residual ranges take 24 bytes a frame and are read first.
+    const FRAMES: u32 = 1 << 22;
+    let mut forged = parts(&tiny_stream(CodecKind::Jpeg));
+    for (tag, payload, _) in forged.iter_mut() {
+        if *tag == Tag::HEADER {
+            let mut header = Header::from_bytes(payload).expect("a valid header");
+            header.frames = FRAMES;
+            *payload = header.to_bytes();
+        } else if *tag == Tag::AFFINE {
+            // Bits, then twelve (lo, hi) ranges, then the coded values.
+            payload.truncate(1 + 12 * 8);
+            payload.extend(vec![0u8; 12_000]);
+            assert!(12 * u64::from(FRAMES) <= max_symbols(12_000));
+        }
+    }
+    let bytes = rebuild(forged);
+    let start = std::time::Instant::now();
+    let (result, peak) = peak_of(|| {
+        ContainerReader::new(Cursor::new(bytes)).and_then(mcgv_video::decoder::Decoder::new)
+    });
+    let msg = match result {
+        Ok(_) => panic!("a forged frame count was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        msg.contains(&format!("2 residual ranges for {FRAMES} frames")),
+        "{msg}"
+    );
+    assert!(peak < SMALL, "refusing took {peak} bytes");
+    assert!(start.elapsed().as_secs() < 5, "refusing did the work first");
+}
