@@ -232,6 +232,14 @@ impl<R: Read + Seek> Decoder<R> {
         }
     }
 
+    /// The residual range of every frame and coordinate (empty for tdct streams).
+    pub fn ranges(&self) -> &[FrameRanges] {
+        match &self.residuals {
+            Residuals::Images { ranges, .. } => ranges,
+            Residuals::Tdct(_) => &[],
+        }
+    }
+
     /// The part table, for bit budgets.
     pub fn container(&self) -> &ContainerReader<R> {
         &self.reader

@@ -43,6 +43,9 @@ pub struct EncodeOptions {
     pub predictor: PredictorKind,
     /// Bits per skinning weight, sign included (the paper's 16 by default).
     pub weight_bits: u8,
+    /// Residual ranges narrower than this fraction of the sequence's widest are widened to it, so
+    /// frames with small residuals get coarser levels instead of the full 0..255 (0 = off).
+    pub range_floor: f32,
     /// Temporal-DCT quantiser step as a fraction of the first frame's bounding-box diagonal;
     /// `None` derives it from `quality` (tdct only).
     pub step: Option<f64>,
@@ -64,6 +67,7 @@ impl Default for EncodeOptions {
             reorder: false,
             predictor: PredictorKind::Affine,
             weight_bits: motion::WEIGHT_BITS,
+            range_floor: 0.0,
             step: None,
         }
     }
@@ -417,6 +421,12 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
             "--weight-bits must be between 2 and 31".into(),
         ));
     }
+    if !(0.0..=1.0).contains(&opts.range_floor) {
+        return Err(Error::Usage(format!(
+            "--range-floor must be between 0 and 1, not {}",
+            opts.range_floor
+        )));
+    }
     if opts.gop == 0 {
         return Err(Error::Usage("--gop must be at least 1".into()));
     }
@@ -434,6 +444,11 @@ fn check_options(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<()> {
         if let Lattice::Fixed(..) = opts.lattice {
             return Err(Error::Usage(
                 "--lattice applies to the image codecs: tdct has no geometry images".into(),
+            ));
+        }
+        if opts.range_floor > 0.0 {
+            return Err(Error::Usage(
+                "--range-floor applies to the image codecs: tdct has no residual ranges".into(),
             ));
         }
         if opts.padding.is_some() {
@@ -543,7 +558,8 @@ pub fn analyse_partition(
         CodecKind::Jpeg | CodecKind::Tdct => RangeMode::PerFrame,
         CodecKind::Mpeg4 => RangeMode::PerGroup(opts.gop),
     };
-    let ranges = quantise::frame_ranges(&residuals, mode);
+    let mut ranges = quantise::frame_ranges(&residuals, mode);
+    quantise::widen(&mut ranges, opts.range_floor);
     Ok(Analysis {
         reference,
         partition,

@@ -63,6 +63,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             PredictorChoice::Skinning => PredictorKind::Skinning,
         },
         weight_bits: args.weight_bits,
+        range_floor: args.range_floor,
         step: args.step,
         ..defaults
     })

@@ -305,6 +305,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
             weight_bits: decoder
                 .weights()
                 .map_or(crate::motion::WEIGHT_BITS, |w| w.bits),
+            range_floor: 0.0,
             step: None,
         };
         let ff = first_frame::encode(
@@ -321,12 +322,14 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
         };
         // The stream's partition, not a re-run segmentation: decimation's K is not in the options,
         // and the images must be those of the clusters the stream was coded with.
-        let analysis = encoder::analyse_partition(
+        let mut analysis = encoder::analyse_partition(
             &mesh,
             ff.decoded_positions,
             decoder.partition().clone(),
             &opts,
         )?;
+        // The stream's own ranges: the encoder may have widened them (--range-floor).
+        analysis.ranges = decoder.ranges().to_vec();
         let fixed = analysis.atlas.fixed_mask();
         for &f in &frames {
             // Raw: the quantised residuals on the pixels that carry data, free pixels black.

@@ -92,6 +92,36 @@ pub fn frame_ranges(residuals: &[Vec<[f32; 3]>], mode: RangeMode) -> Vec<FrameRa
     }
 }
 
+/// Widens every range narrower than `floor` × the widest range of its coordinate over the sequence
+/// to that width, about its own midpoint (`floor` 0 leaves them all).
+///
+/// A tight range spends all 256 levels on small residuals, so the image codec's error in levels
+/// becomes a small geometric error bought with many bits, while frames with wide ranges carry the
+/// large errors. A common floor evens the step across frames, which is where a fixed rate buys the
+/// lowest mean error (reverse water-filling).
+pub fn widen(ranges: &mut [FrameRanges], floor: f32) {
+    if floor <= 0.0 {
+        return;
+    }
+    for a in 0..3 {
+        let widest = ranges
+            .iter()
+            .map(|r| r[a].max - r[a].min)
+            .fold(0.0f32, f32::max);
+        let min_width = floor.min(1.0) * widest;
+        for r in ranges.iter_mut() {
+            let width = r[a].max - r[a].min;
+            if width < min_width {
+                let mid = 0.5 * (r[a].max + r[a].min);
+                r[a] = AxisRange {
+                    min: mid - 0.5 * min_width,
+                    max: mid + 0.5 * min_width,
+                };
+            }
+        }
+    }
+}
+
 /// Serialises ranges (6 floats per frame).
 pub fn write_ranges(ranges: &[FrameRanges], w: &mut ByteWriter) {
     w.u32(ranges.len() as u32);
@@ -146,6 +176,23 @@ mod tests {
         }
         let flat = AxisRange { min: 3.0, max: 3.0 };
         assert_eq!(flat.dequantise(flat.quantise(3.0)), 3.0);
+    }
+
+    #[test]
+    fn widening_keeps_each_range_covering_its_values() {
+        let narrow = AxisRange { min: 0.9, max: 1.1 };
+        let wide = AxisRange {
+            min: -2.0,
+            max: 2.0,
+        };
+        let mut ranges = vec![[narrow; 3], [wide; 3]];
+        widen(&mut ranges, 0.0);
+        assert_eq!(ranges[0][0], narrow);
+        widen(&mut ranges, 0.5);
+        assert_eq!(ranges[1][0], wide, "the widest range is left as it is");
+        let r = ranges[0][2];
+        assert!((r.max - r.min - 2.0).abs() < 1e-6, "{r:?}");
+        assert!(r.min <= narrow.min && r.max >= narrow.max, "{r:?}");
     }
 
     #[test]
