@@ -129,6 +129,31 @@ fn band_checksums_are_repaired_so_damage_reaches_the_band_decoder() {
 }
 
 #[test]
+fn a_step_that_overflows_the_coefficients_is_refused() {
+    let opts = mcgv_video::encoder::EncodeOptions {
+        codec: CodecKind::Tdct,
+        quality: 10,
+        ..Default::default()
+    };
+    let honest = common::encode_bytes(&common::read_media("RiggedSimple.glb"), &opts);
+    let index = ContainerReader::new(Cursor::new(honest.clone()))
+        .unwrap()
+        .entry(Tag::TDCT_INDEX)
+        .unwrap()
+        .offset as usize;
+    // The step is the index's first field: 3e38 times any level beyond ±1 is beyond f32, which
+    // the full decode refused only when building the mesh, while a frame read alone came back as
+    // infinities. Now the bands are refused as they are read.
+    let mut bytes = honest;
+    bytes[index..index + 4].copy_from_slice(&3e38f32.to_le_bytes());
+    harness::fix_checksums(&mut bytes);
+    match open(bytes) {
+        Err(e) => assert!(e.to_string().contains("not a finite number"), "{e}"),
+        Ok(_) => panic!("a step of 3e38 was accepted"),
+    }
+}
+
+#[test]
 fn a_billion_vertices_or_frames_is_refused_before_allocating() {
     for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
         // Header layout: vertices, frames, triangles, clusters (u32 each), then the lattice.
