@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Seeds for the fuzz targets, made from media/ by the mcgv-video binary given as $1 into folder $2:
-#   $2/decode_stream/  small real streams of both codecs (64x64 lattice: fast to decode per execution),
-#                      and of the skinning predictor and the decimation segmentation (parts and
-#                      header fields the k-means/affine seeds never reach)
+#   $2/decode_stream/  small real streams of every codec (64x64 lattice for the image codecs: fast to
+#                      decode per execution), and of the skinning predictor and the decimation
+#                      segmentation (parts and header fields the k-means/affine seeds never reach)
 #   $2/read_mesh/      a kind byte (0 OBJ, 1 OBJ + NUL + PC2, 2 glTF) followed by a real file
 # Regenerated every run (cheap) so that they follow the current stream format.
 set -euo pipefail
@@ -19,6 +19,12 @@ small=(--lattice 64x64 --clusters 4 --fps 6 --quiet)
 	--lattice 64x64 --clusters 2 --fps 2 --quality 10 --quiet
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-skinning.mcgv" --codec jpeg \
 	--predictor skinning "${small[@]}"
+# Temporal DCT: no lattice; the band index (TDIX) and the progressive coefficients part (TDCT) are
+# parts no image codec writes, and the skinning predictor reaches them with a different prediction.
+tdct=(--codec tdct --clusters 4 --fps 6 --quality 10 --quiet)
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/tdct.mcgv" "${tdct[@]}"
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/tdct-skinning.mcgv" --predictor skinning \
+	"${tdct[@]}"
 # Decimation finds K itself, so it takes no --clusters.
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-decimation.mcgv" --codec jpeg \
 	--segmentation decimation --lattice 64x64 --fps 6 --quiet

@@ -281,9 +281,16 @@ impl<R: Read + Seek> Decoder<R> {
                     }
                 }
             }
-            for (p, s) in out.iter_mut().zip(sum.chunks_exact(3)) {
+            for (v, (p, s)) in out.iter_mut().zip(sum.chunks_exact(3)).enumerate() {
                 for a in 0..3 {
                     p[a] += s[a] as f32;
+                }
+                // decode_all refuses such a frame (a mesh holds finite coordinates only): a frame
+                // read alone must not come back as infinities instead.
+                if p.iter().any(|x| !x.is_finite()) {
+                    return Err(Error::Stream(format!(
+                        "frame {f}, vertex {v}: coordinate is not a finite number"
+                    )));
                 }
             }
             return Ok(out);
@@ -479,11 +486,22 @@ fn read_bands<R: Read + Seek>(
             )?
         };
         let levels = coder.decode(k, &bytes)?;
-        bands.push(levels.map(|l| {
+        let coefficients = levels.map(|l| -> Vec<f32> {
             l.iter()
                 .map(|&q| (q as f64 * f64::from(step)) as f32)
                 .collect()
-        }));
+        });
+        // Levels are bounded but the step is any positive f32: their product can overflow, and an
+        // infinite coefficient would turn every frame's coordinates into infinities or NaN.
+        if coefficients
+            .as_ref()
+            .is_some_and(|c| c.iter().any(|x| !x.is_finite()))
+        {
+            return Err(Error::Stream(format!(
+                "temporal-DCT band {k}: a level times the step {step:e} is not a finite number"
+            )));
+        }
+        bands.push(coefficients);
     }
     Ok(TdctBands {
         band_lengths: index.bands.iter().map(|b| b.len).collect(),

@@ -6,7 +6,7 @@ mod common;
 use common::{harness, tiny_stream};
 
 use mcgv_video::decoder::Decoder;
-use mcgv_video::stream::container::{ContainerReader, FILE_HEADER_LEN, PART_HEADER_LEN};
+use mcgv_video::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
 use mcgv_video::stream::header::CodecKind;
 use mcgv_video::Error;
 use std::io::Cursor;
@@ -96,6 +96,60 @@ fn the_forgery_helper_keeps_an_honest_stream_valid() {
             "fixing right checksums changes nothing"
         );
         assert!(harness::decode_stream(&bytes).is_ok());
+    }
+}
+
+#[test]
+fn band_checksums_are_repaired_so_damage_reaches_the_band_decoder() {
+    // The tiny square's bands are all empty (the affine predictor is exact): a real animation.
+    let opts = mcgv_video::encoder::EncodeOptions {
+        codec: CodecKind::Tdct,
+        quality: 10,
+        ..Default::default()
+    };
+    let honest = common::encode_bytes(&common::read_media("RiggedSimple.glb"), &opts);
+    let mut bytes = honest.clone();
+    harness::fix_band_index(&mut bytes);
+    harness::fix_checksums(&mut bytes);
+    assert_eq!(bytes, honest, "fixing right checksums changes nothing");
+    assert!(harness::decode_stream(&bytes).is_ok());
+    // Damage the first band: unrepaired, its CRC refuses it; repaired, the band decoder gets it.
+    let reader = ContainerReader::new(Cursor::new(honest.clone())).unwrap();
+    let tdct = reader.entry(Tag::TDCT).unwrap();
+    assert!(tdct.len > 0);
+    let mut damaged = honest;
+    damaged[tdct.offset as usize] ^= 0x5a;
+    let err = open(damaged.clone()).map(|_| ()).unwrap_err().to_string();
+    assert!(err.contains("checksum"), "{err}");
+    harness::fix_band_index(&mut damaged);
+    harness::fix_checksums(&mut damaged);
+    if let Err(e) = open(damaged) {
+        assert!(!e.to_string().contains("checksum"), "{e}");
+    }
+}
+
+#[test]
+fn a_step_that_overflows_the_coefficients_is_refused() {
+    let opts = mcgv_video::encoder::EncodeOptions {
+        codec: CodecKind::Tdct,
+        quality: 10,
+        ..Default::default()
+    };
+    let honest = common::encode_bytes(&common::read_media("RiggedSimple.glb"), &opts);
+    let index = ContainerReader::new(Cursor::new(honest.clone()))
+        .unwrap()
+        .entry(Tag::TDCT_INDEX)
+        .unwrap()
+        .offset as usize;
+    // The step is the index's first field: 3e38 times any level beyond ±1 is beyond f32, which
+    // the full decode refused only when building the mesh, while a frame read alone came back as
+    // infinities. Now the bands are refused as they are read.
+    let mut bytes = honest;
+    bytes[index..index + 4].copy_from_slice(&3e38f32.to_le_bytes());
+    harness::fix_checksums(&mut bytes);
+    match open(bytes) {
+        Err(e) => assert!(e.to_string().contains("not a finite number"), "{e}"),
+        Ok(_) => panic!("a step of 3e38 was accepted"),
     }
 }
 

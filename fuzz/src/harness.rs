@@ -6,6 +6,8 @@ use mcgv_video::decoder::Decoder;
 use mcgv_video::mesh::{parse_gltf, parse_obj, parse_pc2, AnimatedMesh, Triangle};
 use mcgv_video::stream::container::{ContainerReader, FILE_HEADER_LEN, PART_HEADER_LEN};
 use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
+use mcgv_video::stream::header::CodecKind;
+use mcgv_video::stream::tdct::BandIndex;
 use mcgv_video::Result;
 use std::io::Cursor;
 use std::path::Path;
@@ -18,19 +20,50 @@ const FIRST_FRAME_HEADER_LEN: usize = 56;
 const ROUND_TRIP_LIMIT: usize = 4096;
 
 /// Decodes `data` as a `.mcgv` stream after repairing its checksums, then every frame in order and
-/// the last one on its own (random access decodes from the previous key frame).
+/// the last one on its own (random access decodes from the previous key frame). A temporal-DCT
+/// stream is decoded a second time cut inside its coefficients part, as a file still downloading
+/// would be: that prefix must decode or be refused like any other input.
 pub fn decode_stream(data: &[u8]) -> Result<()> {
     let mut bytes = data.to_vec();
+    fix_band_index(&mut bytes);
     fix_checksums(&mut bytes);
-    let mut decoder = Decoder::new(ContainerReader::new(Cursor::new(bytes))?)?;
+    if let Some((start, end)) = part_span(&bytes, b"TDCT").filter(|&(s, e)| e > s) {
+        // Where to cut follows the input, so that the corpus covers cuts at band boundaries and
+        // inside bands alike; each input always cuts at the same place, so crashes replay.
+        let cut = start + crc32fast::hash(data) as usize % (end - start);
+        let _ = decode_and_check(&bytes[..cut]);
+    }
+    decode_and_check(&bytes)
+}
+
+fn decode_and_check(bytes: &[u8]) -> Result<()> {
+    let mut decoder = Decoder::new(ContainerReader::new(Cursor::new(bytes.to_vec()))?)?;
     let mesh = decoder.decode_all(&mcgv_video::progress::bar(0, "", true))?;
     let last = mesh.frame_count() - 1;
     let alone = decoder.decode_frame(last)?;
-    // Decoding is deterministic: the frame read alone is the one read in sequence.
-    assert!(
-        same_bits(&alone, mesh.frame(last)),
-        "frame {last} decodes differently alone and in sequence"
-    );
+    if decoder.header().codec == CodecKind::Tdct {
+        // The frame alone sums the bands' basis functions directly, the whole sequence goes
+        // through the fast inverse DCT: equal up to rounding, of the order of the coordinates'.
+        let scale = mesh
+            .frames()
+            .iter()
+            .flatten()
+            .chain(decoder.reference())
+            .flatten()
+            .filter(|x| x.is_finite())
+            .fold(1.0f32, |m, x| m.max(x.abs()));
+        assert!(
+            close(&alone, mesh.frame(last), 1e-6 * scale),
+            "frame {last} decodes differently alone and in sequence"
+        );
+    } else {
+        // Image codecs decode the same pictures either way: the frame read alone is the one read
+        // in sequence, bit for bit.
+        assert!(
+            same_bits(&alone, mesh.frame(last)),
+            "frame {last} decodes differently alone and in sequence"
+        );
+    }
     Ok(())
 }
 
@@ -83,6 +116,17 @@ pub fn canonical(triangles: &[Triangle]) -> Vec<Triangle> {
         .collect();
     out.sort_unstable();
     out
+}
+
+/// Equal within `tol`; non-finite coordinates must be the same non-finite value in both.
+fn close(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(p, q)| {
+            (0..3).all(|k| {
+                let (x, y) = (p[k], q[k]);
+                x == y || (x.is_nan() && y.is_nan()) || (x - y).abs() <= tol
+            })
+        })
 }
 
 fn same_bits(a: &[[f32; 3]], b: &[[f32; 3]]) -> bool {
@@ -182,4 +226,75 @@ fn refresh_part_crc(bytes: &mut [u8], tag: &[u8; 4]) {
         }
         pos = end;
     }
+}
+
+/// Payload span of the (first) part tagged `tag`. The last part may be cut short by the end of the
+/// file (a progressive part does that legitimately): its span then ends with the file.
+fn part_span(bytes: &[u8], tag: &[u8; 4]) -> Option<(usize, usize)> {
+    part_layout(bytes, tag).map(|(_, start, _, end)| (start, end))
+}
+
+/// Header offset, payload start, declared payload length and payload end (clipped to the file) of
+/// the first part tagged `tag`, walking the part table as far as it makes sense.
+fn part_layout(bytes: &[u8], tag: &[u8; 4]) -> Option<(usize, usize, u64, usize)> {
+    let mut pos = FILE_HEADER_LEN;
+    loop {
+        let head = bytes.get(pos..pos + PART_HEADER_LEN)?;
+        let len = u64::from_le_bytes(head[5..13].try_into().ok()?);
+        let start = pos + PART_HEADER_LEN;
+        let end = usize::try_from(len)
+            .ok()
+            .and_then(|l| l.checked_add(start))
+            .map_or(bytes.len(), |e| e.min(bytes.len()));
+        if &head[..4] == tag {
+            return Some((pos, start, len, end));
+        }
+        if end == bytes.len() {
+            return None;
+        }
+        pos = end;
+    }
+}
+
+/// Rewrites the per-band CRCs of a temporal-DCT index (TDIX) to match the bands in the
+/// coefficients part (TDCT), re-coding the index; its part CRC is left to [`fix_checksums`]. An
+/// index that no longer parses is left as it is: refusing it is the decoder's job.
+pub fn fix_band_index(bytes: &mut Vec<u8>) {
+    let Some((_, c_start, c_declared, c_end)) = part_layout(bytes, b"TDCT") else {
+        return;
+    };
+    let Some((i_pos, i_start, _, i_end)) = part_layout(bytes, b"TDIX") else {
+        return;
+    };
+    // The index states its own band count; the decoder checks it against the header's frames.
+    let Some(count) = bytes
+        .get(i_start + 4..i_start + 8)
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes)
+    else {
+        return;
+    };
+    let Ok(mut index) = BandIndex::from_bytes(&bytes[i_start..i_end], count as usize, c_declared)
+    else {
+        return;
+    };
+    for band in &mut index.bands {
+        // Bands past the end of a cut file keep their CRC: the decoder stops before them.
+        let range = usize::try_from(band.offset)
+            .ok()
+            .zip(usize::try_from(band.len).ok())
+            .and_then(|(o, l)| Some((c_start.checked_add(o)?, l)))
+            .and_then(|(s, l)| Some((s, s.checked_add(l)?)))
+            .filter(|&(_, e)| e <= c_end);
+        if let (Some((s, e)), true) = (range, band.len > 0) {
+            band.crc = crc32fast::hash(&bytes[s..e]);
+        }
+    }
+    let Ok(coded) = index.to_bytes() else {
+        return;
+    };
+    // Re-coding may change the index's length (a mutated index that still parses need not be the
+    // encoder's own coding of it): splice it in and fix the part's declared length.
+    bytes.splice(i_start..i_end, coded.iter().copied());
+    bytes[i_pos + 5..i_pos + 13].copy_from_slice(&(coded.len() as u64).to_le_bytes());
 }
