@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `make demo`: encode a sample animation from media/ with both codecs, decode it, and print size,
+# `make demo`: encode a sample animation from media/ with the three codecs (JPEG, MPEG-4, temporal DCT), decode it, and print size,
 # bpvf, RMSE and time for each.
 set -euo pipefail
 bin=${MCGV_BIN:-target/release/mcgv-video}
@@ -11,7 +11,7 @@ echo "== the input"
 "$bin" info "$sample"
 echo
 printf '%-7s %-14s %10s %8s %12s %12s %8s %8s\n' codec setting bytes bpvf "RMSE(1e-4)" "Hausdorff" "enc s" "dec s"
-for codec in jpeg mpeg4; do
+for codec in jpeg mpeg4 tdct; do
     stream="$out/sample-$codec.mcgv"
     t0=$(date +%s.%N)
     "$bin" encode "$sample" -o "$stream" --codec "$codec" --quiet
@@ -21,7 +21,7 @@ for codec in jpeg mpeg4; do
     json=$("$bin" eval "$sample" "$stream" --json --quiet)
     setting=$("$bin" inspect "$stream" --json | sed -E 's/.*"codec":"([a-z0-9]+)".*"qscale":([0-9]+).*"quality":([0-9]+).*/\1 \3 \2/')
     read -r _ quality qscale <<<"$setting"
-    case $codec in jpeg) setting="quality $quality" ;; *) setting="qscale $qscale" ;; esac
+    case $codec in mpeg4) setting="qscale $qscale" ;; *) setting="quality $quality" ;; esac
     field() { sed -E "s/.*\"$1\":([0-9.eE+-]+).*/\1/" <<<"$json"; }
     awk -v c="$codec" -v s="$setting" -v b="$(stat -c %s "$stream")" -v bpvf="$(field bpvf)" \
         -v r="$(field rmse)" -v h="$(field hausdorff)" -v t0="$t0" -v t1="$t1" -v t2="$t2" \
