@@ -228,6 +228,12 @@ impl AffineTrack {
                 self.quantised.frames
             )));
         }
+        self.check_fits(reference, partition)?;
+        Ok(self.predict(frame, reference, partition))
+    }
+
+    /// Fails unless `partition` has this track's clusters and `reference`'s vertices.
+    pub fn check_fits(&self, reference: &[Point], partition: &Partition) -> Result<()> {
         if partition.clusters() != self.quantised.clusters
             || partition.vertex_count() != reference.len()
         {
@@ -240,7 +246,7 @@ impl AffineTrack {
                 self.quantised.clusters
             )));
         }
-        Ok(self.predict(frame, reference, partition))
+        Ok(())
     }
 
     /// Predicts frame `frame` (eq. 3) like [`AffineTrack::try_predict`], for callers that have

@@ -196,7 +196,7 @@ impl SkinningWeights {
                 "skinning ridge {ridge} is not a non-negative number"
             )));
         }
-        check_sizes(track, reference, partition)?;
+        track.check_fits(reference, partition)?;
         if frames.len() != track.frame_count() {
             return Err(Error::Usage(format!(
                 "{} frames for a {}-frame affine track",
@@ -258,7 +258,7 @@ impl SkinningWeights {
         reference: &[Point],
         partition: &Partition,
     ) -> Result<Vec<Point>> {
-        check_sizes(track, reference, partition)?;
+        track.check_fits(reference, partition)?;
         if frame >= track.frame_count() {
             return Err(Error::Usage(format!(
                 "frame {frame} asked of a {}-frame prediction",
@@ -323,21 +323,6 @@ pub fn predict_frame(
         Some(w) => w.try_predict(frame, track, reference, partition),
         None => track.try_predict(frame, reference, partition),
     }
-}
-
-fn check_sizes(track: &AffineTrack, reference: &[Point], partition: &Partition) -> Result<()> {
-    if partition.clusters() != track.cluster_count() || partition.vertex_count() != reference.len()
-    {
-        return Err(Error::Usage(format!(
-            "partition ({} vertices, {} clusters) does not match the reference ({} vertices) \
-             and the affine track ({} clusters)",
-            partition.vertex_count(),
-            partition.clusters(),
-            reference.len(),
-            track.cluster_count()
-        )));
-    }
-    Ok(())
 }
 
 /// What every vertex's weight fit shares.
