@@ -23,6 +23,22 @@ fn leftovers(dir: &Path) -> Vec<String> {
 }
 
 /// Two OBJ frames of a square in `dir`.
+/// Encodes the OBJ frames in `frames` (as [`obj_frames`] writes them) to `out`; must succeed.
+fn encode_frames(frames: &Path, out: &Path) {
+    let enc = run(&[
+        "encode",
+        frames.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--lattice",
+        "16x16",
+        "--clusters",
+        "1",
+        "--quiet",
+    ]);
+    assert!(enc.status.success(), "{enc:?}");
+}
+
 fn obj_frames(dir: &Path) {
     std::fs::create_dir_all(dir).unwrap();
     for f in 0..2 {
@@ -55,24 +71,11 @@ fn no_input_file_can_be_the_output() {
     assert_eq!(std::fs::read(&frame1).unwrap(), before);
     // The base OBJ of a PC2 cache.
     let pc2 = d.path().join("anim.pc2");
+    let stream = d.path().join("s.mcgv");
+    encode_frames(Path::new(dir), &stream);
     let ok = run(&[
         "decode",
-        &{
-            let s = d.path().join("s.mcgv");
-            let out = run(&[
-                "encode",
-                dir,
-                "-o",
-                s.to_str().unwrap(),
-                "--lattice",
-                "16x16",
-                "--clusters",
-                "1",
-                "--quiet",
-            ]);
-            assert!(out.status.success(), "{out:?}");
-            s.to_str().unwrap().to_string()
-        },
+        stream.to_str().unwrap(),
         "-o",
         pc2.to_str().unwrap(),
         "--quiet",
@@ -128,18 +131,7 @@ fn outputs_get_ordinary_file_permissions() {
     let frames = d.path().join("frames");
     obj_frames(&frames);
     let s = d.path().join("s.mcgv");
-    let out = run(&[
-        "encode",
-        frames.to_str().unwrap(),
-        "-o",
-        s.to_str().unwrap(),
-        "--lattice",
-        "16x16",
-        "--clusters",
-        "1",
-        "--quiet",
-    ]);
-    assert!(out.status.success(), "{out:?}");
+    encode_frames(&frames, &s);
     // A file written directly in the same folder gets the mode the umask allows.
     let plain = d.path().join("plain");
     std::fs::write(&plain, b"x").unwrap();
