@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Checksums of encoded streams, to prove that a refactor changes no output: run it before and after
+# and compare (`diff`). Encodes media/CesiumMan.glb and media/Fox.glb with every codec, with the
+# default encoder and with the skinning predictor + decimation segmentation.
+#   scripts/checksums.sh [BIN] [WORKDIR]   (BIN defaults to target/release/mcgv-video)
+set -euo pipefail
+bin=${1:-target/release/mcgv-video}
+work=${2:-$(mktemp -d)}
+mkdir -p "$work"
+for sample in media/CesiumMan.glb media/Fox.glb; do
+    name=$(basename "$sample" .glb)
+    for codec in jpeg mpeg4 tdct; do
+        for variant in default skinning+decimation; do
+            extra=()
+            [ "$variant" = default ] || extra=(--predictor skinning --segmentation decimation)
+            out="$work/$name-$codec-$variant.mcgv"
+            "$bin" encode "$sample" -o "$out" --codec "$codec" --quiet "${extra[@]}"
+            printf '%s  %s\n' "$(sha256sum <"$out" | cut -d' ' -f1)" "$name-$codec-$variant"
+        done
+    done
+done
