@@ -1,4 +1,5 @@
-//! The crate-wide error type: every failure a user can cause ends here, with a message naming the culprit.
+//! The library's error type: every failure a caller can cause ends here, with a message naming the
+//! culprit and, where another crate failed, that crate's error as the [`source`](std::error::Error::source).
 
 use std::path::PathBuf;
 
@@ -22,9 +23,26 @@ pub enum Error {
     /// An image or video codec failed.
     #[error("codec: {0}")]
     Codec(String),
-    /// The user asked for something that cannot be done.
+    /// An option (a field of [`EncodeOptions`](crate::EncodeOptions),
+    /// [`DecodeOptions`](crate::DecodeOptions) or [`ReadOptions`](crate::ReadOptions)) is out of
+    /// range or does not apply; `option` is the field's name, which a command line renders as its flag.
+    #[error("{option}: {message}")]
+    InvalidOption {
+        /// The option's field name, e.g. `clusters`.
+        option: &'static str,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The caller asked for something the input cannot give (a frame past the end, images of a
+    /// stream that has none).
     #[error("{0}")]
     Usage(String),
+    /// The atlas could not be built.
+    #[error("atlas: {0}")]
+    Atlas(#[from] atlas::AtlasError),
+    /// Padding the free pixels of a geometry image failed.
+    #[error("padding: {0}")]
+    Padding(#[from] padding::PaddingError),
 }
 
 impl Error {
@@ -33,6 +51,14 @@ impl Error {
         Error::Io {
             path: path.into(),
             source,
+        }
+    }
+
+    /// An invalid option, by its field name.
+    pub fn option(option: &'static str, message: impl Into<String>) -> Self {
+        Error::InvalidOption {
+            option,
+            message: message.into(),
         }
     }
 }

@@ -1,29 +1,16 @@
-//! Progress bars on stderr that honour `--quiet` (and stay silent when stderr is not a terminal).
+//! Progress of long work, reported to whoever shows it: the command line draws bars, a program
+//! embedding the library may log or ignore it.
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-
-/// A bar of `len` steps labelled `what`, hidden when `quiet`.
-pub fn bar(len: u64, what: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template(
-        "{prefix:>8} [{bar:30}] {pos}/{len} frames {msg} ({elapsed}, eta {eta})",
-    ) {
-        pb.set_style(style.progress_chars("=> "));
-    }
-    pb.set_prefix(what.to_string());
-    pb
+/// Receives progress reports; every method does nothing unless overridden.
+pub trait Progress: Sync {
+    /// A new stage starts (e.g. `segmentation`, `images`).
+    fn stage(&self, _name: &str) {}
+    /// `count` more frames are done.
+    fn frames(&self, _count: u64) {}
 }
 
-/// A spinner for work of unknown length, hidden when `quiet`.
-pub fn spinner(what: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new_spinner();
-    pb.set_message(what.to_string());
-    pb.enable_steady_tick(std::time::Duration::from_millis(120));
-    pb
-}
+/// Reports nothing.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Silent;
+
+impl Progress for Silent {}

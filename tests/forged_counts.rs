@@ -8,7 +8,7 @@ use common::{parts, rebuild, tiny_stream};
 use mcgv_video::stream::container::{ContainerReader, Tag};
 use mcgv_video::stream::entropy::max_symbols;
 use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
-use mcgv_video::stream::header::{CodecKind, Header};
+use mcgv_video::{codec::Codec, stream::header::Header};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::io::Cursor;
@@ -210,7 +210,7 @@ fn frames_past_what_the_ranges_hold_are_refused_before_the_affine_track() {
     // many (each at the coder's floor), so the affine part alone cannot refuse the claim. The
     // residual ranges take 24 bytes a frame and are read first.
     const FRAMES: u32 = 1 << 22;
-    let mut forged = parts(&tiny_stream(CodecKind::Jpeg));
+    let mut forged = parts(&tiny_stream(Codec::Jpeg));
     for (tag, payload, _) in forged.iter_mut() {
         if *tag == Tag::HEADER {
             let mut header = Header::from_bytes(payload).expect("a valid header");

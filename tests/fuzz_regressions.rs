@@ -5,9 +5,9 @@ mod common;
 
 use common::{harness, tiny_stream};
 
+use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
-use mcgv_video::stream::header::CodecKind;
 use mcgv_video::Error;
 use std::io::Cursor;
 use std::path::PathBuf;
@@ -65,7 +65,7 @@ const HEAD: usize = FILE_HEADER_LEN + PART_HEADER_LEN;
 
 /// The stream with one header field (`u32` at `offset` in the header payload) replaced, every
 /// checksum made right again so that only the size checks can refuse it.
-fn forged(codec: CodecKind, offset: usize, value: u32) -> Vec<u8> {
+fn forged(codec: Codec, offset: usize, value: u32) -> Vec<u8> {
     let mut bytes = tiny_stream(codec);
     assert_eq!(&bytes[FILE_HEADER_LEN..FILE_HEADER_LEN + 4], b"HEAD");
     bytes[HEAD + offset..HEAD + offset + 4].copy_from_slice(&value.to_le_bytes());
@@ -87,7 +87,7 @@ fn stream_error(bytes: Vec<u8>) -> String {
 
 #[test]
 fn the_forgery_helper_keeps_an_honest_stream_valid() {
-    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4] {
         let mut bytes = tiny_stream(codec);
         harness::fix_checksums(&mut bytes);
         assert_eq!(
@@ -103,7 +103,7 @@ fn the_forgery_helper_keeps_an_honest_stream_valid() {
 fn band_checksums_are_repaired_so_damage_reaches_the_band_decoder() {
     // The tiny square's bands are all empty (the affine predictor is exact): a real animation.
     let opts = mcgv_video::encoder::EncodeOptions {
-        codec: CodecKind::Tdct,
+        codec: Codec::Tdct,
         quality: 10,
         ..Default::default()
     };
@@ -131,7 +131,7 @@ fn band_checksums_are_repaired_so_damage_reaches_the_band_decoder() {
 #[test]
 fn a_step_that_overflows_the_coefficients_is_refused() {
     let opts = mcgv_video::encoder::EncodeOptions {
-        codec: CodecKind::Tdct,
+        codec: Codec::Tdct,
         quality: 10,
         ..Default::default()
     };
@@ -155,7 +155,7 @@ fn a_step_that_overflows_the_coefficients_is_refused() {
 
 #[test]
 fn a_billion_vertices_or_frames_is_refused_before_allocating() {
-    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4] {
         // Header layout: vertices, frames, triangles, clusters (u32 each), then the lattice.
         for (offset, what) in [
             (0, "vertices"),
@@ -176,7 +176,7 @@ fn a_billion_vertices_or_frames_is_refused_before_allocating() {
 fn counts_under_the_header_limit_are_checked_against_the_bytes() {
     // 2^27 passes the header's own limit; the parts' real sizes must refuse it, quickly.
     let start = std::time::Instant::now();
-    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4] {
         for offset in [4, 8] {
             let msg = stream_error(forged(codec, offset, 1 << 27));
             assert!(!msg.is_empty());
@@ -193,7 +193,7 @@ fn counts_under_the_header_limit_are_checked_against_the_bytes() {
 
 #[test]
 fn a_huge_lattice_is_refused() {
-    let mut bytes = tiny_stream(CodecKind::Jpeg);
+    let mut bytes = tiny_stream(Codec::Jpeg);
     // Lattice width and height are u16 at offset 16 and 18 of the header.
     bytes[HEAD + 16..HEAD + 20].copy_from_slice(&[0xF0, 0xFF, 0xF0, 0xFF]);
     harness::fix_checksums(&mut bytes);

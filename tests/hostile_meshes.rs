@@ -8,12 +8,12 @@
 mod common;
 
 use common::canonical;
+use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
 use mcgv_video::mesh::{AnimatedMesh, Point, Triangle};
 use mcgv_video::stream::container::ContainerReader;
 use mcgv_video::stream::entropy::{self, BitModel, IntModel, SymbolCoder, SymbolModel, UIntModel};
-use mcgv_video::stream::header::CodecKind;
 use proptest::prelude::*;
 use std::io::Cursor;
 
@@ -109,7 +109,7 @@ fn odd_mesh(grids: &[(usize, usize)], odd: &Oddities, frames: usize, seed: u64) 
 }
 
 /// Small-lattice settings that keep one encode well under a second in a debug build.
-fn small(codec: CodecKind) -> EncodeOptions {
+fn small(codec: Codec) -> EncodeOptions {
     EncodeOptions {
         codec,
         quality: 90,
@@ -171,7 +171,7 @@ proptest! {
     ) {
         let odd = Oddities { fin, degenerate, duplicates, isolated };
         let mesh = odd_mesh(&grids, &odd, frames, seed);
-        let codec = if mpeg4 { CodecKind::Mpeg4 } else { CodecKind::Jpeg };
+        let codec = if mpeg4 { Codec::Mpeg4 } else { Codec::Jpeg };
         round_trip(&mesh, &small(codec), 0.05);
     }
 }
@@ -183,7 +183,7 @@ fn a_single_triangle_of_one_frame_round_trips_with_both_codecs() {
         vec![vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]],
     )
     .unwrap();
-    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4] {
         let opts = EncodeOptions {
             clusters: 1,
             ..small(codec)
@@ -205,7 +205,7 @@ fn a_thousand_frames_of_three_vertices_round_trip() {
         })
         .collect();
     let mesh = AnimatedMesh::new(vec![[0, 1, 2]], frames).unwrap();
-    for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4] {
         let opts = EncodeOptions {
             clusters: 1,
             lattice: Lattice::Fixed(16, 16),

@@ -1,12 +1,12 @@
 //! `--range-floor`: widened residual ranges are what the stream carries, cost fewer bits, and
 //! decode within the error the wider step allows.
 
+use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::metrics::compare;
 use mcgv_video::stream::container::ContainerReader;
-use mcgv_video::stream::header::CodecKind;
 use std::io::Cursor;
 
 #[test]
@@ -17,7 +17,7 @@ fn a_range_floor_widens_the_streams_ranges_and_saves_bits() -> mcgv_video::Resul
     let mut results = Vec::new();
     for floor in [0.0f32, 1.0] {
         let opts = EncodeOptions {
-            codec: CodecKind::Jpeg,
+            codec: Codec::Jpeg,
             quality: 50,
             padding: Some(padding::Method::Cg),
             range_floor: floor,

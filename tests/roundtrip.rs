@@ -4,15 +4,15 @@
 mod common;
 
 use common::{canonical, decode_all, decoder, encode_bytes, read_media};
+use mcgv_video::codec::Codec;
 use mcgv_video::encoder::EncodeOptions;
 use mcgv_video::metrics::compare;
 use mcgv_video::stream::container::{ContainerReader, Tag};
-use mcgv_video::stream::header::CodecKind;
 use std::io::Cursor;
 
 /// Test settings: CG padding (the paper's) keeps these debug-build tests fast; the default padding
 /// is exercised by the random-access test and the CLI tests.
-fn opts(codec: CodecKind, quality: u8) -> EncodeOptions {
+fn opts(codec: Codec, quality: u8) -> EncodeOptions {
     EncodeOptions {
         codec,
         quality,
@@ -31,7 +31,7 @@ fn jpeg_round_trip_keeps_connectivity_and_bounds_error() {
     let mut last_rmse = f64::INFINITY;
     let mut last_size = 0;
     for (quality, bound) in [(30u8, 5e-5), (90, 1.8e-5)] {
-        let bytes = encode_bytes(&mesh, &opts(CodecKind::Jpeg, quality));
+        let bytes = encode_bytes(&mesh, &opts(Codec::Jpeg, quality));
         let size = bytes.len();
         let decoded = decode_all(bytes).unwrap();
         assert_eq!(decoded.vertex_count(), mesh.vertex_count());
@@ -59,7 +59,7 @@ fn mpeg4_round_trip_keeps_connectivity_and_bounds_error() {
         &mesh,
         &EncodeOptions {
             qscale: Some(4),
-            ..opts(CodecKind::Mpeg4, 75)
+            ..opts(Codec::Mpeg4, 75)
         },
     );
     let decoded = decode_all(bytes.clone()).unwrap();
@@ -80,7 +80,7 @@ fn jpeg_frame_decodes_alone_when_every_other_frame_is_destroyed() {
         &mesh,
         &EncodeOptions {
             padding: None,
-            ..opts(CodecKind::Jpeg, 75)
+            ..opts(Codec::Jpeg, 75)
         },
     );
     let n = 7;
@@ -115,7 +115,7 @@ fn jpeg_frame_decodes_alone_when_every_other_frame_is_destroyed() {
 #[test]
 fn truncated_and_bit_flipped_streams_are_errors_not_panics() {
     let mesh = read_media("RiggedSimple.glb");
-    let bytes = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50));
+    let bytes = encode_bytes(&mesh, &opts(Codec::Jpeg, 50));
     let want = decode_all(bytes.clone()).unwrap();
     // Every cut length in the part headers and a spread of cuts through the payloads.
     let step = (bytes.len() / 300).max(1);

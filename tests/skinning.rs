@@ -7,15 +7,15 @@ use common::{
     canonical, decode_all, decoder, encode_bytes, json, media_path, ok, parts, read_media, rebuild,
     run,
 };
+use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{analyse, EncodeOptions};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{self, PredictorKind};
 use mcgv_video::stream::container::{Checksum, ContainerReader, Tag};
-use mcgv_video::stream::header::CodecKind;
 use std::io::Cursor;
 
 /// As in `tests/roundtrip.rs`: CG padding keeps the debug-build tests fast.
-fn opts(codec: CodecKind, quality: u8, predictor: PredictorKind) -> EncodeOptions {
+fn opts(codec: Codec, quality: u8, predictor: PredictorKind) -> EncodeOptions {
     EncodeOptions {
         codec,
         quality,
@@ -29,7 +29,7 @@ fn opts(codec: CodecKind, quality: u8, predictor: PredictorKind) -> EncodeOption
 #[test]
 fn jpeg_skinning_round_trip_keeps_connectivity_and_bounds_error() {
     let mesh = read_media("RiggedSimple.glb");
-    let bytes = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50, PredictorKind::Skinning));
+    let bytes = encode_bytes(&mesh, &opts(Codec::Jpeg, 50, PredictorKind::Skinning));
     let dec = decoder(bytes.clone()).unwrap();
     assert_eq!(dec.header().predictor, PredictorKind::Skinning);
     let weights = dec.weights().expect("a skinning stream carries weights");
@@ -57,7 +57,7 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
         &mesh,
         &EncodeOptions {
             qscale: Some(4),
-            ..opts(CodecKind::Mpeg4, 75, PredictorKind::Skinning)
+            ..opts(Codec::Mpeg4, 75, PredictorKind::Skinning)
         },
     );
     let decoded = decode_all(bytes.clone()).unwrap();
@@ -73,8 +73,8 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
 #[test]
 fn damaged_or_inconsistent_weights_are_errors() {
     let mesh = read_media("RiggedSimple.glb");
-    let skin = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50, PredictorKind::Skinning));
-    let affine = encode_bytes(&mesh, &opts(CodecKind::Jpeg, 50, PredictorKind::Affine));
+    let skin = encode_bytes(&mesh, &opts(Codec::Jpeg, 50, PredictorKind::Skinning));
+    let affine = encode_bytes(&mesh, &opts(Codec::Jpeg, 50, PredictorKind::Affine));
     let skin_parts = parts(&skin);
     let weights = skin_parts
         .iter()
@@ -139,12 +139,7 @@ fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
     let mesh = read_media("RiggedFigure.glb");
     let reference = mesh.frame(0).to_vec();
     let energy = |predictor| {
-        let a = analyse(
-            &mesh,
-            reference.clone(),
-            &opts(CodecKind::Jpeg, 50, predictor),
-        )
-        .unwrap();
+        let a = analyse(&mesh, reference.clone(), &opts(Codec::Jpeg, 50, predictor)).unwrap();
         assert_eq!(a.weights.is_some(), predictor == PredictorKind::Skinning);
         a.residuals.iter().map(|r| motion::energy(r)).sum::<f64>()
     };

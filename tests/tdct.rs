@@ -11,13 +11,13 @@ use mcgv_video::mesh::{AnimatedMesh, Triangle};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::PredictorKind;
 use mcgv_video::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
-use mcgv_video::stream::header::{CodecKind, Header};
+use mcgv_video::{codec::Codec, stream::header::Header};
 use std::collections::BTreeSet;
 use std::io::Cursor;
 
 fn tdct(quality: u8) -> EncodeOptions {
     EncodeOptions {
-        codec: CodecKind::Tdct,
+        codec: Codec::Tdct,
         quality,
         ..EncodeOptions::default()
     }
@@ -88,7 +88,7 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
     let mut dec = decoder(bytes, None).unwrap();
     let h = dec.header().clone();
     assert_eq!((h.lattice_width, h.lattice_height, h.charts), (0, 0, 0));
-    assert_eq!((h.codec, h.padding.as_str()), (CodecKind::Tdct, "none"));
+    assert_eq!((h.codec, h.padding.as_str()), (Codec::Tdct, "none"));
     assert_eq!(dec.bands_total(), mesh.frame_count());
     assert_eq!(dec.bands_decoded(), mesh.frame_count());
     assert!(!dec.truncated());

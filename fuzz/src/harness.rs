@@ -1,12 +1,12 @@
 //! The fuzz targets' bodies. Uses only `mcgv_video` and `crc32fast`, so the regression test
 //! (`tests/fuzz_regressions.rs`) includes this file by path and replays crashers through the same code.
 
+use mcgv_video::codec::Codec;
 use mcgv_video::commands::info::Info;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::mesh::{parse_gltf, parse_obj, parse_pc2, AnimatedMesh, Triangle};
 use mcgv_video::stream::container::{ContainerReader, FILE_HEADER_LEN, PART_HEADER_LEN};
 use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
-use mcgv_video::stream::header::CodecKind;
 use mcgv_video::stream::tdct::BandIndex;
 use mcgv_video::Result;
 use std::io::Cursor;
@@ -41,7 +41,7 @@ fn decode_and_check(bytes: &[u8]) -> Result<()> {
     let mesh = decoder.decode_all(&mcgv_video::progress::bar(0, "", true))?;
     let last = mesh.frame_count() - 1;
     let alone = decoder.decode_frame(last)?;
-    if decoder.header().codec == CodecKind::Tdct {
+    if decoder.header().codec == Codec::Tdct {
         // The frame alone sums the bands' basis functions directly, the whole sequence goes
         // through the fast inverse DCT: equal up to rounding, of the order of the coordinates'.
         let scale = mesh

@@ -7,7 +7,12 @@
 //! the same bytes decode to the same samples on every machine. JPEG decoders legitimately differ by ±1
 //! (IDCT rounding); the encoder and decoder of mcgv must use this one function to agree exactly.
 
-use super::Plane;
+use super::geometry_video::{PictureCodec, PictureDecoder, PictureEncoder};
+use super::{abbreviated, Codec, Plane};
+use crate::encoder::EncodeOptions;
+use crate::geometry_image::RangeMode;
+use crate::stream::bytes::{ByteReader, ByteWriter};
+use crate::stream::frame_index::FrameChunk;
 use crate::{Error, Result};
 use jpeg_encoder::{ColorType, Encoder};
 use zune_core::bytestream::ZCursor;
@@ -87,5 +92,103 @@ fn side_u16(width: u32, height: u32) -> Result<(u16, u16)> {
         _ => Err(Error::Codec(format!(
             "jpeg size {width}×{height} outside 1..={MAX_SIDE}"
         ))),
+    }
+}
+
+/// JPEG as the geometry-video picture codec: every frame a key frame, the tables every frame
+/// shares stored once in the codec set-up part ([`super::abbreviated`]).
+pub struct Pictures;
+
+impl PictureCodec for Pictures {
+    fn codec(&self) -> Codec {
+        Codec::Jpeg
+    }
+
+    fn range_mode(&self, _opts: &EncodeOptions) -> RangeMode {
+        RangeMode::PerFrame
+    }
+
+    /// `snap`, tuned to JPEG's quantiser at the stream's quality (padding/README.md).
+    fn default_padding(&self) -> padding::Method {
+        padding::Method::Snap
+    }
+
+    fn qscale(&self, _opts: &EncodeOptions) -> u8 {
+        0
+    }
+
+    fn gop(&self, _opts: &EncodeOptions) -> u32 {
+        1
+    }
+
+    fn encoder(
+        &self,
+        _width: u32,
+        _height: u32,
+        opts: &EncodeOptions,
+    ) -> Result<Box<dyn PictureEncoder>> {
+        Ok(Box::new(FrameEncoder {
+            quality: opts.quality,
+            shared: None,
+            chunks: Vec::new(),
+        }))
+    }
+
+    fn decoder(&self, width: u32, height: u32, setup: &[u8]) -> Result<Box<dyn PictureDecoder>> {
+        Ok(Box::new(FrameDecoder {
+            width,
+            height,
+            setup: setup.to_vec(),
+        }))
+    }
+}
+
+struct FrameEncoder {
+    quality: u8,
+    /// The header every frame shares (tables aside), from the first frame.
+    shared: Option<Vec<u8>>,
+    chunks: Vec<FrameChunk>,
+}
+
+impl PictureEncoder for FrameEncoder {
+    fn push(&mut self, plane: &Plane) -> Result<()> {
+        let jpeg = encode(plane, self.quality)?;
+        let parts = abbreviated::split(&jpeg)?;
+        match &self.shared {
+            None => self.shared = Some(parts.shared.clone()),
+            Some(s) if *s != parts.shared => {
+                return Err(Error::Codec("JPEG headers differ between frames".into()))
+            }
+            Some(_) => {}
+        }
+        let mut data = ByteWriter::new();
+        data.blob(&parts.tables).raw(parts.scan);
+        self.chunks.push(FrameChunk {
+            data: data.into_bytes(),
+            key: true,
+        });
+        Ok(())
+    }
+
+    fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
+        Ok((self.shared.unwrap_or_default(), self.chunks))
+    }
+}
+
+struct FrameDecoder {
+    width: u32,
+    height: u32,
+    setup: Vec<u8>,
+}
+
+impl PictureDecoder for FrameDecoder {
+    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane> {
+        let mut r = ByteReader::new(chunk, "JPEG frame");
+        let tables = r.blob()?;
+        let scan = r.take(r.remaining())?;
+        let bytes = abbreviated::join(&self.setup, tables, scan)
+            .map_err(|e| Error::Stream(format!("frame {f}: {e}")))?;
+        decode(&bytes, self.width, self.height)
+            .map_err(|e| Error::Stream(format!("frame {f}: {e}")))
     }
 }

@@ -1,190 +1,238 @@
-//! Image and video codecs for the 8-bit residual geometry images.
+//! Residual coders: how the motion the predictor leaves over is stored.
 //!
-//! The pipeline hands over grayscale [`Plane`]s and gets them back after a lossy round trip:
-//! [`jpeg`] codes every plane on its own (any frame decodes alone), [`mpeg4`] codes a sequence as
-//! MPEG-4 Part 2 I- and P-frames through FFmpeg. [`quality_to_qscale`] maps the one user-facing rate
-//! knob (`--quality 1..100`) onto the MPEG-4 quantiser so both codecs follow the same scale.
+//! Every codec implements one interface, [`ResidualEncoder`] and [`ResidualDecoder`], and the only
+//! place that knows which codecs exist is [`Codec`] ([`Codec::encoder`], [`Codec::open_decoder`]):
+//! a new codec is one new module and one variant.
 //!
-//! Three coordinate images per frame, measured on smooth synthetic 256×256 planes (see
-//! `measure_rate_distortion_and_speed` in `tests/codec.rs`): tiling them into one 768×256 picture
-//! saves JPEG ≈ 460 bytes a frame with full headers (2–4 %) but only ≈ 100–130 bytes (< 1 %) in the
-//! abbreviated form the stream stores ([`abbreviated`]), while MPEG-4 codes three separate streams 2–4 % smaller
-//! than the tiled picture. Chroma is flat and costs nothing measurable
-//! (the GRAY flag changes no byte).
+//! - [`jpeg`] and [`mpeg4`] are the paper's geometry video: the residuals are splatted onto a
+//!   multi-chart atlas ([`geometry_video`]), padded, and coded as pictures — one JPEG per frame
+//!   (any frame decodes alone) or MPEG-4 Part 2 I- and P-frames through FFmpeg (cargo feature
+//!   `mpeg4`).
+//! - [`tdct`] is the follow-up paper's temporal DCT: each vertex's residual trajectory transformed
+//!   over all frames and coded band by band, no images.
+//!
+//! [`quality`] maps the one `quality` knob onto each codec's quantiser.
 
 pub mod abbreviated;
+pub mod geometry_video;
 pub mod jpeg;
+#[cfg(feature = "mpeg4")]
 pub mod mpeg4;
+mod plane;
+pub mod quality;
+pub mod tdct;
 
-use crate::{Error, Result};
+pub use plane::Plane;
+pub use quality::{ijg_scale_percent, quality_to_qscale};
 
-/// One 8-bit grayscale picture, rows top to bottom, `width` bytes per row, no padding.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Plane {
-    /// Pixels per row.
-    pub width: u32,
-    /// Number of rows.
-    pub height: u32,
-    /// `width × height` samples, row-major.
-    pub data: Vec<u8>,
+use crate::encoder::EncodeOptions;
+use crate::error::{Error, Result};
+use crate::mesh::{AnimatedMesh, Point, Triangle};
+use crate::motion::Partition;
+use crate::progress::Progress;
+use crate::stream::container::{ContainerReader, Part};
+use crate::stream::header::Header;
+use std::io::{Read, Seek};
+
+/// The residual codec recorded in the stream.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Codec {
+    /// One JPEG picture per frame: every frame decodes on its own.
+    Jpeg,
+    /// MPEG-4 Part 2: I-frames every `gop` frames, P-frames between.
+    Mpeg4,
+    /// No images: each vertex's residuals as a temporal DCT over all frames, coded from low to high
+    /// frequency, so that a truncated stream still decodes a coarser animation.
+    Tdct,
 }
 
-impl Plane {
-    /// A plane from its samples; fails when `data` does not hold exactly `width × height` bytes.
-    pub fn new(width: u32, height: u32, data: Vec<u8>) -> Result<Self> {
-        let plane = Plane {
-            width,
-            height,
-            data,
-        };
-        plane.check()?;
-        Ok(plane)
-    }
+impl Codec {
+    /// Every codec, in the order of their stream ids.
+    pub const ALL: [Codec; 3] = [Codec::Jpeg, Codec::Mpeg4, Codec::Tdct];
 
-    /// A plane with every sample set to `value`.
-    pub fn filled(width: u32, height: u32, value: u8) -> Self {
-        Plane {
-            width,
-            height,
-            data: vec![value; width as usize * height as usize],
+    /// The codec's id in the stream header.
+    pub fn id(self) -> u8 {
+        match self {
+            Codec::Jpeg => 0,
+            Codec::Mpeg4 => 1,
+            Codec::Tdct => 2,
         }
     }
 
-    /// Fails when the fields are inconsistent (the fields are public, so anyone can break them).
-    pub fn check(&self) -> Result<()> {
-        let expected = self.width as usize * self.height as usize;
-        if self.width == 0 || self.height == 0 {
-            return Err(Error::Codec(format!(
-                "empty plane {}×{}",
-                self.width, self.height
-            )));
+    /// The codec of a stream id.
+    pub fn from_id(id: u8) -> Result<Self> {
+        Codec::ALL
+            .into_iter()
+            .find(|c| c.id() == id)
+            .ok_or_else(|| Error::Stream(format!("unknown codec id {id}")))
+    }
+
+    /// The name used in reports (and on the command line).
+    pub fn name(self) -> &'static str {
+        match self {
+            Codec::Jpeg => "jpeg",
+            Codec::Mpeg4 => "mpeg4",
+            Codec::Tdct => "tdct",
         }
-        if self.data.len() != expected {
-            return Err(Error::Codec(format!(
-                "plane {}×{} holds {} bytes, expected {expected}",
-                self.width,
-                self.height,
-                self.data.len()
-            )));
-        }
-        Ok(())
     }
 
-    /// One row of samples; `None` past the last row.
-    pub fn row(&self, y: u32) -> Option<&[u8]> {
-        let w = self.width as usize;
-        let start = y as usize * w;
-        self.data.get(start..start + w)
+    /// Whether the codec codes geometry images on a lattice (and so has an atlas).
+    pub fn has_images(self) -> bool {
+        !matches!(self, Codec::Tdct)
     }
 
-    /// Largest absolute sample difference to `other`; fails when the sizes differ.
-    pub fn max_abs_diff(&self, other: &Plane) -> Result<u8> {
-        self.same_size(other)?;
-        Ok(self
-            .data
-            .iter()
-            .zip(&other.data)
-            .map(|(a, b)| a.abs_diff(*b))
-            .max()
-            .unwrap_or(0))
+    /// Whether this build can code the codec (MPEG-4 needs the `mpeg4` feature, i.e. FFmpeg).
+    pub fn available(self) -> bool {
+        !matches!(self, Codec::Mpeg4) || cfg!(feature = "mpeg4")
     }
 
-    /// Mean squared sample difference to `other`; fails when the sizes differ.
-    pub fn mse(&self, other: &Plane) -> Result<f64> {
-        self.same_size(other)?;
-        let sum: u64 = self
-            .data
-            .iter()
-            .zip(&other.data)
-            .map(|(a, b)| u64::from(a.abs_diff(*b)).pow(2))
-            .sum();
-        Ok(sum as f64 / self.data.len().max(1) as f64)
+    /// The codec's encoder.
+    pub fn encoder(self) -> Result<Box<dyn ResidualEncoder>> {
+        Ok(match self {
+            Codec::Jpeg => Box::new(geometry_video::Encoder::new(jpeg::Pictures)),
+            #[cfg(feature = "mpeg4")]
+            Codec::Mpeg4 => Box::new(geometry_video::Encoder::new(mpeg4::Pictures)),
+            #[cfg(not(feature = "mpeg4"))]
+            Codec::Mpeg4 => return Err(unavailable()),
+            Codec::Tdct => Box::new(tdct::Encoder),
+        })
     }
 
-    /// Peak signal-to-noise ratio to `other` in dB (peak 255); infinite for identical planes.
-    pub fn psnr(&self, other: &Plane) -> Result<f64> {
-        let mse = self.mse(other)?;
-        Ok(10.0 * (255.0_f64 * 255.0 / mse).log10())
+    /// The picture codec of a geometry-video codec (`None` for codecs without images).
+    pub fn pictures(self) -> Result<Option<Box<dyn geometry_video::PictureCodec>>> {
+        Ok(match self {
+            Codec::Jpeg => Some(Box::new(jpeg::Pictures)),
+            #[cfg(feature = "mpeg4")]
+            Codec::Mpeg4 => Some(Box::new(mpeg4::Pictures)),
+            #[cfg(not(feature = "mpeg4"))]
+            Codec::Mpeg4 => return Err(unavailable()),
+            Codec::Tdct => None,
+        })
     }
 
-    fn same_size(&self, other: &Plane) -> Result<()> {
-        if (self.width, self.height) != (other.width, other.height)
-            || self.data.len() != other.data.len()
-        {
-            return Err(Error::Codec(format!(
-                "planes differ in size: {}×{} vs {}×{}",
-                self.width, self.height, other.width, other.height
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// The MPEG-4 quantiser (`qscale`, 1..31, lower = better) for a user quality 1..100 (higher = better).
-///
-/// Follows the IJG law that JPEG uses for its quality (table scale 5000/q % below 50, 200 − 2q %
-/// from 50 up), anchored so that quality 50 ↔ qscale 4: on a smooth 256×256 test sequence that pair,
-/// and every other along the law (10↔20, 20↔10, 30↔7, 75↔2, 90↔1), gives the two codecs the same PSNR
-/// within about 1 dB (measured by `measure_rate_distortion_and_speed` in `tests/codec.rs`). So one
-/// `--quality` means roughly the same distortion whichever codec is chosen.
-pub fn quality_to_qscale(quality: u8) -> u8 {
-    let scale_percent = ijg_scale_percent(quality);
-    // qscale = 4 · scale / 100, rounded to nearest.
-    let qscale = (4 * scale_percent + 50) / 100;
-    qscale.clamp(1, 31) as u8
-}
-
-/// The IJG quality law (libjpeg's `jpeg_quality_scaling`): the quantiser scale in percent for a
-/// quality 1..100 (clamped), 5000/q below 50 and 200 − 2q from 50 up (0 at 100).
-///
-/// Shared by every codec that follows the one `--quality` scale: MPEG-4's qscale
-/// ([`quality_to_qscale`]) and the temporal-DCT step.
-pub fn ijg_scale_percent(quality: u8) -> u32 {
-    let q = u32::from(quality.clamp(1, 100));
-    if q < 50 {
-        5000 / q
-    } else {
-        200 - 2 * q
+    /// Reads the codec's parts of a stream (everything but the coded residuals themselves, which
+    /// a decoder reads on demand, or for tdct the bands, read here) and returns its decoder.
+    pub fn open_decoder<R: Read + Seek>(
+        self,
+        stream: &StreamLayout,
+        reader: &mut ContainerReader<R>,
+        max_bands: Option<usize>,
+    ) -> Result<Box<dyn ResidualDecoder<R>>> {
+        Ok(match self {
+            Codec::Jpeg => Box::new(geometry_video::Decoder::open(
+                jpeg::Pictures,
+                stream,
+                reader,
+            )?),
+            #[cfg(feature = "mpeg4")]
+            Codec::Mpeg4 => Box::new(geometry_video::Decoder::open(
+                mpeg4::Pictures,
+                stream,
+                reader,
+            )?),
+            #[cfg(not(feature = "mpeg4"))]
+            Codec::Mpeg4 => return Err(unavailable()),
+            Codec::Tdct => Box::new(tdct::Decoder::open(stream, reader, max_bands)?),
+        })
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+#[cfg(not(feature = "mpeg4"))]
+fn unavailable() -> Error {
+    Error::Codec("this build has no MPEG-4 codec (built without the `mpeg4` feature)".into())
+}
 
-    #[test]
-    fn quality_mapping_is_monotone_and_anchored() {
-        assert_eq!(quality_to_qscale(50), 4);
-        assert_eq!(quality_to_qscale(75), 2);
-        assert_eq!(quality_to_qscale(10), 20);
-        assert_eq!(quality_to_qscale(100), 1);
-        assert_eq!(quality_to_qscale(1), 31);
-        assert_eq!(quality_to_qscale(0), 31);
-        let mut last = u8::MAX;
-        for q in 1..=100 {
-            let s = quality_to_qscale(q);
-            assert!((1..=31).contains(&s));
-            assert!(s <= last, "qscale must not grow with quality ({q})");
-            last = s;
-        }
+/// What the encoder hands a residual coder: the animation, the decoder's reference frame and
+/// partition, and every frame's residual against the quantised predictor.
+pub struct ResidualInput<'a> {
+    /// The animation (vertices in the stream's order).
+    pub mesh: &'a AnimatedMesh,
+    /// The decoded first frame, which the decoder will have.
+    pub reference: &'a [Point],
+    /// The motion clusters.
+    pub partition: &'a Partition,
+    /// `residuals[f][v]`: frame f's residual of vertex v against the quantised predictor.
+    pub residuals: &'a [Vec<[f32; 3]>],
+    /// The encoding's options.
+    pub options: &'a EncodeOptions,
+    /// Where to report frames done.
+    pub progress: &'a dyn Progress,
+}
+
+/// The codec's fields of the stream header.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CodecParams {
+    /// Geometry-image lattice, (0, 0) without images.
+    pub lattice: (u16, u16),
+    /// The MPEG-4 quantiser (0 for other codecs).
+    pub qscale: u8,
+    /// Frames per group of pictures (1 for intra codecs).
+    pub gop: u32,
+    /// The padding method's name (`none` without images).
+    pub padding: String,
+}
+
+/// What a residual coder produced: its header fields and its parts, in file order.
+pub struct CodedResiduals {
+    /// The codec's fields of the header.
+    pub params: CodecParams,
+    /// The atlas's figures, for codecs with an atlas.
+    pub atlas: Option<atlas::AtlasStats>,
+    /// Parts written before the predictor's (geometry video: the lattice coordinates).
+    pub before_predictor: Vec<Part>,
+    /// Parts written after the predictor's.
+    pub after_predictor: Vec<Part>,
+    /// Seconds per stage of the coder.
+    pub stage_seconds: Vec<(String, f64)>,
+}
+
+/// The encoding half of a residual codec.
+pub trait ResidualEncoder {
+    /// Codes every frame's residuals.
+    fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals>;
+}
+
+/// What every residual decoder may need of the stream, read before it.
+pub struct StreamLayout<'a> {
+    /// The stream header.
+    pub header: &'a Header,
+    /// The shared connectivity.
+    pub triangles: &'a [Triangle],
+}
+
+/// The decoding half of a residual codec: adds the coded residuals to the decoder's prediction.
+pub trait ResidualDecoder<R> {
+    /// Adds frame `f`'s residuals to its prediction, reading no more of the stream than `f` needs.
+    fn add_frame(
+        &mut self,
+        reader: &mut ContainerReader<R>,
+        f: usize,
+        frame: &mut [Point],
+    ) -> Result<()>;
+
+    /// Adds every frame's residuals to the predictions, in order.
+    fn add_all(
+        &mut self,
+        reader: &mut ContainerReader<R>,
+        frames: &mut [Vec<Point>],
+        progress: &dyn Progress,
+    ) -> Result<()>;
+
+    /// The geometry-image side of the stream, for codecs that code images.
+    fn images(&self) -> Option<&geometry_video::ImageLayout> {
+        None
     }
 
-    #[test]
-    fn plane_rejects_wrong_length() {
-        assert!(Plane::new(4, 4, vec![0; 15]).is_err());
-        assert!(Plane::new(0, 4, vec![]).is_err());
-        let p = Plane::new(4, 2, (0..8).collect());
-        assert!(p.is_ok());
+    /// Frame `f`'s decoded picture (x | y | z residual images side by side), for codecs that code images.
+    fn picture(&mut self, _reader: &mut ContainerReader<R>, _f: usize) -> Result<Plane> {
+        Err(Error::Usage(
+            "a tdct stream has no images: its residuals are temporal-DCT bands".into(),
+        ))
     }
 
-    #[test]
-    fn plane_measures() -> Result<()> {
-        let a = Plane::new(2, 2, vec![10, 20, 30, 40])?;
-        let b = Plane::new(2, 2, vec![11, 20, 27, 40])?;
-        assert_eq!(a.max_abs_diff(&b)?, 3);
-        assert!((a.mse(&b)? - 2.5).abs() < 1e-12);
-        assert!(a.psnr(&a)?.is_infinite());
-        assert!(a.mse(&Plane::filled(1, 4, 0)).is_err());
-        Ok(())
+    /// The temporal-DCT bands, for codecs that code them.
+    fn bands(&self) -> Option<&tdct::Bands> {
+        None
     }
 }

@@ -8,7 +8,11 @@
 //! Headers are in-band (no global header): each I-frame packet repeats the VOL header, so decoding can
 //! start at any I-frame.
 
-use super::Plane;
+use super::geometry_video::{PictureCodec, PictureDecoder, PictureEncoder};
+use super::{Codec, Plane};
+use crate::encoder::EncodeOptions;
+use crate::geometry_image::RangeMode;
+use crate::stream::frame_index::FrameChunk;
 use crate::{Error, Result};
 use ffmpeg_next as ffmpeg;
 use ffmpeg_next::util::{error::EAGAIN, picture};
@@ -325,5 +329,95 @@ impl Decoder {
             data.extend_from_slice(row);
         }
         Plane::new(self.width, self.height, data)
+    }
+}
+
+/// MPEG-4 Part 2 as the geometry-video picture codec: an I-frame every `gop` frames, P-frames
+/// between, residual ranges shared by a group so that P-frames predict like from like.
+pub struct Pictures;
+
+impl PictureCodec for Pictures {
+    fn codec(&self) -> Codec {
+        Codec::Mpeg4
+    }
+
+    fn range_mode(&self, opts: &EncodeOptions) -> RangeMode {
+        RangeMode::PerGroup(opts.gop)
+    }
+
+    /// `biharmonic`: quality-independent, measured best with MPEG-4's quantiser (padding/README.md).
+    fn default_padding(&self) -> padding::Method {
+        padding::Method::Biharmonic
+    }
+
+    fn qscale(&self, opts: &EncodeOptions) -> u8 {
+        opts.qscale
+            .unwrap_or_else(|| super::quality_to_qscale(opts.quality))
+    }
+
+    fn gop(&self, opts: &EncodeOptions) -> u32 {
+        opts.gop as u32
+    }
+
+    fn encoder(
+        &self,
+        width: u32,
+        height: u32,
+        opts: &EncodeOptions,
+    ) -> Result<Box<dyn PictureEncoder>> {
+        let options = Mpeg4Options {
+            qscale: self.qscale(opts),
+            gop: opts.gop,
+        };
+        Ok(Box::new(PacketEncoder {
+            encoder: Encoder::new(width, height, &options)?,
+            packets: Vec::new(),
+        }))
+    }
+
+    fn decoder(&self, width: u32, height: u32, _setup: &[u8]) -> Result<Box<dyn PictureDecoder>> {
+        Ok(Box::new(PacketDecoder(Decoder::new(width, height)?)))
+    }
+}
+
+struct PacketEncoder {
+    encoder: Encoder,
+    packets: Vec<Packet>,
+}
+
+impl PictureEncoder for PacketEncoder {
+    fn push(&mut self, plane: &Plane) -> Result<()> {
+        self.packets.extend(self.encoder.encode(plane)?);
+        Ok(())
+    }
+
+    fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
+        let mut packets = self.packets;
+        packets.extend(self.encoder.finish()?);
+        let chunks = packets
+            .into_iter()
+            .map(|p| FrameChunk {
+                data: p.data,
+                key: p.key,
+            })
+            .collect();
+        Ok((Vec::new(), chunks))
+    }
+}
+
+/// One packet per frame and no B-frames: no reordering.
+struct PacketDecoder(Decoder);
+
+impl PictureDecoder for PacketDecoder {
+    fn decode(&mut self, f: usize, packet: &[u8]) -> Result<Plane> {
+        let mut planes = self.0.decode(packet)?;
+        if planes.is_empty() {
+            planes = self.0.flush()?;
+        }
+        planes.pop().ok_or_else(|| {
+            Error::Stream(format!(
+                "frame {f}: the MPEG-4 packet decoded to no picture"
+            ))
+        })
     }
 }

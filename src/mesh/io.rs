@@ -19,16 +19,6 @@ pub struct ReadOptions {
     pub base: Option<PathBuf>,
 }
 
-impl From<&crate::cli::InputArgs> for ReadOptions {
-    fn from(args: &crate::cli::InputArgs) -> Self {
-        Self {
-            fps: args.fps,
-            clip: args.clip.clone(),
-            base: args.base.clone(),
-        }
-    }
-}
-
 /// Reads an animation: a folder or glob of `.obj` files, a `.pc2` point cache, or a `.gltf`/`.glb`.
 ///
 /// - OBJ: a folder's `.obj` files, a glob such as `dir/*.obj`, or one `.obj` (one frame). Frames are
@@ -44,9 +34,10 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
     if let Some(fps) = opts.fps {
         if !(fps.is_finite() && fps > 0.0) {
-            return Err(Error::Usage(format!(
-                "--fps {fps}: the frame rate must be a positive number"
-            )));
+            return Err(Error::option(
+                "fps",
+                format!("{fps}: the frame rate must be a positive number"),
+            ));
         }
     }
     match extension.as_deref() {

@@ -12,7 +12,6 @@ mod decimate;
 mod fit;
 mod predict;
 mod refine;
-mod render;
 mod segment;
 mod skinning;
 
@@ -20,7 +19,6 @@ pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_B
 pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
 pub use fit::AffineCoefficients;
 pub use predict::{energy, residuals};
-pub use render::render_partition_png;
 pub use segment::{segment, Partition, SegmentOptions, MIN_CLUSTER_SIZE};
 pub use skinning::{
     cluster_neighbours, predict_frame, PredictorKind, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT,

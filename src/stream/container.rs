@@ -104,6 +104,28 @@ impl Checksum {
     }
 }
 
+/// One part as a coder hands it to the container: the container knows parts, not codecs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Part {
+    /// What the part holds.
+    pub tag: Tag,
+    /// Its payload.
+    pub bytes: Vec<u8>,
+    /// How its integrity is checked.
+    pub checksum: Checksum,
+}
+
+impl Part {
+    /// A part whose payload one CRC covers.
+    pub fn whole(tag: Tag, bytes: Vec<u8>) -> Self {
+        Self {
+            tag,
+            bytes,
+            checksum: Checksum::Whole,
+        }
+    }
+}
+
 /// Builds a container in memory; [`ContainerWriter::write_atomic`] puts it on disk.
 #[derive(Debug, Default)]
 pub struct ContainerWriter {
@@ -119,6 +141,11 @@ impl ContainerWriter {
     /// Adds a part; parts are written in the order added.
     pub fn add(&mut self, tag: Tag, payload: Vec<u8>, checksum: Checksum) {
         self.parts.push((tag, payload, checksum));
+    }
+
+    /// Adds a part after those already added.
+    pub fn push(&mut self, part: Part) {
+        self.add(part.tag, part.bytes, part.checksum);
     }
 
     /// Bytes each part takes in the file (payload plus its part header), by part name, in file order.

@@ -1,54 +1,9 @@
 //! The stream header: everything the decoder must know before it reads any other part.
 
+use crate::codec::Codec;
 use crate::error::{Error, Result};
 use crate::motion::PredictorKind;
 use crate::stream::bytes::{ByteReader, ByteWriter};
-
-/// The residual image codec recorded in the stream.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum CodecKind {
-    /// One JPEG picture per frame: every frame decodes on its own.
-    Jpeg,
-    /// MPEG-4 Part 2: I-frames every `gop` frames, P-frames between.
-    Mpeg4,
-    /// No images: each vertex's residuals as a temporal DCT over all frames, coded from low to high
-    /// frequency, so that a truncated stream still decodes a coarser animation.
-    Tdct,
-}
-
-impl CodecKind {
-    fn id(self) -> u8 {
-        match self {
-            CodecKind::Jpeg => 0,
-            CodecKind::Mpeg4 => 1,
-            CodecKind::Tdct => 2,
-        }
-    }
-
-    fn from_id(id: u8) -> Result<Self> {
-        match id {
-            0 => Ok(CodecKind::Jpeg),
-            1 => Ok(CodecKind::Mpeg4),
-            2 => Ok(CodecKind::Tdct),
-            _ => Err(Error::Stream(format!("unknown codec id {id}"))),
-        }
-    }
-
-    /// The name used on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            CodecKind::Jpeg => "jpeg",
-            CodecKind::Mpeg4 => "mpeg4",
-            CodecKind::Tdct => "tdct",
-        }
-    }
-
-    /// Whether the codec codes geometry images on a lattice (and so has an atlas).
-    pub fn has_images(self) -> bool {
-        !matches!(self, CodecKind::Tdct)
-    }
-}
 
 /// Stream parameters.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -66,7 +21,7 @@ pub struct Header {
     /// Geometry-image lattice height in pixels (0 for tdct).
     pub lattice_height: u16,
     /// The residual image codec.
-    pub codec: CodecKind,
+    pub codec: Codec,
     /// The `--quality` the stream was made with (1..100).
     pub quality: u8,
     /// The MPEG-4 quantiser (0 for JPEG streams).
@@ -164,7 +119,7 @@ impl Header {
             clusters: r.u32()?,
             lattice_width: r.u16()?,
             lattice_height: r.u16()?,
-            codec: CodecKind::from_id(r.u8()?)?,
+            codec: Codec::from_id(r.u8()?)?,
             quality: r.u8()?,
             qscale: r.u8()?,
             gop: r.u32()?,
@@ -256,7 +211,7 @@ mod tests {
             clusters: 20,
             lattice_width: 256,
             lattice_height: 256,
-            codec: CodecKind::Mpeg4,
+            codec: Codec::Mpeg4,
             quality: 75,
             qscale: 4,
             gop: 50,
@@ -293,7 +248,7 @@ mod tests {
         Header {
             lattice_width: 0,
             lattice_height: 0,
-            codec: CodecKind::Tdct,
+            codec: Codec::Tdct,
             qscale: 0,
             gop: 1,
             padding: "none".into(),
@@ -327,7 +282,7 @@ mod tests {
             assert!(Header::from_bytes(&bad.to_bytes()).is_err());
         }
         // … and the image codecs still need one that holds every vertex.
-        for codec in [CodecKind::Jpeg, CodecKind::Mpeg4] {
+        for codec in [Codec::Jpeg, Codec::Mpeg4] {
             let none = Header {
                 codec,
                 lattice_width: 0,

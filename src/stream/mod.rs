@@ -1,10 +1,10 @@
-//! The `.mcgv` stream: container, byte serialisation, entropy coding and the parts it holds.
+//! The `.mcgv` stream: the container (parts with checksums, knowing nothing of codecs), byte
+//! serialisation, the entropy coder, and the parts every codec shares: header, frame index and
+//! side information (partition, lattice coordinates, predictor).
 
 pub mod bytes;
 pub mod container;
 pub mod entropy;
-pub mod first_frame;
 pub mod frame_index;
 pub mod header;
 pub mod side_info;
-pub mod tdct;

@@ -5,11 +5,11 @@
 //! so unused items are not warnings here.
 #![allow(dead_code)]
 
+use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, Point, ReadOptions, Triangle};
 use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
-use mcgv_video::stream::header::CodecKind;
 use std::io::Cursor;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -84,7 +84,7 @@ pub fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
 }
 
 /// A real two-frame stream of a square (two triangles, one cluster), small enough to forge quickly.
-pub fn tiny_stream(codec: CodecKind) -> Vec<u8> {
+pub fn tiny_stream(codec: Codec) -> Vec<u8> {
     let square = |t: f32| {
         vec![
             [0.0, 0.0, 0.0],

@@ -1,13 +1,14 @@
 //! `mcgv-video encode`.
 
-use crate::cli::{CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
-use crate::encoder::{self, EncodeOptions, Lattice, Segmentation};
-use crate::error::{Error, Result};
-use crate::mesh::io::input_files;
-use crate::mesh::{read_animation, ReadOptions};
-use crate::motion::PredictorKind;
+use crate::args::{CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
-use crate::stream::header::CodecKind;
+use mcgv_video::codec::Codec;
+use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
+use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::io::input_files;
+use mcgv_video::mesh::{read_animation, ReadOptions};
+use mcgv_video::motion::PredictorKind;
+use mcgv_video::Lattice;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -38,16 +39,16 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
                 ));
             }
             Segmentation::Decimation {
-                e0: args.e0.unwrap_or(crate::motion::DEFAULT_E0),
+                e0: args.e0.unwrap_or(mcgv_video::motion::DEFAULT_E0),
             }
         }
     };
     let defaults = EncodeOptions::default();
     Ok(EncodeOptions {
         codec: match args.codec {
-            CodecChoice::Jpeg => CodecKind::Jpeg,
-            CodecChoice::Mpeg4 => CodecKind::Mpeg4,
-            CodecChoice::Tdct => CodecKind::Tdct,
+            CodecChoice::Jpeg => Codec::Jpeg,
+            CodecChoice::Mpeg4 => Codec::Mpeg4,
+            CodecChoice::Tdct => Codec::Tdct,
         },
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
         qscale: args.qscale,
@@ -118,7 +119,7 @@ pub fn run(args: &EncodeArgs, quiet: bool) -> Result<()> {
     let mesh = read_animation(&args.input, &read_options)?;
     spin.finish_and_clear();
     let pb = progress::bar(mesh.frame_count() as u64, "encode", quiet);
-    let encoded = encoder::encode(&mesh, &opts, &pb)?;
+    let encoded = encoder::encode_with_progress(&mesh, &opts, &progress::Reporter(&pb))?;
     pb.finish_and_clear();
     encoded.container.write_atomic(&args.output)?;
     let seconds = start.elapsed().as_secs_f64();

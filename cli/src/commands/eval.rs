@@ -1,11 +1,11 @@
 //! `mcgv-video eval`: the error measures of one animation against another.
 
-use crate::cli::EvalArgs;
-use crate::decoder::Decoder;
-use crate::error::{Error, Result};
-use crate::mesh::{read_animation, ReadOptions};
-use crate::metrics::{compare, Measures};
+use crate::args::EvalArgs;
 use crate::progress;
+use mcgv_video::decoder::Decoder;
+use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::{read_animation, ReadOptions};
+use mcgv_video::metrics::{compare, Measures};
 use std::path::Path;
 
 /// Runs `eval`.
@@ -18,7 +18,7 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
         super::decode::warn_if_truncated(&decoder);
         let bits = decoder.container().file_len() * 8;
         let pb = progress::bar(decoder.header().frames as u64, "decode", quiet);
-        let decoded = decoder.decode_all(&pb)?;
+        let decoded = decoder.decode_all_with_progress(&crate::progress::Reporter(&pb))?;
         pb.finish_and_clear();
         compare(&original, &decoded)?.with_bits(bits)
     } else {

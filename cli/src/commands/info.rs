@@ -1,9 +1,9 @@
 //! `mcgv-video info`: what an animation is made of, as text or one JSON object.
 
-use crate::cli::InfoArgs;
-use crate::error::{Error, Result};
-use crate::mesh::topology::{ManifoldReport, VertexAdjacency};
-use crate::mesh::{bounding_box, read_animation, AnimatedMesh, Point, ReadOptions};
+use crate::args::InfoArgs;
+use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::topology::{ManifoldReport, VertexAdjacency};
+use mcgv_video::mesh::{bounding_box, read_animation, AnimatedMesh, Point, ReadOptions};
 use std::time::Instant;
 
 /// What `info` reports; the field names are the JSON keys.

@@ -1,11 +1,11 @@
 //! `mcgv-video decode`.
 
-use crate::cli::DecodeArgs;
-use crate::decoder::{DecodeOptions, Decoder};
-use crate::error::{Error, Result};
-use crate::mesh::io::write_obj_sequence_from;
-use crate::mesh::{write_pc2, AnimatedMesh};
+use crate::args::DecodeArgs;
 use crate::progress;
+use mcgv_video::decoder::{DecodeOptions, Decoder};
+use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::io::write_obj_sequence_from;
+use mcgv_video::mesh::{write_pc2, AnimatedMesh};
 use std::path::Path;
 use std::time::Instant;
 
@@ -55,7 +55,7 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
         }
         None => {
             let pb = progress::bar(frames as u64, "decode", quiet);
-            let mesh = decoder.decode_all(&pb)?;
+            let mesh = decoder.decode_all_with_progress(&crate::progress::Reporter(&pb))?;
             pb.finish_and_clear();
             mesh
         }

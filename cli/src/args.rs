@@ -1,6 +1,5 @@
-//! Command-line interface: argument definitions and dispatch to [`crate::commands`].
+//! The command line: argument definitions (clap). `main.rs` dispatches them to [`crate::commands`].
 
-use crate::commands;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -231,35 +230,12 @@ pub struct ConvertArgs {
     pub input_args: InputArgs,
 }
 
-/// Runs the CLI and returns the process exit code: 0 on success, 1 on error (message on stderr),
-/// 2 on a usage error (clap's own).
-pub fn main() -> i32 {
-    // A panic anywhere (a dependency's bug, caught where it can be) is reported in one line, like
-    // every other error, instead of a backtrace.
-    std::panic::set_hook(Box::new(|info| {
-        eprintln!("mcgv-video: internal error: {info}");
-    }));
-    let cli = match Cli::try_parse() {
-        Ok(cli) => cli,
-        Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
-            let _ = e.print();
-            return code;
-        }
-    };
-    let result = match &cli.command {
-        Command::Encode(a) => commands::encode::run(a, cli.quiet),
-        Command::Decode(a) => commands::decode::run(a, cli.quiet),
-        Command::Inspect(a) => commands::inspect::run(a, cli.quiet),
-        Command::Eval(a) => commands::eval::run(a, cli.quiet),
-        Command::Info(a) => commands::info::run(a, cli.quiet),
-        Command::Convert(a) => commands::convert::run(a, cli.quiet),
-    };
-    match result {
-        Ok(()) => 0,
-        Err(e) => {
-            eprintln!("mcgv-video: error: {e}");
-            1
+impl From<&InputArgs> for mcgv_video::ReadOptions {
+    fn from(args: &InputArgs) -> Self {
+        Self {
+            fps: args.fps,
+            clip: args.clip.clone(),
+            base: args.base.clone(),
         }
     }
 }

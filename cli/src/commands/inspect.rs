@@ -1,14 +1,11 @@
 //! `mcgv-video inspect`.
 
-use crate::cli::InspectArgs;
-use crate::decoder::Decoder;
-use crate::encoder::{self, EncodeOptions, Lattice};
-use crate::error::{Error, Result};
-use crate::geometry_image::tile;
-use crate::mesh::read_animation;
-use crate::stream::container::{FILE_HEADER_LEN, PART_HEADER_LEN};
-use crate::stream::first_frame;
-use crate::stream::header::{CodecKind, Header};
+use crate::args::InspectArgs;
+use mcgv_video::decoder::Decoder;
+use mcgv_video::error::{Error, Result};
+use mcgv_video::geometry_image::tile;
+use mcgv_video::mesh::read_animation;
+use mcgv_video::{codec::Codec, stream::header::Header};
 use std::path::Path;
 
 /// Runs `inspect`.
@@ -16,14 +13,7 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
     let mut decoder = Decoder::open(&args.input)?;
     let header = decoder.header().clone();
     let total = decoder.container().file_len();
-    let mut parts: Vec<(String, u64)> = vec![("file header".into(), FILE_HEADER_LEN as u64)];
-    parts.extend(
-        decoder
-            .container()
-            .parts()
-            .iter()
-            .map(|p| (p.tag.name().to_string(), p.len + PART_HEADER_LEN as u64)),
-    );
+    let parts = mcgv_video::inspect::part_bytes(&decoder);
     let vf = header.vertices as f64 * header.frames as f64;
     let bpvf = total as f64 * 8.0 / vf;
     if let Some(dir) = &args.png {
@@ -145,9 +135,9 @@ fn band_table(bands: &[u64], decoded: usize) -> String {
 
 fn summary(h: &Header, path: &Path) -> String {
     let codec = match h.codec {
-        CodecKind::Jpeg => format!("jpeg quality {}", h.quality),
-        CodecKind::Mpeg4 => format!("mpeg4 qscale {} gop {}", h.qscale, h.gop),
-        CodecKind::Tdct => {
+        Codec::Jpeg => format!("jpeg quality {}", h.quality),
+        Codec::Mpeg4 => format!("mpeg4 qscale {} gop {}", h.qscale, h.gop),
+        Codec::Tdct => {
             return format!(
                 "{}: {} vertices x {} frames, {} faces; tdct quality {}; {} clusters, {} predictor, no atlas",
                 path.display(),
@@ -252,7 +242,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
         .ok_or_else(|| Error::Usage("atlas image size".into()))?
         .save(&atlas_path)
         .map_err(|e| Error::Usage(format!("{}: {e}", atlas_path.display())))?;
-    crate::motion::render_partition_png(
+    crate::render::render_partition_png(
         decoder.reference(),
         decoder.triangles(),
         decoder.partition().labels(),
@@ -272,92 +262,20 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
 
     if let Some(original) = &args.original {
         let mesh = read_animation(original, &(&args.input_args).into())?;
-        if mesh.vertex_count() != header.vertices as usize
-            || mesh.frame_count() != header.frames as usize
-        {
-            return Err(Error::Usage(format!(
-                "{original} has {} vertices x {} frames; the stream has {} x {}",
-                mesh.vertex_count(),
-                mesh.frame_count(),
-                header.vertices,
-                header.frames
-            )));
-        }
-        let opts = EncodeOptions {
-            codec: header.codec,
-            quality: header.quality,
-            qscale: Some(header.qscale).filter(|&q| q > 0),
-            clusters: header.requested_clusters as usize,
-            // Unused: the analysis below takes the stream's own partition.
-            segmentation: encoder::Segmentation::KMeans,
-            affine_bits: header.affine_bits,
-            first_frame_bits: header.first_frame_bits,
-            lattice: Lattice::Fixed(header.lattice_width, header.lattice_height),
-            padding: Some(
-                header
-                    .padding
-                    .parse()
-                    .map_err(|e| Error::Stream(format!("padding {}: {e}", header.padding)))?,
-            ),
-            gop: header.gop as usize,
-            reorder: header.reorder,
-            predictor: header.predictor,
-            weight_bits: decoder
-                .weights()
-                .map_or(crate::motion::WEIGHT_BITS, |w| w.bits),
-            range_floor: 0.0,
-            step: None,
-        };
-        let ff = first_frame::encode(
-            mesh.frame(0),
-            mesh.triangles(),
-            &first_frame::FirstFrameOptions {
-                bits: opts.first_frame_bits,
-                reorder: opts.reorder,
-            },
-        )?;
-        let mesh = match &ff.permutation {
-            Some(p) => mesh.permuted(p)?,
-            None => mesh,
-        };
-        // The stream's partition, not a re-run segmentation: decimation's K is not in the options,
-        // and the images must be those of the clusters the stream was coded with.
-        let mut analysis = encoder::analyse_partition(
-            &mesh,
-            ff.decoded_positions,
-            decoder.partition().clone(),
-            &opts,
-        )?;
-        // The stream's own ranges: the encoder may have widened them (--range-floor).
-        analysis.ranges = decoder.ranges().to_vec();
-        let fixed = analysis.atlas.fixed_mask();
-        for &f in &frames {
-            // Raw: the quantised residuals on the pixels that carry data, free pixels black.
-            let mut raw: [Vec<f32>; 3] = Default::default();
-            for (a, img) in raw.iter_mut().enumerate() {
-                *img = encoder::level_image(&analysis, f, a)?;
-                for (p, &keep) in img.iter_mut().zip(&fixed) {
-                    if !keep {
-                        *p = 0.0;
-                    }
-                }
-            }
-            save_levels(&dir.join(format!("frame_{f:04}_raw.png")), &raw, w, h)?;
-            // P-frames pad against the previous frame; re-padding from the group start reproduces it.
-            let padded = match header.codec {
-                CodecKind::Jpeg | CodecKind::Tdct => {
-                    encoder::residual_images(&analysis, f, &opts, None)?
-                }
-                CodecKind::Mpeg4 => {
-                    let start = f - f % opts.gop;
-                    let mut prev = encoder::residual_images(&analysis, start, &opts, None)?;
-                    for g in start + 1..=f {
-                        prev = encoder::residual_images(&analysis, g, &opts, Some(&prev))?;
-                    }
-                    prev
-                }
-            };
-            save_levels(&dir.join(format!("frame_{f:04}_padded.png")), &padded, w, h)?;
+        for images in mcgv_video::inspect::encoder_images(decoder, &mesh, &frames)? {
+            let f = images.frame;
+            save_levels(
+                &dir.join(format!("frame_{f:04}_raw.png")),
+                &images.raw,
+                w,
+                h,
+            )?;
+            save_levels(
+                &dir.join(format!("frame_{f:04}_padded.png")),
+                &images.padded,
+                w,
+                h,
+            )?;
         }
     }
     if !quiet {

@@ -6,9 +6,11 @@
 //! `encode` and `eval` use makes every codec start from exactly the frames mcgv-video sees.
 //! Positions are `f32` in both forms, so nothing is lost.
 
-use crate::cli::ConvertArgs;
-use crate::error::{Error, Result};
-use crate::mesh::{read_animation, write_obj_frame, write_obj_sequence, write_pc2, ReadOptions};
+use crate::args::ConvertArgs;
+use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::{
+    read_animation, write_obj_frame, write_obj_sequence, write_pc2, ReadOptions,
+};
 use std::path::Path;
 
 /// Whether the output path names a PC2 point cache rather than an OBJ folder.

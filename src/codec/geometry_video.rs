@@ -1,0 +1,321 @@
+//! Geometry video (MCGV §3.3–3.4): the residual coder shared by the picture codecs.
+//!
+//! Encoding builds the atlas on the decoded first frame, splats each frame's quantised residuals
+//! onto it, pads the free pixels, tiles x | y | z into one picture and hands the pictures to a
+//! [`PictureCodec`] (JPEG, MPEG-4). Its parts, in file order: the lattice coordinates (before the
+//! predictor's), then the residual ranges, the codec set-up, the frame index and the coded frames.
+//! Decoding reads the frames from the last key frame before the one asked for.
+
+use super::{Codec, StreamLayout};
+use super::{CodecParams, CodedResiduals, Plane, ResidualDecoder, ResidualEncoder, ResidualInput};
+use crate::encoder::EncodeOptions;
+use crate::error::{Error, Result};
+use crate::geometry_image::{lattice, quantise, tile, FrameRanges, GeometryImages, RangeMode};
+use crate::mesh::Point;
+use crate::progress::Progress;
+use crate::stream::bytes::{ByteReader, ByteWriter};
+use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
+use crate::stream::frame_index::{FrameChunk, FrameIndex};
+use crate::stream::side_info;
+use std::io::{Read, Seek};
+use std::time::Instant;
+
+/// What a picture codec (one file per codec) tells the geometry-video coder.
+pub trait PictureCodec {
+    /// The codec's stream id.
+    fn codec(&self) -> Codec;
+    /// How residual ranges are shared between frames.
+    fn range_mode(&self, opts: &EncodeOptions) -> RangeMode;
+    /// The padding this codec measured best with.
+    fn default_padding(&self) -> padding::Method;
+    /// The MPEG-4 quantiser of the header (0 when the codec has none).
+    fn qscale(&self, opts: &EncodeOptions) -> u8;
+    /// Frames per group of pictures (1 for intra codecs).
+    fn gop(&self, opts: &EncodeOptions) -> u32;
+    /// An encoder for `width`×`height` pictures.
+    fn encoder(
+        &self,
+        width: u32,
+        height: u32,
+        opts: &EncodeOptions,
+    ) -> Result<Box<dyn PictureEncoder>>;
+    /// A decoder for `width`×`height` pictures; `setup` is the stream's codec set-up part.
+    fn decoder(&self, width: u32, height: u32, setup: &[u8]) -> Result<Box<dyn PictureDecoder>>;
+}
+
+/// Codes pictures in frame order.
+pub trait PictureEncoder {
+    /// Codes the next frame's picture.
+    fn push(&mut self, plane: &Plane) -> Result<()>;
+    /// Ends the sequence: the codec set-up part and one chunk per frame.
+    fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)>;
+}
+
+/// Decodes pictures, starting at a key frame and continuing in order.
+pub trait PictureDecoder {
+    /// Decodes frame `f` from its chunk.
+    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane>;
+}
+
+/// The padding an encoding uses: the option's, else the picture codec's measured best.
+pub fn padding_method(codec: &dyn PictureCodec, opts: &EncodeOptions) -> padding::Method {
+    opts.padding.unwrap_or(codec.default_padding())
+}
+
+/// The residual images an encoding with `codec` makes of `input`'s residuals.
+pub fn images(codec: &dyn PictureCodec, input: &ResidualInput) -> Result<GeometryImages> {
+    images_of(
+        codec,
+        input.reference,
+        input.mesh.triangles(),
+        input.partition,
+        input.residuals,
+        input.options,
+    )
+}
+
+/// The residual images an encoding with `codec` and `opts` makes of `residuals` on the atlas of
+/// `reference`, `triangles` and `partition`.
+pub fn images_of(
+    codec: &dyn PictureCodec,
+    reference: &[Point],
+    triangles: &[[u32; 3]],
+    partition: &crate::motion::Partition,
+    residuals: &[Vec<[f32; 3]>],
+    opts: &EncodeOptions,
+) -> Result<GeometryImages> {
+    let (size, atlas) = lattice::build_atlas(reference, triangles, partition, opts.lattice)?;
+    Ok(GeometryImages::new(
+        size,
+        atlas,
+        residuals,
+        codec.range_mode(opts),
+        opts.range_floor,
+        padding::PaddingOptions {
+            method: padding_method(codec, opts),
+            jpeg_quality: opts.quality,
+            ..padding::PaddingOptions::default()
+        },
+    ))
+}
+
+/// The geometry-video residual encoder over one picture codec.
+pub struct Encoder<P>(P);
+
+impl<P: PictureCodec> Encoder<P> {
+    /// The encoder for picture codec `codec`.
+    pub fn new(codec: P) -> Self {
+        Self(codec)
+    }
+}
+
+impl<P: PictureCodec> ResidualEncoder for Encoder<P> {
+    fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals> {
+        let clock = Instant::now();
+        let images = images(&self.0, input)?;
+        let atlas_seconds = clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
+        input.progress.stage("images");
+        let (setup, chunks) = code_pictures(&self.0, &images, input)?;
+        let images_seconds = clock.elapsed().as_secs_f64();
+        let mut ranges = ByteWriter::new();
+        quantise::write_ranges(&images.ranges, &mut ranges);
+        let (index, payload) = FrameIndex::build(chunks);
+        let lattice_part = side_info::encode_lattice(
+            images.atlas.vertex_pixels(),
+            images.lattice,
+            input.mesh.triangles(),
+        )?;
+        let opts = input.options;
+        Ok(CodedResiduals {
+            params: CodecParams {
+                lattice: images.lattice,
+                qscale: self.0.qscale(opts),
+                gop: self.0.gop(opts),
+                padding: images.padding.method.to_string(),
+            },
+            atlas: Some(images.atlas.stats().clone()),
+            before_predictor: vec![Part::whole(Tag::LATTICE, lattice_part)],
+            after_predictor: vec![
+                Part::whole(Tag::RANGES, ranges.into_bytes()),
+                Part::whole(Tag::CODEC_SETUP, setup),
+                Part::whole(Tag::FRAME_INDEX, index.to_bytes()),
+                Part {
+                    tag: Tag::FRAMES,
+                    bytes: payload,
+                    checksum: Checksum::Chunked,
+                },
+            ],
+            stage_seconds: vec![
+                ("atlas".into(), atlas_seconds),
+                ("images".into(), images_seconds),
+            ],
+        })
+    }
+}
+
+/// Pads, tiles and codes every frame's images in order.
+fn code_pictures(
+    codec: &dyn PictureCodec,
+    images: &GeometryImages,
+    input: &ResidualInput,
+) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
+    let (w, h) = (images.lattice.0 as usize, images.lattice.1 as usize);
+    let mut encoder = codec.encoder((3 * w) as u32, h as u32, input.options)?;
+    let mut previous: Option<[Vec<f32>; 3]> = None;
+    for (f, frame) in input.residuals.iter().enumerate() {
+        // A new group starts from a key frame: its free pixels need no temporal continuity.
+        let prev = previous.as_ref().filter(|_| images.continues(f));
+        let padded = images.padded(frame, f, prev)?;
+        encoder.push(&tile::compose([&padded[0], &padded[1], &padded[2]], w, h))?;
+        previous = Some(padded);
+        input.progress.frames(1);
+    }
+    let (setup, chunks) = encoder.finish()?;
+    if chunks.len() != input.residuals.len() {
+        return Err(Error::Codec(format!(
+            "the {} encoder gave {} pictures for {} frames",
+            codec.codec().name(),
+            chunks.len(),
+            input.residuals.len()
+        )));
+    }
+    Ok((setup, chunks))
+}
+
+/// The geometry-image side of a stream: what the decoder reads before any picture.
+pub struct ImageLayout {
+    /// Lattice pixel of every vertex.
+    pub pixels: Vec<[u16; 2]>,
+    /// Residual range per frame and coordinate.
+    pub ranges: Vec<FrameRanges>,
+    /// Where each frame's picture lies.
+    pub index: FrameIndex,
+    /// The codec set-up part.
+    pub setup: Vec<u8>,
+    /// Lattice width and height.
+    pub lattice: (u16, u16),
+}
+
+/// The geometry-video residual decoder over one picture codec.
+pub struct Decoder<P> {
+    codec: P,
+    layout: ImageLayout,
+}
+
+impl<P: PictureCodec> Decoder<P> {
+    /// Reads the lattice coordinates, ranges, codec set-up and frame index.
+    pub fn open<R: Read + Seek>(
+        codec: P,
+        stream: &StreamLayout,
+        reader: &mut ContainerReader<R>,
+    ) -> Result<Self> {
+        let h = stream.header;
+        let (v, frames) = (h.vertices as usize, h.frames as usize);
+        let lattice = (h.lattice_width, h.lattice_height);
+        let pixels =
+            side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, stream.triangles)?;
+        let ranges_bytes = reader.part(Tag::RANGES)?;
+        let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
+        let ranges = quantise::read_ranges(&mut r, frames)?;
+        r.finish()?;
+        let setup = reader.part(Tag::CODEC_SETUP)?;
+        let images_len = reader.entry(Tag::FRAMES)?.len;
+        let index = FrameIndex::from_bytes(&reader.part(Tag::FRAME_INDEX)?, frames, images_len)?;
+        Ok(Self {
+            codec,
+            layout: ImageLayout {
+                pixels,
+                ranges,
+                index,
+                setup,
+                lattice,
+            },
+        })
+    }
+
+    fn picture_size(&self) -> (u32, u32) {
+        (
+            3 * u32::from(self.layout.lattice.0),
+            u32::from(self.layout.lattice.1),
+        )
+    }
+
+    fn picture_decoder(&self) -> Result<Box<dyn PictureDecoder>> {
+        let (w, h) = self.picture_size();
+        self.codec.decoder(w, h, &self.layout.setup)
+    }
+
+    fn next_picture<R: Read + Seek>(
+        &self,
+        decoder: &mut dyn PictureDecoder,
+        reader: &mut ContainerReader<R>,
+        f: usize,
+    ) -> Result<Plane> {
+        let e = self.layout.index.entry(f)?;
+        let chunk = reader.chunk(Tag::FRAMES, e.offset, e.len, e.crc, &format!("frame {f}"))?;
+        decoder.decode(f, &chunk)
+    }
+
+    /// Adds frame `f`'s residuals, read from `plane`, to `frame`.
+    fn add(&self, f: usize, plane: &Plane, frame: &mut [Point]) -> Result<()> {
+        let (w, h) = self.picture_size();
+        if plane.width != w || plane.height != h {
+            return Err(Error::Stream(format!(
+                "frame {f}: picture is {}x{}, expected {w}x{h}",
+                plane.width, plane.height
+            )));
+        }
+        let lw = self.layout.lattice.0 as usize;
+        for a in 0..3 {
+            let levels = tile::sample(plane, a, lw, &self.layout.pixels);
+            let range = self.layout.ranges[f][a];
+            for (p, l) in frame.iter_mut().zip(levels) {
+                p[a] += range.dequantise(l);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<P: PictureCodec, R: Read + Seek> ResidualDecoder<R> for Decoder<P> {
+    fn add_frame(
+        &mut self,
+        reader: &mut ContainerReader<R>,
+        f: usize,
+        frame: &mut [Point],
+    ) -> Result<()> {
+        let plane = ResidualDecoder::picture(self, reader, f)?;
+        self.add(f, &plane, frame)
+    }
+
+    fn add_all(
+        &mut self,
+        reader: &mut ContainerReader<R>,
+        frames: &mut [Vec<Point>],
+        progress: &dyn Progress,
+    ) -> Result<()> {
+        let mut decoder = self.picture_decoder()?;
+        for (f, frame) in frames.iter_mut().enumerate() {
+            let plane = self.next_picture(decoder.as_mut(), reader, f)?;
+            self.add(f, &plane, frame)?;
+            progress.frames(1);
+        }
+        Ok(())
+    }
+
+    fn images(&self) -> Option<&ImageLayout> {
+        Some(&self.layout)
+    }
+
+    fn picture(&mut self, reader: &mut ContainerReader<R>, f: usize) -> Result<Plane> {
+        self.layout.index.entry(f)?;
+        let key = self.layout.index.key_before(f);
+        let mut decoder = self.picture_decoder()?;
+        let mut last = None;
+        for g in key..=f {
+            last = Some(self.next_picture(decoder.as_mut(), reader, g)?);
+        }
+        last.ok_or_else(|| Error::Stream("no frame decoded".into()))
+    }
+}

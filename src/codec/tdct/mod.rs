@@ -1,0 +1,223 @@
+//! Temporal-DCT residual coding (`tdct`, skinning paper §3.3, eq. 12): no atlas, no images.
+//!
+//! Each vertex's residual trajectory along x, y and z is transformed over all frames, quantised
+//! with one step that `quality` sets as a fraction of the bounding-box diagonal, and coded band by
+//! band from low to high frequency ([`coefficients`]). Its parts come after the predictor's: the
+//! band index, then the bands, last in the file so that a stream cut inside them still decodes
+//! every complete band (a coarser animation).
+
+pub mod coefficients;
+
+use super::StreamLayout;
+use super::{CodecParams, CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
+use crate::encoder::EncodeOptions;
+use crate::error::{Error, Result};
+use crate::mesh::{AnimatedMesh, Point};
+use crate::progress::Progress;
+use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
+use coefficients::{BandCoder, BandIndex};
+use std::io::{Read, Seek};
+use std::time::Instant;
+
+pub use coefficients::{step_for_quality, DEAD_ZONE};
+
+/// The absolute quantiser step of an encoding: `step` (a fraction of the first frame's
+/// bounding-box diagonal) or the one `quality` maps to, rounded to the `f32` the stream stores, so
+/// that the encoder quantises with exactly the step the decoder reads.
+pub fn step(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<f32> {
+    let diagonal = mesh.bbox_diagonal();
+    let step = match opts.step {
+        Some(fraction) => diagonal * fraction,
+        None => step_for_quality(opts.quality, diagonal),
+    };
+    let stored = step as f32;
+    if !(stored.is_normal() && stored > 0.0) {
+        return Err(Error::Mesh(format!(
+            "the temporal-DCT step is {step} (first frame's bounding-box diagonal {diagonal}): \
+             a degenerate first frame gives no scale to quantise against"
+        )));
+    }
+    Ok(stored)
+}
+
+/// The temporal-DCT residual encoder.
+pub struct Encoder;
+
+impl ResidualEncoder for Encoder {
+    fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals> {
+        let clock = Instant::now();
+        input.progress.stage("temporal DCT");
+        let step = step(input.mesh, input.options)?;
+        let coefficients = coefficients::forward(input.residuals)?;
+        let levels = coefficients::quantise(&coefficients, f64::from(step), DEAD_ZONE)?;
+        let mut coder = BandCoder::new(input.mesh.vertex_count());
+        let chunks = levels
+            .iter()
+            .enumerate()
+            .map(|(k, band)| coder.encode(k, band))
+            .collect::<Result<Vec<_>>>()?;
+        let (index, payload) = BandIndex::build(step, chunks);
+        input.progress.frames(input.residuals.len() as u64);
+        Ok(CodedResiduals {
+            params: CodecParams {
+                lattice: (0, 0),
+                qscale: 0,
+                gop: 1,
+                padding: "none".into(),
+            },
+            atlas: None,
+            before_predictor: Vec::new(),
+            after_predictor: vec![
+                Part::whole(Tag::TDCT_INDEX, index.to_bytes()?),
+                // Last, so that a stream cut inside it still decodes the bands before the cut.
+                Part {
+                    tag: Tag::TDCT,
+                    bytes: payload,
+                    checksum: Checksum::Progressive,
+                },
+            ],
+            stage_seconds: vec![("temporal DCT".into(), clock.elapsed().as_secs_f64())],
+        })
+    }
+}
+
+/// The decoded temporal-DCT coefficients of a stream, read once at open.
+pub struct Bands {
+    /// Byte length of every band in the stream, decoded or not.
+    pub lengths: Vec<u64>,
+    /// Dequantised coefficients of the decoded bands (`[3v + a]`); `None` for an all-zero band.
+    /// Bands past the decoded ones are missing (truncated stream, or a preview) and count as zero.
+    pub decoded: Vec<Option<Vec<f32>>>,
+    /// Whether the stream was cut inside the coefficients part.
+    pub truncated: bool,
+    /// The quantiser step.
+    pub step: f32,
+}
+
+/// The temporal-DCT residual decoder.
+pub struct Decoder {
+    bands: Bands,
+    frames: usize,
+}
+
+impl Decoder {
+    /// Reads the band index and decodes the bands, low to high, up to `max_bands`, the end of a
+    /// truncated file, or the last band. A band cut by the end of the file ends decoding (it and
+    /// the rest count as zero); a band present in full that fails its CRC is damage, an error.
+    pub fn open<R: Read + Seek>(
+        stream: &StreamLayout,
+        reader: &mut ContainerReader<R>,
+        max_bands: Option<usize>,
+    ) -> Result<Self> {
+        let (vertices, frames) = (
+            stream.header.vertices as usize,
+            stream.header.frames as usize,
+        );
+        let entry = reader.entry(Tag::TDCT)?;
+        let declared = reader.truncated(Tag::TDCT);
+        let index = BandIndex::from_bytes(
+            &reader.part(Tag::TDCT_INDEX)?,
+            frames,
+            declared.unwrap_or(entry.len),
+        )?;
+        let step = index.step;
+        let limit = max_bands.unwrap_or(frames).min(frames);
+        let mut coder = BandCoder::new(vertices);
+        let mut decoded = Vec::new();
+        for (k, band) in index.bands.iter().enumerate().take(limit) {
+            if band.offset + band.len > entry.len {
+                break;
+            }
+            let bytes = if band.len == 0 {
+                Vec::new()
+            } else {
+                let what = format!("temporal-DCT band {k}");
+                reader.chunk(Tag::TDCT, band.offset, band.len, band.crc, &what)?
+            };
+            decoded.push(dequantise(k, coder.decode(k, &bytes)?, step)?);
+        }
+        Ok(Self {
+            bands: Bands {
+                lengths: index.bands.iter().map(|b| b.len).collect(),
+                decoded,
+                truncated: declared.is_some(),
+                step,
+            },
+            frames,
+        })
+    }
+}
+
+/// Band `k`'s coefficients from its levels.
+fn dequantise(k: usize, levels: Option<Vec<i64>>, step: f32) -> Result<Option<Vec<f32>>> {
+    let coefficients = levels.map(|l| -> Vec<f32> {
+        l.iter()
+            .map(|&q| (q as f64 * f64::from(step)) as f32)
+            .collect()
+    });
+    // Levels are bounded but the step is any positive f32: their product can overflow, and an
+    // infinite coefficient would turn every frame's coordinates into infinities or NaN.
+    if coefficients
+        .as_ref()
+        .is_some_and(|c| c.iter().any(|x| !x.is_finite()))
+    {
+        return Err(Error::Stream(format!(
+            "temporal-DCT band {k}: a level times the step {step:e} is not a finite number"
+        )));
+    }
+    Ok(coefficients)
+}
+
+impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
+    /// Sums the decoded bands' basis functions at `f`: O(V · bands).
+    fn add_frame(
+        &mut self,
+        _reader: &mut ContainerReader<R>,
+        f: usize,
+        frame: &mut [Point],
+    ) -> Result<()> {
+        let mut sum = vec![0.0f64; 3 * frame.len()];
+        for (k, band) in self.bands.decoded.iter().enumerate() {
+            if let Some(c) = band {
+                let b = coefficients::basis(k, f, self.frames);
+                for (s, &c) in sum.iter_mut().zip(c) {
+                    *s += f64::from(c) * b;
+                }
+            }
+        }
+        for (p, s) in frame.iter_mut().zip(sum.chunks_exact(3)) {
+            for a in 0..3 {
+                p[a] += s[a] as f32;
+            }
+        }
+        Ok(())
+    }
+
+    /// The inverse DCT of each vertex/axis sequence (rustdct's DCT-III over all frames).
+    fn add_all(
+        &mut self,
+        _reader: &mut ContainerReader<R>,
+        frames: &mut [Vec<Point>],
+        progress: &dyn Progress,
+    ) -> Result<()> {
+        let vertices = frames.first().map_or(0, Vec::len);
+        let mut inverse = coefficients::Inverse::new(self.frames);
+        for v in 0..vertices {
+            for a in 0..3 {
+                let x = inverse.run(|k| match self.bands.decoded.get(k) {
+                    Some(Some(c)) => f64::from(c[3 * v + a]),
+                    _ => 0.0,
+                });
+                for (frame, &x) in frames.iter_mut().zip(x) {
+                    frame[v][a] += x as f32;
+                }
+            }
+        }
+        progress.frames(frames.len() as u64);
+        Ok(())
+    }
+
+    fn bands(&self) -> Option<&Bands> {
+        Some(&self.bands)
+    }
+}

@@ -1,0 +1,163 @@
+//! The analysis half of the encoder: the first frame the decoder will have, the motion
+//! segmentation, and the quantised predictor with every frame's residual against it. `inspect`
+//! redoes it on a stream's own partition to show the images the encoder coded.
+
+use super::options::{EncodeOptions, Segmentation};
+use crate::error::{Error, Result};
+use crate::first_frame::{self, EncodedFirstFrame, FirstFrameOptions};
+use crate::mesh::{AnimatedMesh, Point};
+use crate::motion::{
+    self, AffineTrack, DecimateOptions, Partition, PredictorKind, SegmentOptions, SkinningWeights,
+};
+use std::time::Instant;
+
+/// What the segmentation stage did, for reports.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SegmentationReport {
+    /// `kmeans` or `decimation`.
+    pub method: &'static str,
+    /// Clusters found (K).
+    pub clusters: usize,
+    /// Seconds the segmentation took.
+    pub seconds: f64,
+    /// Decimation only: the threshold E0 asked for.
+    pub e0: Option<f64>,
+    /// Decimation only: the RMS affine-fit error per vertex and frame reached, over the bbox diagonal (E_l).
+    pub error: Option<f64>,
+    /// Decimation only: connected components (seams welded), a lower bound on K.
+    pub components: Option<usize>,
+}
+
+/// The quantised predictor and every frame's residuals against it.
+pub struct Prediction {
+    /// The quantised affine track.
+    pub track: AffineTrack,
+    /// The quantised skinning weights (skinning predictor only).
+    pub weights: Option<SkinningWeights>,
+    /// `residuals[f][v]`: frame f's residual of vertex v.
+    pub residuals: Vec<Vec<[f32; 3]>>,
+}
+
+/// Codes the first frame and, when the coder reordered the vertices, permutes the animation the
+/// same way: everything after it works in the stream's vertex order.
+pub fn first_frame(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+) -> Result<(EncodedFirstFrame, Option<AnimatedMesh>)> {
+    let ff = first_frame::encode(
+        mesh.frame(0),
+        mesh.triangles(),
+        &FirstFrameOptions {
+            bits: opts.first_frame_bits,
+            reorder: opts.reorder,
+        },
+    )?;
+    let permuted = match &ff.permutation {
+        Some(perm) => Some(mesh.permuted(perm)?),
+        None => None,
+    };
+    Ok((ff, permuted))
+}
+
+/// The motion segmentation `opts` ask for, and what it did.
+pub fn segment(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+) -> Result<(Partition, SegmentationReport)> {
+    let start = Instant::now();
+    let (partition, e0, error, components) = match opts.segmentation {
+        Segmentation::KMeans => {
+            let options = SegmentOptions {
+                clusters: opts.clusters,
+                ..SegmentOptions::default()
+            };
+            (motion::segment(mesh, &options)?, None, None, None)
+        }
+        Segmentation::Decimation { e0 } => {
+            let options = DecimateOptions {
+                e0,
+                ..DecimateOptions::default()
+            };
+            let d = motion::decimate(mesh, &options)?;
+            (d.partition, Some(e0), Some(d.error), Some(d.components))
+        }
+    };
+    let report = SegmentationReport {
+        method: opts.segmentation.name(),
+        clusters: partition.clusters(),
+        seconds: start.elapsed().as_secs_f64(),
+        e0,
+        error,
+        components,
+    };
+    Ok((partition, report))
+}
+
+/// The quantised predictor (affine track, skinning weights) and every frame's residuals against
+/// it, as the decoder will rebuild them: closed loop.
+pub fn predict(
+    mesh: &AnimatedMesh,
+    reference: &[Point],
+    partition: &Partition,
+    opts: &EncodeOptions,
+) -> Result<Prediction> {
+    let track = AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_bits)?;
+    let weights = match opts.predictor {
+        PredictorKind::Affine => None,
+        PredictorKind::Skinning => Some(SkinningWeights::fit_with(
+            mesh.frames(),
+            reference,
+            partition,
+            mesh.triangles(),
+            &track,
+            motion::DEFAULT_RIDGE,
+            opts.weight_bits,
+        )?),
+    };
+    let residuals = (0..mesh.frame_count())
+        .map(|f| {
+            let predicted =
+                motion::predict_frame(&track, weights.as_ref(), f, reference, partition)?;
+            Ok(motion::residuals(mesh.frame(f), &predicted))
+        })
+        .collect::<Result<_>>()?;
+    Ok(Prediction {
+        track,
+        weights,
+        residuals,
+    })
+}
+
+/// The encoder's analysis of `original` redone with a stream's options and partition.
+pub struct Redone {
+    /// The decoded first frame.
+    pub reference: Vec<Point>,
+    /// The connectivity in the stream's vertex order.
+    pub triangles: Vec<[u32; 3]>,
+    /// The predictor and the residuals the stream's residual codec was given.
+    pub prediction: Prediction,
+}
+
+/// Redoes the encoder's analysis of `original` with a stream's options and partition: the
+/// residuals the stream's codec was given, in the stream's vertex order.
+pub fn redo(
+    original: &AnimatedMesh,
+    opts: &EncodeOptions,
+    partition: &Partition,
+) -> Result<Redone> {
+    let (ff, permuted) = first_frame(original, opts)?;
+    let mesh = permuted.as_ref().unwrap_or(original);
+    if partition.labels().len() != mesh.vertex_count() {
+        return Err(Error::Usage(format!(
+            "the original has {} vertices; the stream's partition {}",
+            mesh.vertex_count(),
+            partition.labels().len()
+        )));
+    }
+    let prediction = predict(mesh, &ff.decoded_positions, partition, opts)?;
+    Ok(Redone {
+        triangles: mesh.triangles().to_vec(),
+        reference: ff.decoded_positions,
+        prediction,
+    })
+}

@@ -1,0 +1,231 @@
+//! The encoder: mesh → first frame → motion segmentation → predictor and residuals → residual
+//! codec → stream. [`encode`] is a chain of small stages; what a codec does with the residuals is
+//! behind [`ResidualEncoder`](crate::codec::ResidualEncoder), and the container only sees parts.
+
+pub mod analysis;
+mod options;
+
+pub use analysis::{Prediction, SegmentationReport};
+pub use options::{EncodeOptions, Segmentation, DEFAULT_QUALITY};
+
+use crate::codec::{CodecParams, ResidualInput};
+use crate::error::Result;
+use crate::mesh::AnimatedMesh;
+use crate::motion::Partition;
+use crate::progress::{Progress, Silent};
+use crate::stream::container::{ContainerWriter, Part, Tag};
+use crate::stream::header::Header;
+use crate::stream::side_info;
+use std::path::Path;
+use std::time::Instant;
+
+/// What an encoding produced, for reports.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct EncodeReport {
+    /// The stream header.
+    pub header: Header,
+    /// Bytes per part, in file order.
+    pub parts: Vec<(String, u64)>,
+    /// Total file bytes.
+    pub bytes: u64,
+    /// Bits per vertex per frame.
+    pub bpvf: f64,
+    /// Charts in the atlas (0 for codecs without an atlas).
+    pub charts: usize,
+    /// Chart pixels / lattice pixels (0 without an atlas).
+    pub packing_efficiency: f64,
+    /// Vertices moved to resolve lattice collisions (0 without an atlas).
+    pub moved_vertices: usize,
+    /// Area-weighted L2 stretch of the charts (1 = none; 0 without an atlas).
+    pub l2_stretch: f64,
+    /// Seconds per stage.
+    pub stage_seconds: Vec<(String, f64)>,
+    /// The segmentation: method, K found, its time (and for decimation, the error reached).
+    pub segmentation: SegmentationReport,
+    /// If the first-frame coder reordered vertices: new index → input index.
+    #[serde(skip)]
+    pub permutation: Option<Vec<u32>>,
+}
+
+/// An encoded stream in memory, and what it took.
+pub struct Encoded {
+    /// The container, ready to be written.
+    pub container: ContainerWriter,
+    /// The figures of the encoding.
+    pub report: EncodeReport,
+}
+
+impl Encoded {
+    /// The `.mcgv` file's bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        self.container.to_bytes()
+    }
+
+    /// Writes the `.mcgv` file so that a failure never leaves half of one; returns its size.
+    pub fn write(&self, path: &Path) -> Result<u64> {
+        self.container.write_atomic(path)
+    }
+}
+
+/// Encodes an animation.
+pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Encoded> {
+    encode_with_progress(mesh, opts, &Silent)
+}
+
+/// Encodes an animation, telling `progress` each stage and each frame coded.
+pub fn encode_with_progress(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    progress: &dyn Progress,
+) -> Result<Encoded> {
+    opts.check(mesh)?;
+    let mut clock = Stopwatch::default();
+    clock.restart();
+    progress.stage("first frame");
+    let (ff, permuted) = analysis::first_frame(mesh, opts)?;
+    let mesh = permuted.as_ref().unwrap_or(mesh);
+    clock.lap("first frame");
+    progress.stage("segmentation");
+    let (partition, segmentation) = analysis::segment(mesh, opts)?;
+    clock.lap("segmentation");
+    progress.stage("motion");
+    let prediction = analysis::predict(mesh, &ff.decoded_positions, &partition, opts)?;
+    clock.lap("motion");
+    let coded = opts.codec.encoder()?.encode(&ResidualInput {
+        mesh,
+        reference: &ff.decoded_positions,
+        partition: &partition,
+        residuals: &prediction.residuals,
+        options: opts,
+        progress,
+    })?;
+    clock.stages.extend(coded.stage_seconds);
+    clock.restart();
+    let atlas = coded.atlas;
+    let header = header(mesh, opts, &partition, &coded.params, atlas.as_ref());
+    let parts = (coded.before_predictor, coded.after_predictor);
+    let container = assemble(&header, ff.bytes, mesh, &partition, &prediction, parts)?;
+    clock.lap("side information");
+    let report = EncodeReport {
+        stage_seconds: clock.stages,
+        ..report(header, &container, atlas.as_ref(), segmentation)
+    };
+    Ok(Encoded {
+        container,
+        report: EncodeReport {
+            permutation: ff.permutation,
+            ..report
+        },
+    })
+}
+
+/// Seconds per stage.
+#[derive(Default)]
+struct Stopwatch {
+    stages: Vec<(String, f64)>,
+    start: Option<Instant>,
+}
+
+impl Stopwatch {
+    fn lap(&mut self, name: &str) {
+        let start = self.start.unwrap_or_else(Instant::now);
+        self.stages
+            .push((name.to_string(), start.elapsed().as_secs_f64()));
+        self.restart();
+    }
+
+    fn restart(&mut self) {
+        self.start = Some(Instant::now());
+    }
+}
+
+/// The stream header of an encoding.
+fn header(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    partition: &Partition,
+    params: &CodecParams,
+    atlas: Option<&atlas::AtlasStats>,
+) -> Header {
+    Header {
+        vertices: mesh.vertex_count() as u32,
+        frames: mesh.frame_count() as u32,
+        triangles: mesh.triangles().len() as u32,
+        clusters: partition.clusters() as u32,
+        lattice_width: params.lattice.0,
+        lattice_height: params.lattice.1,
+        codec: opts.codec,
+        quality: opts.quality,
+        qscale: params.qscale,
+        gop: params.gop,
+        affine_bits: opts.affine_bits,
+        first_frame_bits: opts.first_frame_bits,
+        padding: params.padding.clone(),
+        // Decimation asks for no K: the header then records the K it found.
+        requested_clusters: match opts.segmentation {
+            Segmentation::KMeans => opts.clusters as u32,
+            Segmentation::Decimation { .. } => partition.clusters() as u32,
+        },
+        reorder: opts.reorder,
+        charts: atlas.map_or(0, |s| s.charts as u32),
+        chart_pixels: atlas.map_or(0, |s| s.chart_pixels as u32),
+        predictor: opts.predictor,
+    }
+}
+
+/// The container in file order: header, first frame, partition, the codec's leading parts, the
+/// predictor (affine track, skinning weights), the codec's other parts.
+fn assemble(
+    header: &Header,
+    first_frame: Vec<u8>,
+    mesh: &AnimatedMesh,
+    partition: &Partition,
+    prediction: &Prediction,
+    (before, after): (Vec<Part>, Vec<Part>),
+) -> Result<ContainerWriter> {
+    let triangles = mesh.triangles();
+    let mut parts = vec![
+        Part::whole(Tag::HEADER, header.to_bytes()),
+        Part::whole(Tag::FIRST_FRAME, first_frame),
+        Part::whole(
+            Tag::PARTITION,
+            side_info::encode_partition(partition.labels(), partition.clusters(), triangles)?,
+        ),
+    ];
+    parts.extend(before);
+    parts.push(Part::whole(
+        Tag::AFFINE,
+        side_info::encode_affine(&prediction.track)?,
+    ));
+    if let Some(weights) = &prediction.weights {
+        let bytes = side_info::encode_weights(weights, partition, triangles)?;
+        parts.push(Part::whole(Tag::WEIGHTS, bytes));
+    }
+    parts.extend(after);
+    let mut container = ContainerWriter::new();
+    parts.into_iter().for_each(|p| container.push(p));
+    Ok(container)
+}
+
+/// The figures of an encoding.
+fn report(
+    header: Header,
+    container: &ContainerWriter,
+    atlas: Option<&atlas::AtlasStats>,
+    segmentation: SegmentationReport,
+) -> EncodeReport {
+    let bytes = container.to_bytes().len() as u64;
+    EncodeReport {
+        parts: container.part_sizes(),
+        bpvf: bytes as f64 * 8.0 / (header.vertices as f64 * header.frames as f64),
+        header,
+        bytes,
+        charts: atlas.map_or(0, |s| s.charts),
+        packing_efficiency: atlas.map_or(0.0, |s| s.packing_efficiency),
+        moved_vertices: atlas.map_or(0, |s| s.moved_vertices),
+        l2_stretch: atlas.map_or(0.0, |s| s.l2_stretch),
+        stage_seconds: Vec::new(),
+        segmentation,
+        permutation: None,
+    }
+}

@@ -1,0 +1,211 @@
+//! Everything a caller can choose about an encoding, its defaults, and the checks that refuse
+//! nonsense before any work starts (each error names the option's field).
+
+use crate::codec::Codec;
+use crate::error::{Error, Result};
+use crate::geometry_image::{lattice, Lattice};
+use crate::mesh::AnimatedMesh;
+use crate::motion::{self, PredictorKind};
+use crate::stream::header::Header;
+
+/// Default `quality`: the middle of the useful range. On CesiumMan it gives RMSE 2.6e-4 of the
+/// diagonal (under half a millimetre on a 1.8 m figure) at 6.5 bpvf with MPEG-4 (qscale 4); 75
+/// (qscale 2) costs 1.6× the bits for 0.6× the error (scripts/sweep.sh on media/CesiumMan.glb).
+pub const DEFAULT_QUALITY: u8 = 50;
+
+/// Everything the caller can choose about an encoding.
+#[derive(Debug, Clone)]
+pub struct EncodeOptions {
+    /// The residual codec.
+    pub codec: Codec,
+    /// Rate knob 1..100 (higher = better).
+    pub quality: u8,
+    /// MPEG-4 quantiser; `None` derives it from `quality`.
+    pub qscale: Option<u8>,
+    /// Motion clusters K (k-means only; decimation finds its own).
+    pub clusters: usize,
+    /// How the vertices are split into motion clusters.
+    pub segmentation: Segmentation,
+    /// Bits per affine coefficient.
+    pub affine_bits: u8,
+    /// Bits per coordinate of the first frame.
+    pub first_frame_bits: u8,
+    /// Lattice width and height, or chosen from the mesh.
+    pub lattice: Lattice,
+    /// Padding of the free pixels; `None` picks the codec's measured best.
+    pub padding: Option<padding::Method>,
+    /// MPEG-4 group of pictures.
+    pub gop: usize,
+    /// Let the first-frame coder permute vertices.
+    pub reorder: bool,
+    /// The motion predictor (piecewise affine by default).
+    pub predictor: PredictorKind,
+    /// Bits per skinning weight, sign included (the paper's 16 by default).
+    pub weight_bits: u8,
+    /// Residual ranges narrower than this fraction of the sequence's widest are widened to it, so
+    /// frames with small residuals get coarser levels instead of the full 0..255 (0 = off).
+    pub range_floor: f32,
+    /// Temporal-DCT quantiser step as a fraction of the first frame's bounding-box diagonal;
+    /// `None` derives it from `quality` (tdct only).
+    pub step: Option<f64>,
+}
+
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        Self {
+            codec: Codec::Jpeg,
+            quality: DEFAULT_QUALITY,
+            qscale: None,
+            clusters: 20,
+            segmentation: Segmentation::KMeans,
+            affine_bits: 17,
+            first_frame_bits: 12,
+            lattice: Lattice::Auto,
+            padding: None,
+            gop: 50,
+            reorder: false,
+            predictor: PredictorKind::Affine,
+            weight_bits: motion::WEIGHT_BITS,
+            range_floor: 0.0,
+            step: None,
+        }
+    }
+}
+
+/// The motion segmentation of an encoding.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Segmentation {
+    /// k-means on per-vertex affine motion with border refinement, K = `EncodeOptions::clusters` (MCGV §3.1).
+    KMeans,
+    /// Half-edge collapses by affine-motion cost until the RMS fit error reaches `e0` of the
+    /// bounding-box diagonal (skinning paper §3.1); K falls out of it.
+    Decimation {
+        /// The error threshold E0 (the paper's 0.003).
+        e0: f64,
+    },
+}
+
+impl Segmentation {
+    /// The name used in reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Segmentation::KMeans => "kmeans",
+            Segmentation::Decimation { .. } => "decimation",
+        }
+    }
+}
+
+impl EncodeOptions {
+    /// The options a stream was encoded with, as far as its header records them: enough to redo
+    /// the encoder's analysis on the stream's own partition (`weight_bits` is in the weights part).
+    pub fn from_header(header: &Header, weight_bits: Option<u8>) -> Result<Self> {
+        Ok(Self {
+            codec: header.codec,
+            quality: header.quality,
+            qscale: Some(header.qscale).filter(|&q| q > 0),
+            clusters: header.requested_clusters as usize,
+            // The segmentation is not redone: the stream carries its partition.
+            segmentation: Segmentation::KMeans,
+            affine_bits: header.affine_bits,
+            first_frame_bits: header.first_frame_bits,
+            lattice: Lattice::Fixed(header.lattice_width, header.lattice_height),
+            padding: match header.codec.has_images() {
+                true => Some(
+                    header
+                        .padding
+                        .parse()
+                        .map_err(|e| Error::Stream(format!("padding {}: {e}", header.padding)))?,
+                ),
+                false => None,
+            },
+            gop: header.gop as usize,
+            reorder: header.reorder,
+            predictor: header.predictor,
+            weight_bits: weight_bits.unwrap_or(motion::WEIGHT_BITS),
+            range_floor: 0.0,
+            step: None,
+        })
+    }
+
+    /// Fails, naming the field, when an option is out of range or does not apply to the codec.
+    pub fn check(&self, mesh: &AnimatedMesh) -> Result<()> {
+        self.check_ranges()?;
+        if self.codec == Codec::Tdct {
+            self.check_tdct()?;
+        } else if self.step.is_some() {
+            return Err(Error::option("step", "applies to the tdct codec only"));
+        }
+        if !self.codec.available() {
+            return Err(Error::option(
+                "codec",
+                format!("{}: this build has no such codec", self.codec.name()),
+            ));
+        }
+        if mesh.triangles().is_empty() {
+            return Err(Error::Mesh(
+                "the mesh has no triangles: nothing to parameterize".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    fn check_ranges(&self) -> Result<()> {
+        if self.clusters == 0 {
+            return Err(Error::option("clusters", "must be at least 1"));
+        }
+        if let Segmentation::Decimation { e0 } = self.segmentation {
+            if !(e0.is_finite() && e0 > 0.0) {
+                return Err(Error::option(
+                    "e0",
+                    format!("must be a positive fraction of the bounding-box diagonal, not {e0}"),
+                ));
+            }
+        }
+        if !(8..=32).contains(&self.affine_bits) {
+            return Err(Error::option("affine_bits", "must be between 8 and 32"));
+        }
+        if let Lattice::Fixed(w, h) = self.lattice {
+            lattice::check(w, h)?;
+        }
+        if !(2..=31).contains(&self.weight_bits) {
+            return Err(Error::option("weight_bits", "must be between 2 and 31"));
+        }
+        if !(0.0..=1.0).contains(&self.range_floor) {
+            return Err(Error::option(
+                "range_floor",
+                format!("must be between 0 and 1, not {}", self.range_floor),
+            ));
+        }
+        if self.gop == 0 {
+            return Err(Error::option("gop", "must be at least 1"));
+        }
+        Ok(())
+    }
+
+    fn check_tdct(&self) -> Result<()> {
+        if let Some(step) = self.step {
+            if !(step.is_finite() && step > 0.0 && step <= 1.0) {
+                return Err(Error::option(
+                    "step",
+                    format!("{step}: expected a fraction of the bounding-box diagonal in (0, 1]"),
+                ));
+            }
+        }
+        let no_images = |option| {
+            Err(Error::option(
+                option,
+                "applies to the image codecs: tdct has no geometry images",
+            ))
+        };
+        if let Lattice::Fixed(..) = self.lattice {
+            return no_images("lattice");
+        }
+        if self.range_floor > 0.0 {
+            return no_images("range_floor");
+        }
+        if self.padding.is_some() {
+            return no_images("padding");
+        }
+        Ok(())
+    }
+}

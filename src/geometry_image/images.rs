@@ -1,0 +1,117 @@
+//! One frame's three residual images (x, y, z) on the atlas: the quantised residuals at each
+//! vertex's pixel, then padded. The encoder and `inspect` both make them here, so the pictures
+//! `inspect` shows are the ones the encoder coded.
+
+use super::quantise::{self, FrameRanges, RangeMode};
+use crate::error::Result;
+
+/// What it takes to make an encoding's residual images.
+pub struct GeometryImages {
+    /// The lattice size.
+    pub lattice: (u16, u16),
+    /// The atlas: each vertex's pixel, the chart pixels.
+    pub atlas: atlas::Atlas,
+    /// Residual range per frame and coordinate.
+    pub ranges: Vec<FrameRanges>,
+    /// How free pixels are filled.
+    pub padding: padding::PaddingOptions,
+    /// Frames per group: the first frame of a group is padded on its own, the others continue the
+    /// previous frame's padding (P-frames); 1 for intra codecs.
+    pub gop: usize,
+}
+
+impl GeometryImages {
+    /// The images of an encoding on `atlas`, with the ranges `residuals` span as `mode` groups
+    /// them, widened to `range_floor` of the widest.
+    pub fn new(
+        lattice: (u16, u16),
+        atlas: atlas::Atlas,
+        residuals: &[Vec<[f32; 3]>],
+        mode: RangeMode,
+        range_floor: f32,
+        padding: padding::PaddingOptions,
+    ) -> Self {
+        let mut ranges = quantise::frame_ranges(residuals, mode);
+        quantise::widen(&mut ranges, range_floor);
+        let gop = match mode {
+            RangeMode::PerFrame => 1,
+            RangeMode::PerGroup(n) => n.max(1),
+        };
+        Self {
+            lattice,
+            atlas,
+            ranges,
+            padding,
+            gop,
+        }
+    }
+
+    fn size(&self) -> (usize, usize) {
+        (self.lattice.0 as usize, self.lattice.1 as usize)
+    }
+
+    /// Frame `f`'s residuals of coordinate `axis` as levels in `0..=255` on the lattice, before
+    /// padding (free pixels are 0).
+    pub fn level_image(&self, frame: &[[f32; 3]], f: usize, axis: usize) -> Result<Vec<f32>> {
+        let range = self.ranges[f][axis];
+        let levels: Vec<f32> = frame.iter().map(|r| range.quantise(r[axis])).collect();
+        Ok(self.atlas.try_splat(&levels)?)
+    }
+
+    /// The three level images of frame `f` with every pixel that carries no vertex at 0.
+    pub fn raw(&self, frame: &[[f32; 3]], f: usize) -> Result<[Vec<f32>; 3]> {
+        let fixed = self.atlas.fixed_mask();
+        let mut out: [Vec<f32>; 3] = Default::default();
+        for (a, img) in out.iter_mut().enumerate() {
+            *img = self.level_image(frame, f, a)?;
+            for (p, &keep) in img.iter_mut().zip(&fixed) {
+                if !keep {
+                    *p = 0.0;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The three padded images of frame `f` (levels in `0..=255`, before rounding). `previous`
+    /// holds the previous frame's padded images when `f` continues a group (see [`Self::continues`]).
+    pub fn padded(
+        &self,
+        frame: &[[f32; 3]],
+        f: usize,
+        previous: Option<&[Vec<f32>; 3]>,
+    ) -> Result<[Vec<f32>; 3]> {
+        let (w, h) = self.size();
+        let fixed = self.atlas.fixed_mask();
+        let mut out: [Vec<f32>; 3] = Default::default();
+        for (a, img) in out.iter_mut().enumerate() {
+            let mut image = self.level_image(frame, f, a)?;
+            padding::pad(
+                &mut image,
+                w,
+                h,
+                &fixed,
+                previous.map(|p| p[a].as_slice()),
+                &self.padding,
+            )?;
+            *img = image;
+        }
+        Ok(out)
+    }
+
+    /// Whether frame `f` is padded against the previous frame's images (not the first of its group).
+    pub fn continues(&self, f: usize) -> bool {
+        f % self.gop != 0
+    }
+
+    /// Frame `f`'s padded images as the encoder made them, re-padding from the start of its group
+    /// when it continues one (`residuals[g]` is frame g's residuals).
+    pub fn padded_alone(&self, residuals: &[Vec<[f32; 3]>], f: usize) -> Result<[Vec<f32>; 3]> {
+        let start = f - f % self.gop;
+        let mut images = self.padded(&residuals[start], start, None)?;
+        for g in start + 1..=f {
+            images = self.padded(&residuals[g], g, Some(&images))?;
+        }
+        Ok(images)
+    }
+}

@@ -1,3 +1,0 @@
-fn main() {
-    std::process::exit(mcgv_video::cli::main());
-}
