@@ -10,15 +10,15 @@
 //! variables `REFINE`, `FEATURE_FRAMES`, `KMEANS_ITERATIONS` and `CLUSTERS` override the matching
 //! `SegmentOptions`, `E0` and `DECIMATE_REFINE` decimation's threshold and border refinement rounds,
 //! and `SEGMENTATION=kmeans|decimation` runs one method only; `SKIN_RIDGE` and `SKIN_BITS` set the
-//! relative ridge and bits per weight of the skinning fits; `PICTURES=DIR` writes each partition's
-//! picture (frame 0 coloured by cluster) there.
+//! relative ridge and bits per weight of the skinning fits. (A partition's picture: encode, then
+//! `mcgv-video inspect STREAM --png DIR` writes `segmentation.png`.)
 //! The `E_l` column is decimation's RMS affine-fit error per vertex and frame over the bbox diagonal;
 //! `K0` is the K its collapses alone left, before border refinement (NaN and 0 on k-means rows).
 
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
-    decimate, energy, render_partition_png, residuals, segment, AffineTrack, DecimateOptions,
-    Partition, SegmentOptions, SkinningWeights, DEFAULT_AFFINE_BITS, DEFAULT_RIDGE, WEIGHT_BITS,
+    decimate, energy, residuals, segment, AffineTrack, DecimateOptions, Partition, SegmentOptions,
+    SkinningWeights, DEFAULT_AFFINE_BITS, DEFAULT_RIDGE, WEIGHT_BITS,
 };
 use mcgv_video::stream::side_info::encode_weights;
 use mcgv_video::AnimatedMesh;
@@ -165,13 +165,6 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
         Err(e) => return println!("{name:<22} {label:<10} segmentation failed: {e}"),
     };
     let segment_time = start.elapsed().as_secs_f64();
-    if let Ok(dir) = std::env::var("PICTURES") {
-        let path = Path::new(&dir).join(format!("{name}-{label}.png"));
-        let (frame0, labels) = (mesh.frame(0), partition.labels());
-        if let Err(e) = render_partition_png(frame0, mesh.triangles(), labels, 512, &path) {
-            println!("{name}: picture not written: {e}");
-        }
-    }
 
     // The reference is the original frame 0: the decoded one is not available to this stage alone.
     let start = Instant::now();

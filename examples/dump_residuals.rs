@@ -5,9 +5,10 @@
 //! `cargo run --release --example dump_residuals -- INPUT OUT_DIR [FRAMES]` (default 24 frames, evenly
 //! spread), then `cargo run --release -p padding --example jpeg_bench -- folder --per-frame 3 OUT_DIR`.
 
-use mcgv_video::encoder::{analyse, level_image, EncodeOptions};
+use mcgv_video::codec::geometry_video;
+use mcgv_video::encoder::{analysis, EncodeOptions};
+use mcgv_video::first_frame;
 use mcgv_video::mesh::read_animation;
-use mcgv_video::stream::first_frame;
 use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -27,9 +28,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             reorder: false,
         },
     )?;
-    let analysis = analyse(&mesh, ff.decoded_positions, &opts)?;
-    let (w, h) = (analysis.lattice.0 as u32, analysis.lattice.1 as u32);
-    let mask: Vec<u8> = analysis
+    let (partition, _) = analysis::segment(&mesh, &opts)?;
+    let prediction = analysis::predict(&mesh, &ff.decoded_positions, &partition, &opts)?;
+    let pictures = opts.codec.pictures()?.ok_or("the codec makes no images")?;
+    let images = geometry_video::images_of(
+        pictures.as_ref(),
+        &ff.decoded_positions,
+        mesh.triangles(),
+        &partition,
+        &prediction.residuals,
+        &opts,
+    )?;
+    let (w, h) = (images.lattice.0 as u32, images.lattice.1 as u32);
+    let mask: Vec<u8> = images
         .atlas
         .fixed_mask()
         .iter()
@@ -40,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for i in 0..wanted.min(frames) {
         let f = i * frames / wanted.min(frames);
         for (a, c) in ["x", "y", "z"].iter().enumerate() {
-            let levels = level_image(&analysis, f, a)?;
+            let levels = images.level_image(&prediction.residuals[f], f, a)?;
             let grey: Vec<u16> = levels
                 .iter()
                 .map(|&v| (v.clamp(0.0, 255.0) * 257.0).round() as u16)

@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use mcgv_video::first_frame::{decode, encode, FirstFrameOptions};
 use mcgv_video::mesh::{Point, Triangle};
-use mcgv_video::stream::first_frame::{decode, encode, FirstFrameOptions};
 use mcgv_video::{Error, Result};
 
 /// Positions and position-index triangles of every model in an OBJ file, concatenated.

@@ -195,4 +195,32 @@ mod tests {
         assert_eq!(*image.get_pixel(8, 24), front);
         assert_eq!(*image.get_pixel(31, 0), BACKGROUND);
     }
+
+    #[test]
+    fn every_cluster_gets_its_colour_and_bad_labels_are_errors() {
+        // A 4×4 grid of squares tilted towards the viewer, left half cluster 0, right half 1.
+        let positions: Vec<Point> = (0..25)
+            .map(|i| [(i % 5) as f32, (i / 5) as f32, 0.3 * (i / 5) as f32])
+            .collect();
+        let mut triangles = Vec::new();
+        for y in 0..4u32 {
+            for x in 0..4u32 {
+                let a = y * 5 + x;
+                triangles.push([a, a + 1, a + 6]);
+                triangles.push([a, a + 6, a + 5]);
+            }
+        }
+        let labels: Vec<u32> = (0..25).map(|i| u32::from(i % 5 >= 2)).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("partition.png");
+        render_partition_png(&positions, &triangles, &labels, 64, &path).unwrap();
+        let image = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(image.dimensions(), (64, 64));
+        let mut colours: Vec<[u8; 3]> = image.pixels().map(|p| p.0).collect();
+        colours.sort();
+        colours.dedup();
+        // Background plus two hues.
+        assert!(colours.len() >= 3, "{} colours", colours.len());
+        assert!(render_partition_png(&positions, &triangles, &labels[1..], 64, &path).is_err());
+    }
 }

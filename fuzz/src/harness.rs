@@ -1,15 +1,13 @@
 //! The fuzz targets' bodies. Uses only `mcgv_video` and `crc32fast`, so the regression test
 //! (`tests/fuzz_regressions.rs`) includes this file by path and replays crashers through the same code.
 
+use mcgv_video::codec::tdct::coefficients::BandIndex;
 use mcgv_video::codec::Codec;
-use mcgv_video::commands::info::Info;
 use mcgv_video::decoder::Decoder;
-use mcgv_video::mesh::{parse_gltf, parse_obj, parse_pc2, AnimatedMesh, Triangle};
-use mcgv_video::stream::container::{ContainerReader, FILE_HEADER_LEN, PART_HEADER_LEN};
-use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
-use mcgv_video::stream::tdct::BandIndex;
+use mcgv_video::first_frame::{self, FirstFrameOptions};
+use mcgv_video::mesh::{parse_gltf, parse_obj, parse_pc2, AnimatedMesh, Summary, Triangle};
+use mcgv_video::stream::container::{FILE_HEADER_LEN, PART_HEADER_LEN};
 use mcgv_video::Result;
-use std::io::Cursor;
 use std::path::Path;
 
 /// Bytes of the first-frame coder's own header; its CRC-32 is the header's last four bytes.
@@ -37,8 +35,8 @@ pub fn decode_stream(data: &[u8]) -> Result<()> {
 }
 
 fn decode_and_check(bytes: &[u8]) -> Result<()> {
-    let mut decoder = Decoder::new(ContainerReader::new(Cursor::new(bytes.to_vec()))?)?;
-    let mesh = decoder.decode_all(&mcgv_video::progress::bar(0, "", true))?;
+    let mut decoder = Decoder::new(bytes)?;
+    let mesh = decoder.decode_all()?;
     let last = mesh.frame_count() - 1;
     let alone = decoder.decode_frame(last)?;
     if decoder.header().codec == Codec::Tdct {
@@ -88,7 +86,7 @@ pub fn read_mesh(data: &[u8]) -> Result<()> {
 }
 
 fn check_mesh(mesh: &AnimatedMesh) -> Result<()> {
-    let info = Info::of(mesh, 0.0);
+    let info = Summary::of(mesh);
     assert_eq!(info.vertices, mesh.vertex_count());
     if mesh.vertex_count() > ROUND_TRIP_LIMIT || mesh.triangles().len() > 2 * ROUND_TRIP_LIMIT {
         return Ok(());

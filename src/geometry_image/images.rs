@@ -109,8 +109,8 @@ impl GeometryImages {
     pub fn padded_alone(&self, residuals: &[Vec<[f32; 3]>], f: usize) -> Result<[Vec<f32>; 3]> {
         let start = f - f % self.gop;
         let mut images = self.padded(&residuals[start], start, None)?;
-        for g in start + 1..=f {
-            images = self.padded(&residuals[g], g, Some(&images))?;
+        for (g, frame) in residuals.iter().enumerate().take(f + 1).skip(start + 1) {
+            images = self.padded(frame, g, Some(&images))?;
         }
         Ok(images)
     }

@@ -4,6 +4,7 @@
 //! [`topology`] holds the adjacency helpers the later stages need.
 
 pub mod io;
+mod summary;
 pub mod topology;
 
 mod gltf_import;
@@ -14,6 +15,7 @@ pub use io::{
     parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_sequence,
     write_pc2, ReadOptions,
 };
+pub use summary::Summary;
 
 use crate::error::{Error, Result};
 

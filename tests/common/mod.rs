@@ -1,18 +1,18 @@
-//! Helpers shared by the integration tests: running the binary, reading its output, the media
-//! samples, encoding and decoding in memory, and synthetic meshes.
+//! Helpers shared by the integration tests (the library's in `tests/it`, the command line's in
+//! `cli/tests/cli`, which adds running the binary): the media samples, encoding and decoding in
+//! memory, forging streams, and synthetic meshes.
 //!
-//! Each test file is its own crate and pulls this in with `mod common;`; most use only part of it,
-//! so unused items are not warnings here.
+//! Each test binary uses only part of it, so unused items are not warnings here.
 #![allow(dead_code)]
 
 use mcgv_video::codec::Codec;
-use mcgv_video::decoder::Decoder;
-use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
+use mcgv_video::decoder::{DecodeOptions, Decoder};
+use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, Point, ReadOptions, Triangle};
 use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
+use mcgv_video::Lattice;
 use std::io::Cursor;
-use std::path::Path;
-use std::process::{Command, Output};
+use std::path::{Path, PathBuf};
 
 /// The fuzz targets' bodies, for replaying their inputs; they compare connectivity the way the
 /// tests do, so `canonical` has one definition for both.
@@ -22,34 +22,19 @@ pub mod harness;
 #[allow(unused_imports)]
 pub use harness::canonical;
 
-/// Runs the `mcgv-video` binary built for these tests; its status is the caller's to check.
-pub fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mcgv-video"))
-        .args(args)
-        .output()
-        .unwrap_or_else(|e| panic!("running mcgv-video: {e}"))
-}
-
-/// Asserts the run succeeded (showing its stderr when not) and returns its stdout.
-pub fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// The single JSON object a successful `--json` run prints.
-pub fn json(out: &Output) -> serde_json::Value {
-    let stdout = ok(out);
-    serde_json::from_str(stdout.trim())
-        .unwrap_or_else(|e| panic!("not one JSON object ({e}): {stdout}"))
-}
-
 /// The path of a sample in `media/`.
 pub fn media_path(name: &str) -> String {
-    format!("{}/media/{name}", env!("CARGO_MANIFEST_DIR"))
+    repo_root().join("media").join(name).display().to_string()
+}
+
+/// The repository's top folder (this file is compiled into test binaries of the root crate and of
+/// `cli/`).
+pub fn repo_root() -> PathBuf {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    match here.join("media").is_dir() {
+        true => here.to_path_buf(),
+        false => here.parent().unwrap_or(here).to_path_buf(),
+    }
 }
 
 /// A sample in `media/`, read with the default options.
@@ -57,30 +42,22 @@ pub fn read_media(name: &str) -> AnimatedMesh {
     read_animation(&media_path(name), &ReadOptions::default()).expect("media sample reads")
 }
 
-/// The grey levels of an image file (a PNG the binary wrote).
-pub fn grey(path: &Path) -> Vec<u8> {
-    image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_luma8()
-        .into_raw()
-}
-
 /// Encodes in memory to the bytes of a `.mcgv` file.
 pub fn encode_bytes(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<u8> {
-    encode(mesh, opts, &indicatif::ProgressBar::hidden())
-        .expect("encodes")
-        .container
-        .to_bytes()
+    encode(mesh, opts).expect("encodes").to_bytes()
 }
 
 /// A decoder over in-memory stream bytes; damaged bytes are its error, not a panic.
 pub fn decoder(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
-    Decoder::new(ContainerReader::new(Cursor::new(bytes))?)
+    Decoder::from_container(
+        ContainerReader::new(Cursor::new(bytes))?,
+        &DecodeOptions::default(),
+    )
 }
 
 /// Decodes every frame of in-memory stream bytes.
 pub fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
-    decoder(bytes)?.decode_all(&indicatif::ProgressBar::hidden())
+    decoder(bytes)?.decode_all()
 }
 
 /// A real two-frame stream of a square (two triangles, one cluster), small enough to forge quickly.
@@ -102,10 +79,7 @@ pub fn tiny_stream(codec: Codec) -> Vec<u8> {
         padding: Some(padding::Method::Cg),
         ..EncodeOptions::default()
     };
-    encode(&mesh, &opts, &indicatif::ProgressBar::hidden())
-        .expect("encodes")
-        .container
-        .to_bytes()
+    encode(&mesh, &opts).expect("encodes").to_bytes()
 }
 
 /// The parts of a stream as (tag, payload, checksum kind), to rebuild it altered.

@@ -1,8 +1,6 @@
 //! Segmentation by decimation (skinning paper §3.1) on synthetic animations with a known answer.
 
-mod common;
-
-use common::{canonical, decoder, rand_index, read_media, tube};
+use crate::common::{canonical, decoder, rand_index, read_media, tube};
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::topology::ManifoldReport;
 use mcgv_video::mesh::{Point, Triangle};
@@ -26,7 +24,7 @@ fn rigid(k: usize, t: f32, p: Point) -> Point {
 }
 
 fn animate(points: &[Point], tris: Vec<Triangle>, part: &[usize]) -> AnimatedMesh {
-    common::animate(points, tris, FRAMES, |t, i, p| rigid(part[i], t, p))
+    crate::common::animate(points, tris, FRAMES, |t, i, p| rigid(part[i], t, p))
 }
 
 /// One tube of 41 rings, x in 0..8: x < 4 is part 0, the rest part 1.
@@ -66,7 +64,7 @@ fn two_rigid_parts_give_two_clusters() {
 fn bent_tube() -> AnimatedMesh {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
     tube(&mut points, &mut tris, 0.0, 8.0, 41, RING_SIZE);
-    common::animate(&points, tris, FRAMES, |t, _, p| {
+    crate::common::animate(&points, tris, FRAMES, |t, _, p| {
         let angle = 0.15 * t * p[0];
         let (c, s) = (angle.cos(), angle.sin());
         [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]]
@@ -287,8 +285,7 @@ fn decimation_round_trips_through_the_stream() {
         padding: Some(padding::Method::Cg),
         ..EncodeOptions::default()
     };
-    let hidden = indicatif::ProgressBar::hidden();
-    let encoded = encode(&mesh, &opts, &hidden).expect("encodes");
+    let encoded = encode(&mesh, &opts).expect("encodes");
     let report = encoded.report;
     let k = report.segmentation.clusters;
     assert_eq!(report.segmentation.method, "decimation");
@@ -297,7 +294,7 @@ fn decimation_round_trips_through_the_stream() {
     let bytes = encoded.container.to_bytes();
     let mut decoder = decoder(bytes).expect("stream");
     assert_eq!(decoder.partition().clusters(), k);
-    let decoded = decoder.decode_all(&hidden).expect("decodes");
+    let decoded = decoder.decode_all().expect("decodes");
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     assert_eq!(decoded.frame_count(), mesh.frame_count());
     let m = compare(&mesh, &decoded).expect("comparable");

@@ -1,8 +1,6 @@
 //! Animated-mesh readers and writers through the public API: OBJ sequences, PC2, glTF samples.
 
-mod common;
-
-use common::media_path;
+use crate::common::media_path;
 use mcgv_video::mesh::{read_animation, write_obj_sequence, write_pc2, AnimatedMesh, ReadOptions};
 use std::path::{Path, PathBuf};
 

@@ -1,10 +1,8 @@
 //! Round trips of the first-frame mesh coder on meshes built in code, random soups and damage.
 
-mod common;
-
-use common::canonical;
+use crate::common::canonical;
+use mcgv_video::first_frame::{decode, encode, FirstFrameOptions};
 use mcgv_video::mesh::{Point, Triangle};
-use mcgv_video::stream::first_frame::{decode, encode, FirstFrameOptions};
 use mcgv_video::Error;
 use proptest::prelude::*;
 

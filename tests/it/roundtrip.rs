@@ -1,9 +1,7 @@
 //! End-to-end: encode media samples with both codecs, decode, and check connectivity, error bounds,
 //! random access and the handling of damaged streams.
 
-mod common;
-
-use common::{canonical, decode_all, decoder, encode_bytes, read_media};
+use crate::common::{canonical, decode_all, decoder, encode_bytes, read_media};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::EncodeOptions;
 use mcgv_video::metrics::compare;

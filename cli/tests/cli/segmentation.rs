@@ -1,9 +1,7 @@
 //! `encode --segmentation decimation` through the binary: the report, the stream, `inspect`, and
 //! the options that do not belong together.
 
-mod common;
-
-use common::{grey, json, media_path, ok, run};
+use crate::common::{grey, json, media_path, ok, run};
 
 #[test]
 fn decimation_reports_k_and_time_and_inspect_uses_the_streams_clusters() {

@@ -5,17 +5,14 @@
 //! Case counts are low so that `make test` stays fast; `PROPTEST_CASES=256 cargo test --test
 //! hostile_meshes` runs more.
 
-mod common;
-
-use common::canonical;
+use crate::common::canonical;
 use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
-use mcgv_video::encoder::{encode, EncodeOptions, Lattice};
+use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{AnimatedMesh, Point, Triangle};
-use mcgv_video::stream::container::ContainerReader;
 use mcgv_video::stream::entropy::{self, BitModel, IntModel, SymbolCoder, SymbolModel, UIntModel};
+use mcgv_video::Lattice;
 use proptest::prelude::*;
-use std::io::Cursor;
 
 /// Cases per property unless `PROPTEST_CASES` says otherwise.
 fn cases(default: u32) -> ProptestConfig {
@@ -124,14 +121,14 @@ fn small(codec: Codec) -> EncodeOptions {
 /// Encodes, checks the file decodes to the same connectivity, vertex and frame count, and that
 /// every decoded vertex is within `tolerance` of the bounding-box diagonal of where it was.
 fn round_trip(mesh: &AnimatedMesh, opts: &EncodeOptions, tolerance: f64) -> Vec<u8> {
-    let hidden = indicatif::ProgressBar::hidden();
-    let bytes = encode(mesh, opts, &hidden)
+    let bytes = encode(mesh, opts)
         .unwrap_or_else(|e| panic!("encode failed: {e}"))
         .container
         .to_bytes();
-    let mut decoder = Decoder::new(ContainerReader::new(Cursor::new(bytes.clone())).unwrap())
-        .unwrap_or_else(|e| panic!("decoder refused its own stream: {e}"));
-    let decoded = decoder.decode_all(&hidden).unwrap();
+    let decoded = Decoder::new(&bytes)
+        .unwrap_or_else(|e| panic!("decoder refused its own stream: {e}"))
+        .decode_all()
+        .unwrap();
     assert_eq!(decoded.vertex_count(), mesh.vertex_count());
     assert_eq!(decoded.frame_count(), mesh.frame_count());
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));

@@ -1,8 +1,6 @@
 //! `mcgv-video convert` through the real binary: the converted animation is the input, exactly.
 
-mod common;
-
-use common::{json, media_path, ok, run};
+use crate::common::{json, media_path, ok, run};
 
 fn eval_json(original: &str, other: &str) -> serde_json::Value {
     json(&run(&["eval", "--json", "--quiet", original, other]))

@@ -1,9 +1,7 @@
 //! Hostile streams and meshes: every input the fuzzers once crashed on (tests/data/fuzz/TARGET/),
 //! replayed through the fuzz targets' own code, and forged headers that claim absurd sizes.
 
-mod common;
-
-use common::{harness, tiny_stream};
+use crate::common::{harness, tiny_stream};
 
 use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
@@ -74,7 +72,7 @@ fn forged(codec: Codec, offset: usize, value: u32) -> Vec<u8> {
 }
 
 fn open(bytes: Vec<u8>) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
-    Decoder::new(ContainerReader::new(Cursor::new(bytes))?)
+    crate::common::decoder(bytes)
 }
 
 fn stream_error(bytes: Vec<u8>) -> String {
@@ -107,7 +105,7 @@ fn band_checksums_are_repaired_so_damage_reaches_the_band_decoder() {
         quality: 10,
         ..Default::default()
     };
-    let honest = common::encode_bytes(&common::read_media("RiggedSimple.glb"), &opts);
+    let honest = crate::common::encode_bytes(&crate::common::read_media("RiggedSimple.glb"), &opts);
     let mut bytes = honest.clone();
     harness::fix_band_index(&mut bytes);
     harness::fix_checksums(&mut bytes);
@@ -135,7 +133,7 @@ fn a_step_that_overflows_the_coefficients_is_refused() {
         quality: 10,
         ..Default::default()
     };
-    let honest = common::encode_bytes(&common::read_media("RiggedSimple.glb"), &opts);
+    let honest = crate::common::encode_bytes(&crate::common::read_media("RiggedSimple.glb"), &opts);
     let index = ContainerReader::new(Cursor::new(honest.clone()))
         .unwrap()
         .entry(Tag::TDCT_INDEX)

@@ -1,8 +1,6 @@
 //! `encode -o` never damages what is there: no half-written output, no overwritten input.
 
-mod common;
-
-use common::{media_path, run};
+use crate::common::{media_path, run};
 use std::path::Path;
 use std::process::Output;
 

@@ -1,8 +1,6 @@
 //! `mcgv-video info` through the real binary: text, `--json`, and failures.
 
-mod common;
-
-use common::{media_path, ok, run};
+use crate::common::{media_path, ok, run};
 
 fn info(args: &[&str]) -> std::process::Output {
     run(&[&["info"], args].concat())

@@ -1,12 +1,8 @@
 //! Segmentation and piecewise affine prediction on synthetic animations with a known answer.
 
-mod common;
-
-use common::{animate, rand_index, tube};
+use crate::common::{animate, rand_index, tube};
 use mcgv_video::mesh::{Point, Triangle};
-use mcgv_video::motion::{
-    energy, render_partition_png, residuals, segment, AffineTrack, Partition, SegmentOptions,
-};
+use mcgv_video::motion::{energy, residuals, segment, AffineTrack, Partition, SegmentOptions};
 use mcgv_video::AnimatedMesh;
 
 const FRAMES: usize = 12;
@@ -310,25 +306,6 @@ fn bad_requests_are_errors() {
     let partition = Partition::from_labels(labels, 4).unwrap();
     assert!(AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 0).is_err());
     assert!(AffineTrack::fit(mesh.frames(), &mesh.frame(0)[1..], &partition, 17).is_err());
-}
-
-#[test]
-fn partition_picture_shows_every_cluster() {
-    let (mesh, truth) = separate_parts();
-    let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("partition.png");
-    render_partition_png(mesh.frame(0), mesh.triangles(), &labels, 96, &path).unwrap();
-    let image = image::open(&path).unwrap().to_rgb8();
-    assert_eq!(image.dimensions(), (96, 96));
-    let mut colours: Vec<[u8; 3]> = image.pixels().map(|p| p.0).collect();
-    colours.sort();
-    colours.dedup();
-    // Background plus four hues, each in a few shades.
-    assert!(colours.len() >= 5, "{} colours", colours.len());
-    assert!(
-        render_partition_png(mesh.frame(0), mesh.triangles(), &labels[1..], 96, &path).is_err()
-    );
 }
 
 /// Frame 0 of a real mesh shipped with the project (CesiumMan: 138 pieces, flat patches), cut into

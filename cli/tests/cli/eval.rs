@@ -1,8 +1,6 @@
 //! `mcgv-video eval` end to end: the binary on files, its JSON and human output, its errors.
 
-mod common;
-
-use common::{json, media_path, ok, run};
+use crate::common::{json, media_path, ok, run};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::Output;

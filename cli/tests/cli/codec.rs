@@ -1,8 +1,6 @@
 //! The encode / decode / inspect / eval commands through the binary, as a user runs them.
 
-mod common;
-
-use common::{json, media_path, ok, run};
+use crate::common::{json, media_path, ok, run};
 use std::path::Path;
 
 #[test]
@@ -304,7 +302,7 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
         "--quiet",
     ]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--step applies to --codec tdct"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--step applies to the tdct codec"));
     ok(&run(&[
         "encode",
         &sample,

@@ -2,9 +2,7 @@
 //! both segmentations, progressive decoding of a band prefix or a truncated file, random access,
 //! and damaged or forged streams.
 
-mod common;
-
-use common::{encode_bytes, read_media};
+use crate::common::{encode_bytes, read_media};
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::{AnimatedMesh, Triangle};
@@ -27,14 +25,14 @@ fn decoder(
     bytes: Vec<u8>,
     max_bands: Option<usize>,
 ) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
-    Decoder::with_options(
+    Decoder::from_container(
         ContainerReader::new(Cursor::new(bytes))?,
         &DecodeOptions { max_bands },
     )
 }
 
 fn decode_all(bytes: Vec<u8>, max_bands: Option<usize>) -> mcgv_video::Result<AnimatedMesh> {
-    decoder(bytes, max_bands)?.decode_all(&indicatif::ProgressBar::hidden())
+    decoder(bytes, max_bands)?.decode_all()
 }
 
 /// RMS vertex displacement over the first frame's bounding-box diagonal (cheap: the tests below
@@ -92,7 +90,7 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
     assert_eq!(dec.bands_total(), mesh.frame_count());
     assert_eq!(dec.bands_decoded(), mesh.frame_count());
     assert!(!dec.truncated());
-    let decoded = dec.decode_all(&indicatif::ProgressBar::hidden()).unwrap();
+    let decoded = dec.decode_all().unwrap();
     assert_eq!(decoded.vertex_count(), mesh.vertex_count());
     assert_eq!(decoded.frame_count(), mesh.frame_count());
     assert_eq!(
@@ -256,7 +254,7 @@ fn forged_counts_are_refused_before_allocating() {
         },
     );
     let err = decoder(jpeg, Some(2)).err().expect("refused").to_string();
-    assert!(err.contains("--bands"), "{err}");
+    assert!(err.contains("max_bands"), "{err}");
 }
 
 #[test]
@@ -277,7 +275,6 @@ fn step_overrides_quality_and_is_checked() {
         },
     );
     assert!(coarse.len() < fine.len());
-    let hidden = indicatif::ProgressBar::hidden();
     for bad in [
         EncodeOptions {
             step: Some(0.0),
@@ -292,20 +289,20 @@ fn step_overrides_quality_and_is_checked() {
             ..EncodeOptions::default()
         },
     ] {
-        assert!(encode(&mesh, &bad, &hidden).is_err());
+        assert!(encode(&mesh, &bad).is_err());
     }
 }
 
 /// Dead-zone quantisation against plain rounding, at equal error: bytes of the coefficients and
 /// vertex RMSE (coefficient-domain error equals time-domain error, the DCT being orthonormal) over
 /// a sweep of steps. `cargo test --release --test tdct measure_dead_zone -- --ignored --nocapture`;
-/// the figures are in the doc of `stream::tdct::DEAD_ZONE`.
+/// the figures are in the doc of `codec::tdct::DEAD_ZONE`.
 #[test]
 #[ignore = "measurement, not a check"]
 fn measure_dead_zone() {
-    use mcgv_video::encoder::{predict_residuals, segment};
-    use mcgv_video::stream::first_frame::{self, FirstFrameOptions};
-    use mcgv_video::stream::tdct::{forward, quantise, BandCoder};
+    use mcgv_video::codec::tdct::coefficients::{forward, quantise, BandCoder};
+    use mcgv_video::encoder::analysis::{predict, segment};
+    use mcgv_video::first_frame::{self, FirstFrameOptions};
     for name in ["CesiumMan.glb", "Fox.glb", "RiggedFigure.glb"] {
         let mesh = read_media(name);
         let opts = tdct(50);
@@ -319,8 +316,9 @@ fn measure_dead_zone() {
         )
         .unwrap();
         let (partition, _) = segment(&mesh, &opts).unwrap();
-        let (_, _, residuals) =
-            predict_residuals(&mesh, &ff.decoded_positions, &partition, &opts).unwrap();
+        let residuals = predict(&mesh, &ff.decoded_positions, &partition, &opts)
+            .unwrap()
+            .residuals;
         let coefficients = forward(&residuals).unwrap();
         let d = mesh.bbox_diagonal();
         let n = (coefficients.len() * coefficients[0].len() / 3) as f64;

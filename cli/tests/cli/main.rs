@@ -1,0 +1,12 @@
+//! The command line's integration tests, one module per subject, in one test binary: each runs
+//! the `mcgv-video` binary built for the tests and checks its output, files and exit codes.
+
+mod common;
+
+mod codec;
+mod convert;
+mod eval;
+mod info;
+mod outputs;
+mod segmentation;
+mod skinning;

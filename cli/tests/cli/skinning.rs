@@ -1,0 +1,44 @@
+//! The skinning predictor through the command line.
+
+use crate::common::{json, media_path, ok, run};
+
+#[test]
+fn cli_records_the_predictor_and_inspect_reports_the_weights() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = media_path("RiggedSimple.glb");
+    let mut bits = Vec::new();
+    for (predictor, weight_bits) in [("affine", "16"), ("skinning", "16"), ("skinning", "10")] {
+        let path = dir.path().join(format!("{predictor}{weight_bits}.mcgv"));
+        let s = path.to_str().unwrap();
+        ok(&run(&[
+            "encode",
+            &sample,
+            "-o",
+            s,
+            "--predictor",
+            predictor,
+            "--weight-bits",
+            weight_bits,
+            "--padding",
+            "cg",
+            "--quiet",
+        ]));
+        let info = json(&run(&["inspect", s, "--json"]));
+        assert_eq!(info["predictor"], predictor);
+        if predictor == "skinning" {
+            assert_eq!(info["weight_bits"].to_string(), weight_bits);
+        } else {
+            assert!(info["weight_bits"].is_null());
+        }
+        bits.push(info["parts"]["skinning weights"].as_u64());
+    }
+    assert_eq!(bits[0], None);
+    assert!(bits[1].is_some_and(|b| b > 0), "{bits:?}");
+    // Coarser weights take fewer bits.
+    assert!(
+        bits[2].is_some_and(|b| bits[1].is_some_and(|full| b < full)),
+        "{bits:?}"
+    );
+    let bad = run(&["encode", &sample, "-o", "x.mcgv", "--predictor", "bones"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

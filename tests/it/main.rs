@@ -1,0 +1,18 @@
+//! The library's integration tests, one module per subject, in one test binary (so FFmpeg is
+//! linked once). `tests/forged_counts.rs` is its own binary: it installs a counting allocator.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod codec;
+mod decimate;
+mod first_frame;
+mod fuzz_regressions;
+mod hostile_meshes;
+mod mesh_io;
+mod metrics_reference;
+mod motion;
+mod range_floor;
+mod roundtrip;
+mod skinning;
+mod tdct;
