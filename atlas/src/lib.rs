@@ -114,9 +114,14 @@
 mod atlas;
 mod build;
 mod error;
+mod input;
+mod layout;
 mod options;
+mod ownership;
 mod pack;
 mod picture;
+mod raster;
+mod scale;
 mod seed;
 mod stretch;
 mod unwrap;
