@@ -1,32 +1,18 @@
-//! From mesh and partition to a packed, injective lattice atlas.
+//! The build pipeline, from mesh and partition to a packed, injective lattice atlas: check the
+//! inputs, seed and flatten the charts, give every vertex one chart, find the scale at which the
+//! charts pack, write them into the lattice, sum up the figures. Each stage lives in its own file.
 
-use crate::atlas::{Atlas, AtlasStats, Chart, InteriorSample, Occupancy};
+use crate::atlas::{Atlas, AtlasStats};
 use crate::input::check_input;
-use crate::layout::layouts;
+use crate::lattice::Lattice;
+use crate::layout::{layouts, ChartLayout};
 use crate::ownership::{absorb_small_charts, assign_owners};
-use crate::pack::Orientation;
-use crate::raster::{clamp_pixel, nearest_free, rasterise, NO_VERTEX};
 use crate::scale::best_scale;
-use crate::seed::seeds;
+use crate::seed::{seeds, Seeds};
 use crate::stretch::StretchSum;
 use crate::unwrap::{flatten, Flattening};
-use crate::{AtlasError, AtlasOptions, Interior};
+use crate::{AtlasError, AtlasOptions};
 use std::time::Instant;
-
-/// Where one chart sits: maps its local pixels to lattice pixels.
-struct Frame {
-    origin: [f64; 2],
-    /// Local frame size in pixels.
-    size: [f64; 2],
-    orientation: Orientation,
-}
-
-impl Frame {
-    fn to_lattice(&self, local: [f64; 2]) -> [f64; 2] {
-        let p = self.orientation.apply(local, self.size[0], self.size[1]);
-        [self.origin[0] + p[0], self.origin[1] + p[1]]
-    }
-}
 
 /// Builds the atlas of a mesh whose vertices are partitioned into clusters
 /// (one cluster id per vertex).
@@ -39,140 +25,98 @@ pub fn build(
     let start = Instant::now();
     check_input(positions, triangles, partition, opts)?;
     let seeds = seeds(triangles, partition);
-    let flat = if triangles.is_empty() {
-        Flattening {
+    let flat = flatten_seeds(positions, triangles, &seeds, opts)?;
+    let (charts, absorbed) =
+        owned_layouts(triangles, partition, &seeds, &flat, positions.len(), opts);
+    let (scale, shapes, placements) = best_scale(&charts, opts)?;
+    let lattice = Lattice::write(
+        &charts,
+        &shapes,
+        &placements,
+        scale,
+        triangles,
+        positions.len(),
+        opts,
+    );
+    let mut stats = stats(&seeds, &flat, &charts, &lattice, scale, absorbed, opts);
+    stats.build_time = start.elapsed();
+    Ok(Atlas {
+        width: opts.width,
+        height: opts.height,
+        block: opts.block,
+        vertex_pixels: lattice.vertex_pixels,
+        vertex_chart: lattice.vertex_chart,
+        occupancy: lattice.occupancy,
+        block_chart: lattice.block_chart,
+        charts: lattice.charts,
+        interior: lattice.interior,
+        stats,
+    })
+}
+
+/// Steps 1–2: the seed pieces flattened into charts (none for a mesh without faces).
+fn flatten_seeds(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    seeds: &Seeds,
+    opts: &AtlasOptions,
+) -> Result<Flattening, AtlasError> {
+    if triangles.is_empty() {
+        return Ok(Flattening {
             face_chart: Vec::new(),
             corner_uv: Vec::new(),
             charts: 0,
             chart_stretch: Vec::new(),
             split_rounds: 0,
-        }
-    } else {
-        flatten(
-            positions,
-            triangles,
-            &seeds.face_piece,
-            opts.max_stretch,
-            opts.max_split_rounds,
-        )?
-    };
-    let mut owner = assign_owners(
-        triangles,
-        partition,
-        &seeds.face_cluster,
-        &flat,
-        positions.len(),
-    );
-    let absorbed = absorb_small_charts(triangles, &mut owner, flat.charts, opts.min_chart_vertices);
-    let charts = layouts(&flat, &owner);
-    let (scale, shapes, placements) = best_scale(&charts, opts)?;
-
-    let (width, height, block) = (opts.width, opts.height, opts.block);
-    let pixels = (width * height) as usize;
-    let blocks_across = width / block;
-    let mut grid = vec![NO_VERTEX; pixels];
-    let mut vertex_pixels = vec![[0u16; 2]; positions.len()];
-    let mut vertex_chart = vec![0u32; positions.len()];
-    let mut block_chart = vec![None; ((width / block) * (height / block)) as usize];
-    let mut occupancy = vec![Occupancy::Free; pixels];
-    let mut interior = Vec::new();
-    let mut covered = vec![false; pixels];
-    let mut packed = Vec::with_capacity(charts.len());
-    let mut moved = 0usize;
-    let mut total_stretch = StretchSum::default();
-    let mut max_chart_stretch: f64 = 0.0;
-
-    for (ci, ((layout, shape), place)) in charts.iter().zip(&shapes).zip(&placements).enumerate() {
-        let fp = &shape.footprint;
-        let blocks: Vec<(u32, u32)> = place.cells(fp).collect();
-        for &(bx, by) in &blocks {
-            block_chart[(by * blocks_across + bx) as usize] = Some(ci as u32);
-        }
-        let local_rect = [0, 0, fp.width * block, fp.height * block];
-        let frame = Frame {
-            origin: [f64::from(place.bx * block), f64::from(place.by * block)],
-            size: [f64::from(local_rect[2]), f64::from(local_rect[3])],
-            orientation: place.orientation,
-        };
-        let lattice_pixel = |local: [f64; 2]| {
-            let p = frame.to_lattice(local);
-            [p[0].round() as u32, p[1].round() as u32]
-        };
-        for (k, &(v, uv)) in layout.owned.iter().enumerate() {
-            let target = if layout.faceless {
-                let k = k as u32;
-                lattice_pixel([f64::from(k % local_rect[2]), f64::from(k / local_rect[2])])
-            } else {
-                lattice_pixel(
-                    clamp_pixel(layout.local(uv, scale, shape.offset), local_rect).map(f64::from),
-                )
-            };
-            let mut at = target;
-            if grid[(at[1] * width + at[0]) as usize] != NO_VERTEX {
-                // The chart's blocks hold a pixel per owned vertex, so this finds one.
-                at = nearest_free(&grid, width, block, &blocks, target).unwrap_or(target);
-                moved += 1;
-            }
-            grid[(at[1] * width + at[0]) as usize] = v;
-            occupancy[(at[1] * width + at[0]) as usize] = Occupancy::Vertex;
-            covered[(at[1] * width + at[0]) as usize] = true;
-            vertex_pixels[v as usize] = [at[0] as u16, at[1] as u16];
-            vertex_chart[v as usize] = ci as u32;
-        }
-        for (f, corners) in &layout.faces {
-            let local = corners.map(|uv| layout.local(uv, scale, shape.offset));
-            let tri = triangles[*f];
-            rasterise(local, local_rect, |p, w| {
-                let [x, y] = lattice_pixel(p.map(f64::from));
-                let i = (y * width + x) as usize;
-                if covered[i]
-                    || block_chart[((y / block) * blocks_across + x / block) as usize]
-                        != Some(ci as u32)
-                {
-                    return;
-                }
-                covered[i] = true;
-                if opts.interior == Interior::Rasterised {
-                    occupancy[i] = Occupancy::Interior;
-                    interior.push(InteriorSample {
-                        pixel: i as u32,
-                        vertices: tri,
-                        weights: w.map(|x| x as f32),
-                    });
-                }
-            });
-        }
-        let stretch = layout.stretch.value().filter(|_| !layout.faceless);
-        if let Some(s) = stretch {
-            total_stretch.merge(&layout.stretch);
-            max_chart_stretch = max_chart_stretch.max(s);
-        }
-        let (ow, oh) = if place.orientation.transposed {
-            (local_rect[3], local_rect[2])
-        } else {
-            (local_rect[2], local_rect[3])
-        };
-        packed.push(Chart {
-            origin: [place.bx * block, place.by * block],
-            size: [ow, oh],
-            blocks: blocks.len(),
-            transposed: place.orientation.transposed,
-            vertices: layout.owned.len(),
-            stretch,
         });
     }
+    flatten(
+        positions,
+        triangles,
+        &seeds.face_piece,
+        opts.max_stretch,
+        opts.max_split_rounds,
+    )
+}
 
-    let chart_pixels = covered.iter().filter(|&&c| c).count();
-    let owned_blocks = block_chart.iter().filter(|b| b.is_some()).count();
-    let stats = AtlasStats {
-        charts: packed.len(),
+/// Step 3: every vertex owned by one chart, small charts absorbed; returns the layouts of the
+/// charts that own vertices and how many vertices were absorbed.
+fn owned_layouts(
+    triangles: &[[u32; 3]],
+    partition: &[u32],
+    seeds: &Seeds,
+    flat: &Flattening,
+    vertices: usize,
+    opts: &AtlasOptions,
+) -> (Vec<ChartLayout>, usize) {
+    let mut owner = assign_owners(triangles, partition, &seeds.face_cluster, flat, vertices);
+    let absorbed = absorb_small_charts(triangles, &mut owner, flat.charts, opts.min_chart_vertices);
+    (layouts(flat, &owner), absorbed)
+}
+
+/// The build's figures; `build_time` is left at zero for the caller to set.
+fn stats(
+    seeds: &Seeds,
+    flat: &Flattening,
+    charts: &[ChartLayout],
+    lattice: &Lattice,
+    scale: f64,
+    absorbed: usize,
+    opts: &AtlasOptions,
+) -> AtlasStats {
+    let pixels = (opts.width * opts.height) as usize;
+    let chart_pixels = lattice.chart_pixels();
+    let owned_blocks = lattice.block_chart.iter().filter(|b| b.is_some()).count();
+    let (total_stretch, max_chart_stretch) = stretch(charts, lattice);
+    AtlasStats {
+        charts: lattice.charts.len(),
         seed_pieces: seeds.pieces as usize,
         split_rounds: flat.split_rounds,
         scale,
         chart_pixels,
         packing_efficiency: chart_pixels as f64 / pixels as f64,
-        block_efficiency: owned_blocks as f64 / block_chart.len().max(1) as f64,
-        moved_vertices: moved,
+        block_efficiency: owned_blocks as f64 / lattice.block_chart.len().max(1) as f64,
+        moved_vertices: lattice.moved,
         absorbed_vertices: absorbed,
         faceless_vertices: charts
             .iter()
@@ -181,18 +125,19 @@ pub fn build(
             .sum(),
         l2_stretch: total_stretch.value().unwrap_or(1.0),
         max_chart_stretch,
-        build_time: start.elapsed(),
-    };
-    Ok(Atlas {
-        width,
-        height,
-        block,
-        vertex_pixels,
-        vertex_chart,
-        occupancy,
-        block_chart,
-        charts: packed,
-        interior,
-        stats,
-    })
+        build_time: Default::default(),
+    }
+}
+
+/// The stretch summed over the charts that have one, and the largest chart stretch.
+fn stretch(charts: &[ChartLayout], lattice: &Lattice) -> (StretchSum, f64) {
+    let mut total = StretchSum::default();
+    let mut max: f64 = 0.0;
+    for (layout, chart) in charts.iter().zip(&lattice.charts) {
+        if let Some(s) = chart.stretch {
+            total.merge(&layout.stretch);
+            max = max.max(s);
+        }
+    }
+    (total, max)
 }

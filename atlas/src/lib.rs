@@ -115,6 +115,7 @@ mod atlas;
 mod build;
 mod error;
 mod input;
+mod lattice;
 mod layout;
 mod options;
 mod ownership;
