@@ -68,16 +68,7 @@ pub(crate) fn absorb_small_charts(
     if !small.iter().any(|&s| s) {
         return 0;
     }
-    let mut neighbours = vec![Vec::new(); owner.len()];
-    for tri in triangles {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if a != b {
-                neighbours[a as usize].push(b);
-                neighbours[b as usize].push(a);
-            }
-        }
-    }
+    let neighbours = mesh_neighbours(triangles, owner.len());
     let mut absorbed = 0;
     loop {
         let mut changed = false;
@@ -86,26 +77,8 @@ pub(crate) fn absorb_small_charts(
             if !small[c as usize] {
                 continue;
             }
-            let mut tally: Vec<(u32, usize, [f64; 2])> = Vec::new();
-            for &w in &neighbours[v] {
-                let Some((d, uv)) = owner[w as usize] else {
-                    continue;
-                };
-                if small[d as usize] || room[d as usize] == 0 {
-                    continue;
-                }
-                match tally.iter_mut().find(|t| t.0 == d) {
-                    Some(t) => {
-                        t.1 += 1;
-                        t.2 = [t.2[0] + uv[0], t.2[1] + uv[1]];
-                    }
-                    None => tally.push((d, 1, uv)),
-                }
-            }
-            let best = tally
-                .into_iter()
-                .max_by_key(|t| (t.1, std::cmp::Reverse(t.0)));
-            if let Some((d, n, sum)) = best {
+            let takes = |d: u32| !small[d as usize] && room[d as usize] > 0;
+            if let Some((d, n, sum)) = best_absorber(&neighbours[v], owner, takes) {
                 room[d as usize] -= 1;
                 owner[v] = Some((d, [sum[0] / n as f64, sum[1] / n as f64]));
                 absorbed += 1;
@@ -117,4 +90,47 @@ pub(crate) fn absorb_small_charts(
         }
     }
     absorbed
+}
+
+/// Each vertex's neighbours through mesh edges (repeated once per edge side).
+fn mesh_neighbours(triangles: &[[u32; 3]], vertices: usize) -> Vec<Vec<u32>> {
+    let mut neighbours = vec![Vec::new(); vertices];
+    for tri in triangles {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if a != b {
+                neighbours[a as usize].push(b);
+                neighbours[b as usize].push(a);
+            }
+        }
+    }
+    neighbours
+}
+
+/// Among the charts that `takes` and that own some of `neighbours`, the one owning most of them
+/// (ties: lower chart id), with that count and the sum of those neighbours' 2D positions.
+fn best_absorber(
+    neighbours: &[u32],
+    owner: &[Option<(u32, [f64; 2])>],
+    takes: impl Fn(u32) -> bool,
+) -> Option<(u32, usize, [f64; 2])> {
+    let mut tally: Vec<(u32, usize, [f64; 2])> = Vec::new();
+    for &w in neighbours {
+        let Some((d, uv)) = owner[w as usize] else {
+            continue;
+        };
+        if !takes(d) {
+            continue;
+        }
+        match tally.iter_mut().find(|t| t.0 == d) {
+            Some(t) => {
+                t.1 += 1;
+                t.2 = [t.2[0] + uv[0], t.2[1] + uv[1]];
+            }
+            None => tally.push((d, 1, uv)),
+        }
+    }
+    tally
+        .into_iter()
+        .max_by_key(|t| (t.1, std::cmp::Reverse(t.0)))
 }

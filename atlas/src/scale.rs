@@ -36,25 +36,7 @@ pub(crate) fn best_scale(
     opts: &AtlasOptions,
 ) -> Result<Packing, AtlasError> {
     let Some(at_zero) = try_pack(charts, 0.0, opts) else {
-        let unbounded = [u32::MAX; 2];
-        let blocks: usize = charts
-            .iter()
-            .filter_map(|c| c.shape(0.0, opts.block, unbounded))
-            .map(|s| s.footprint.cells.len())
-            .sum();
-        let mut suggest = opts.width.max(opts.height).next_power_of_two();
-        while ((suggest / opts.block) as usize).pow(2) < 2 * blocks && suggest < 16384 {
-            suggest *= 2;
-        }
-        return Err(AtlasError::ChartsDoNotFit {
-            charts: charts.len(),
-            blocks,
-            available: ((opts.width / opts.block) * (opts.height / opts.block)) as usize,
-            block: opts.block,
-            width: opts.width,
-            height: opts.height,
-            suggest,
-        });
+        return Err(charts_do_not_fit(charts, opts));
     };
     let area: f64 = charts.iter().map(|c| c.stretch.area_2d()).sum();
     let pixels = f64::from(opts.width) * f64::from(opts.height);
@@ -95,4 +77,28 @@ pub(crate) fn best_scale(
         }
     }
     Ok((found, best.0, best.1))
+}
+
+/// The error for charts that do not fit even at scale 0: the blocks they need and a square
+/// lattice with room for twice as many.
+fn charts_do_not_fit(charts: &[ChartLayout], opts: &AtlasOptions) -> AtlasError {
+    let unbounded = [u32::MAX; 2];
+    let blocks: usize = charts
+        .iter()
+        .filter_map(|c| c.shape(0.0, opts.block, unbounded))
+        .map(|s| s.footprint.cells.len())
+        .sum();
+    let mut suggest = opts.width.max(opts.height).next_power_of_two();
+    while ((suggest / opts.block) as usize).pow(2) < 2 * blocks && suggest < 16384 {
+        suggest *= 2;
+    }
+    AtlasError::ChartsDoNotFit {
+        charts: charts.len(),
+        blocks,
+        available: ((opts.width / opts.block) * (opts.height / opts.block)) as usize,
+        block: opts.block,
+        width: opts.width,
+        height: opts.height,
+        suggest,
+    }
 }
