@@ -6,7 +6,8 @@
 //!
 //! `cargo bench --bench motion [-- INPUT ...]` (any input `read_animation` takes); with no arguments,
 //! every sequence found under
-//! `/work/media-unpacked` and `/work/shared/media` (those missing are skipped). The environment
+//! `bench-out/media` (where `make bench` unpacks the OBJ sequences) and `$MCGV_SHARED_MEDIA`
+//! (default `../shared/media`), relative to the repository; those missing are skipped. The environment
 //! variables `REFINE`, `FEATURE_FRAMES`, `KMEANS_ITERATIONS` and `CLUSTERS` override the matching
 //! `SegmentOptions`, `E0` and `DECIMATE_REFINE` decimation's threshold and border refinement rounds,
 //! and `SEGMENTATION=kmeans|decimation` runs one method only; `SKIN_RIDGE` and `SKIN_BITS` set the
@@ -84,7 +85,7 @@ fn main() {
 }
 
 fn default_inputs() -> Vec<PathBuf> {
-    let unpacked = Path::new("/work/media-unpacked");
+    let unpacked = Path::new("bench-out/media");
     let mut inputs: Vec<PathBuf> = [
         "chickenCrossing",
         "pcow",
@@ -95,7 +96,8 @@ fn default_inputs() -> Vec<PathBuf> {
     .iter()
     .map(|n| unpacked.join(n))
     .collect();
-    let shared = Path::new("/work/shared/media");
+    let shared =
+        PathBuf::from(std::env::var_os("MCGV_SHARED_MEDIA").unwrap_or("../shared/media".into()));
     inputs.push(shared.join("walking_cat/OBJ"));
     for glb in [
         "khronos_RiggedSimple/robeA.glb",

@@ -233,7 +233,15 @@ fn jpeg_cost(
     Ok((out.len(), mse.sqrt() / f64::from(range)))
 }
 
-fn main() -> Result<(), Box<dyn Error>> {
+/// The command line: flags, then the inputs.
+struct Args {
+    png_dir: Option<PathBuf>,
+    options: AtlasOptions,
+    jpeg: bool,
+    inputs: Vec<String>,
+}
+
+fn parse_args() -> Result<Args, Box<dyn Error>> {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
     let png_dir = args.iter().position(|a| a == "--png").map(|i| {
         args.remove(i);
@@ -256,29 +264,105 @@ fn main() -> Result<(), Box<dyn Error>> {
         .position(|a| a == "--jpeg")
         .map(|i| args.remove(i))
         .is_some();
+    Ok(Args {
+        png_dir,
+        options,
+        jpeg,
+        inputs: args,
+    })
+}
+
+/// The OBJ frames of a folder input (empty for a file) and the mesh of its first frame.
+fn read_input(path: &Path) -> Result<(Vec<PathBuf>, Mesh), Box<dyn Error>> {
+    Ok(if path.is_dir() {
+        let frames = obj_frames(path)?;
+        let first = frames.first().ok_or("no OBJ frames")?;
+        (frames.clone(), read_obj(first)?)
+    } else if path.extension().is_some_and(|e| e == "glb") {
+        (Vec::new(), read_glb(path)?)
+    } else {
+        (Vec::new(), read_obj(path)?)
+    })
+}
+
+/// One table row: the atlas's figures (and with `ATLAS_DEBUG` set, a line of build details).
+fn print_row(name: &str, mesh: &Mesh, atlas: &Atlas) {
+    let (positions, triangles) = mesh;
+    let s = atlas.stats();
+    println!(
+        "{name:<22} {:>6} {:>6} {:>6} {:>7.1} {:>7.1} {:>6} {:>6.3} {:>6.2} {:>8.1}",
+        positions.len(),
+        triangles.len(),
+        s.charts,
+        100.0 * s.packing_efficiency,
+        100.0 * s.block_efficiency,
+        s.moved_vertices,
+        s.l2_stretch,
+        s.max_chart_stretch,
+        s.build_time.as_secs_f64() * 1e3
+    );
+    if std::env::var("ATLAS_DEBUG").is_ok() {
+        let mut sizes: Vec<usize> = atlas.charts().iter().map(|c| c.vertices).collect();
+        sizes.sort_unstable();
+        println!(
+            "  seeds {} split rounds {} scale {:.2} faceless {} chart sizes {:?}",
+            s.seed_pieces, s.split_rounds, s.scale, s.faceless_vertices, sizes
+        );
+    }
+}
+
+/// `--jpeg`: JPEG sizes and errors of the frame-10 displacement with rasterised and free
+/// interiors, per axis, fill and quality.
+fn compare_interiors(
+    atlas: &Atlas,
+    mesh: &Mesh,
+    partition: &[u32],
+    later: &Path,
+) -> Result<(), Box<dyn Error>> {
+    let (positions, triangles) = mesh;
+    let (moved_pos, _) = read_obj(later)?;
+    let free = build(
+        positions,
+        triangles,
+        partition,
+        &AtlasOptions {
+            interior: Interior::Free,
+            ..AtlasOptions::default()
+        },
+    )?;
+    for axis in 0..3 {
+        let values: Vec<f32> = moved_pos
+            .iter()
+            .zip(positions)
+            .map(|(a, b)| a[axis] - b[axis])
+            .collect();
+        for sweeps in [0, 300] {
+            for q in [50u8, 75, 90] {
+                let (rb, re) = jpeg_cost(atlas, &values, q, sweeps)?;
+                let (fb, fe) = jpeg_cost(&free, &values, q, sweeps)?;
+                println!("  jpeg axis {axis} fill sweeps {sweeps:>3} q{q}: rasterised {rb:>6} B rmse {re:.4} | free {fb:>6} B rmse {fe:.4}");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let args = parse_args()?;
     println!(
         "{:<22} {:>6} {:>6} {:>6} {:>7} {:>7} {:>6} {:>6} {:>6} {:>8}",
         "input", "V", "F", "charts", "pack%", "block%", "moved", "L2", "maxL2", "ms"
     );
-    for input in &args {
+    for input in &args.inputs {
         let path = Path::new(input);
-        let (frames, mesh) = if path.is_dir() {
-            let frames = obj_frames(path)?;
-            let first = frames.first().ok_or("no OBJ frames")?;
-            (frames.clone(), read_obj(first)?)
-        } else if path.extension().is_some_and(|e| e == "glb") {
-            (Vec::new(), read_glb(path)?)
-        } else {
-            (Vec::new(), read_obj(path)?)
-        };
-        let (positions, triangles) = mesh;
-        let partition = kmeans(&positions, 20);
+        let (frames, mesh) = read_input(path)?;
+        let (positions, triangles) = &mesh;
+        let partition = kmeans(positions, 20);
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().to_string())
             .unwrap_or_default();
-        let built = build(&positions, &triangles, &partition, &options);
-        let atlas = match built {
+        let atlas = match build(positions, triangles, &partition, &args.options) {
             Ok(a) => a,
             Err(e) => {
                 println!(
@@ -289,59 +373,13 @@ fn main() -> Result<(), Box<dyn Error>> {
                 continue;
             }
         };
-        let s = atlas.stats();
-        println!(
-            "{name:<22} {:>6} {:>6} {:>6} {:>7.1} {:>7.1} {:>6} {:>6.3} {:>6.2} {:>8.1}",
-            positions.len(),
-            triangles.len(),
-            s.charts,
-            100.0 * s.packing_efficiency,
-            100.0 * s.block_efficiency,
-            s.moved_vertices,
-            s.l2_stretch,
-            s.max_chart_stretch,
-            s.build_time.as_secs_f64() * 1e3
-        );
-        if std::env::var("ATLAS_DEBUG").is_ok() {
-            let mut sizes: Vec<usize> = atlas.charts().iter().map(|c| c.vertices).collect();
-            sizes.sort_unstable();
-            println!(
-                "  seeds {} split rounds {} scale {:.2} faceless {} chart sizes {:?}",
-                s.seed_pieces, s.split_rounds, s.scale, s.faceless_vertices, sizes
-            );
-        }
-        if let Some(dir) = &png_dir {
+        print_row(&name, &mesh, &atlas);
+        if let Some(dir) = &args.png_dir {
             std::fs::create_dir_all(dir)?;
             atlas.write_png(dir.join(format!("{name}.png")))?;
         }
-        if jpeg {
-            let Some(later) = frames.get(10) else {
-                continue;
-            };
-            let (moved_pos, _) = read_obj(later)?;
-            let free = build(
-                &positions,
-                &triangles,
-                &partition,
-                &AtlasOptions {
-                    interior: Interior::Free,
-                    ..AtlasOptions::default()
-                },
-            )?;
-            for axis in 0..3 {
-                let values: Vec<f32> = moved_pos
-                    .iter()
-                    .zip(&positions)
-                    .map(|(a, b)| a[axis] - b[axis])
-                    .collect();
-                for sweeps in [0, 300] {
-                    for q in [50u8, 75, 90] {
-                        let (rb, re) = jpeg_cost(&atlas, &values, q, sweeps)?;
-                        let (fb, fe) = jpeg_cost(&free, &values, q, sweeps)?;
-                        println!("  jpeg axis {axis} fill sweeps {sweeps:>3} q{q}: rasterised {rb:>6} B rmse {re:.4} | free {fb:>6} B rmse {fe:.4}");
-                    }
-                }
-            }
+        if let Some(later) = frames.get(10).filter(|_| args.jpeg) {
+            compare_interiors(&atlas, &mesh, &partition, later)?;
         }
     }
     Ok(())

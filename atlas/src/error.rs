@@ -96,3 +96,22 @@ pub enum AtlasError {
         source: image::ImageError,
     },
 }
+
+#[cfg(test)]
+mod tests {
+    use super::AtlasError;
+    use std::error::Error;
+
+    #[test]
+    fn wrapped_errors_are_sources() {
+        let io = std::io::Error::other("disk full");
+        let e = AtlasError::Image {
+            path: "atlas.png".into(),
+            source: image::ImageError::IoError(io),
+        };
+        assert!(e
+            .source()
+            .is_some_and(|s| s.to_string().contains("disk full")));
+        assert!(AtlasError::NonFinitePosition(3).source().is_none());
+    }
+}

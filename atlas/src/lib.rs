@@ -87,10 +87,11 @@
 //!
 //! With a plain mean fill instead, Free is far worse (dance q50: 0.0597 vs
 //! 0.0278). Command: `cargo run --release -p atlas --example measure --
-//! --jpeg /work/media-unpacked/pdance` (and the other folders).
+//! --jpeg bench-out/media/pdance` (and the other folders; the OBJ sequences
+//! as `make bench` unpacks them from `../shared/media`).
 //!
 //! # Measured (256×256, K = 20 k-means partition, release build)
-//! `cargo run --release -p atlas --example measure -- /work/media-unpacked/pdance ...`
+//! `cargo run --release -p atlas --example measure -- bench-out/media/pdance ...`
 //!
 //! | mesh | V | charts | packing | moved | L2 stretch | build |
 //! |---|---|---|---|---|---|---|
@@ -114,9 +115,15 @@
 mod atlas;
 mod build;
 mod error;
+mod input;
+mod lattice;
+mod layout;
 mod options;
+mod ownership;
 mod pack;
 mod picture;
+mod raster;
+mod scale;
 mod seed;
 mod stretch;
 mod unwrap;

@@ -31,6 +31,24 @@ fn flatten_once(
     triangles: &[[u32; 3]],
     materials: &[u32],
 ) -> Result<Flattening, AtlasError> {
+    let out = unwrap(positions, triangles, materials)?;
+    let mut flat = read_charts(&out, triangles.len());
+    flat.chart_stretch = vec![StretchSum::default(); flat.charts as usize];
+    for (f, tri) in triangles.iter().enumerate() {
+        if let Some(c) = flat.face_chart[f] {
+            let q = tri.map(|v| position(positions, v));
+            flat.chart_stretch[c as usize].add(q, flat.corner_uv[f]);
+        }
+    }
+    Ok(flat)
+}
+
+/// Runs `uvunwrap` on the mesh, one chart hint per face in `materials`.
+fn unwrap(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    materials: &[u32],
+) -> Result<uvunwrap::Atlas, AtlasError> {
     let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
     let mesh = uvunwrap::MeshInput {
         face_materials: Some(materials),
@@ -61,13 +79,19 @@ fn flatten_once(
             .unwrap_or("unknown failure");
         AtlasError::UnwrapPanicked(what.to_string())
     })??;
+    Ok(out)
+}
+
+/// Each face's dense chart id (`None` where uvunwrap dropped the face or split its corners over
+/// charts) and its corners' 2D positions in surface units; stretch sums left empty.
+fn read_charts(out: &uvunwrap::Atlas, faces: usize) -> Flattening {
     let texels = f64::from(out.texels_per_unit);
     let (w, h) = (f64::from(out.width), f64::from(out.height));
     let mesh = out.meshes.first();
     let mut dense = std::collections::HashMap::new();
-    let mut face_chart = Vec::with_capacity(triangles.len());
-    let mut corner_uv = Vec::with_capacity(triangles.len());
-    for f in 0..triangles.len() {
+    let mut face_chart = Vec::with_capacity(faces);
+    let mut corner_uv = Vec::with_capacity(faces);
+    for f in 0..faces {
         let corners: Option<Vec<&uvunwrap::OutputVertex>> = (0..3)
             .map(|k| {
                 let i = mesh?.indices.get(3 * f + k)?;
@@ -93,21 +117,13 @@ fn flatten_once(
         face_chart.push(chart);
         corner_uv.push(uv);
     }
-    let charts = dense.len() as u32;
-    let mut chart_stretch = vec![StretchSum::default(); charts as usize];
-    for (f, tri) in triangles.iter().enumerate() {
-        if let Some(c) = face_chart[f] {
-            let q = tri.map(|v| position(positions, v));
-            chart_stretch[c as usize].add(q, corner_uv[f]);
-        }
-    }
-    Ok(Flattening {
+    Flattening {
         face_chart,
         corner_uv,
-        charts,
-        chart_stretch,
+        charts: dense.len() as u32,
+        chart_stretch: Vec::new(),
         split_rounds: 0,
-    })
+    }
 }
 
 /// Splits a chart's faces in two halves across the principal axis of their

@@ -130,9 +130,35 @@ impl DctEnergy {
         limits: CgLimits,
         stats: &mut PadStats,
     ) {
-        let width = grid.width;
-        let mut known = [0.0f64; N];
-        let mut is_fixed = [false; N];
+        let Some(known) = self.gather(grid.width, rect, image, fixed) else {
+            return;
+        };
+        stats.record(self.solve(&known, limits));
+        if let Some(steps) = self.snap_steps {
+            self.snap(&known, &steps);
+        }
+        for (&u, &value) in self.unknowns.iter().zip(&self.x) {
+            let (x, y) = (u % SIDE, u / SIDE);
+            if x < rect.w && y < rect.h && !known.is_fixed[u] {
+                image[(rect.y0 + y) * grid.width + rect.x0 + x] = value as f32;
+            }
+        }
+    }
+
+    /// Reads the block's fixed pixels and lists the others (and those outside the image) as
+    /// unknowns; `None` when the block has no fixed pixel or no free one.
+    fn gather(
+        &mut self,
+        width: usize,
+        rect: BlockRect,
+        image: &[f32],
+        fixed: &[bool],
+    ) -> Option<Known> {
+        let mut known = Known {
+            values: [0.0; N],
+            is_fixed: [false; N],
+            mean: 0.0,
+        };
         let mut fixed_sum = 0.0;
         let mut fixed_count = 0usize;
         self.unknowns.clear();
@@ -142,9 +168,9 @@ impl DctEnergy {
                 let inside = x < rect.w && y < rect.h;
                 let pixel = (rect.y0 + y) * width + rect.x0 + x;
                 if inside && fixed[pixel] {
-                    is_fixed[local] = true;
-                    known[local] = f64::from(image[pixel]);
-                    fixed_sum += known[local];
+                    known.is_fixed[local] = true;
+                    known.values[local] = f64::from(image[pixel]);
+                    fixed_sum += known.values[local];
                     fixed_count += 1;
                 } else {
                     self.unknowns.push(local);
@@ -152,35 +178,32 @@ impl DctEnergy {
             }
         }
         if fixed_count == 0 || self.unknowns.is_empty() {
-            return;
+            return None;
         }
+        known.mean = fixed_sum / fixed_count as f64;
+        Some(known)
+    }
+
+    /// Minimises the block energy over the unknowns by CG, from the fixed pixels' mean; the
+    /// solution is left in `self.x`.
+    fn solve(&mut self, known: &Known, limits: CgLimits) -> cg::CgReport {
         let (basis, weight) = (&self.basis, &self.weight);
-        let operator = |block: &[f64; N], out: &mut [f64; N]| {
-            let mut coefficients = [0.0; N];
-            transform(basis, block, &mut coefficients, false);
-            coefficients
-                .iter_mut()
-                .zip(weight)
-                .for_each(|(c, w)| *c *= w);
-            transform(basis, &coefficients, out, true);
-        };
         let mut image_of_known = [0.0; N];
-        operator(&known, &mut image_of_known);
+        apply_energy(basis, weight, &known.values, &mut image_of_known);
         self.rhs.clear();
         self.rhs
             .extend(self.unknowns.iter().map(|&u| -image_of_known[u]));
         self.x.clear();
-        self.x
-            .resize(self.unknowns.len(), fixed_sum / fixed_count as f64);
+        self.x.resize(self.unknowns.len(), known.mean);
         let unknowns = &self.unknowns;
-        let report = cg::solve(
+        cg::solve(
             |v, out| {
                 let mut block = [0.0; N];
                 for (&u, &value) in unknowns.iter().zip(v) {
                     block[u] = value;
                 }
                 let mut result = [0.0; N];
-                operator(&block, &mut result);
+                apply_energy(basis, weight, &block, &mut result);
                 for (o, &u) in out.iter_mut().zip(unknowns) {
                     *o = result[u];
                 }
@@ -189,38 +212,54 @@ impl DctEnergy {
             &mut self.x,
             limits,
             &mut self.scratch,
-        );
-        stats.record(report);
-        if let Some(steps) = &self.snap_steps {
-            let mut block = known;
-            for (&u, &value) in self.unknowns.iter().zip(&self.x) {
-                block[u] = value;
-            }
-            for _ in 0..SNAP_ROUNDS {
-                let mut c = [0.0; N];
-                transform(basis, &block, &mut c, false);
-                for (ck, q) in c.iter_mut().zip(steps).skip(1) {
-                    if ck.abs() < 0.5 * q {
-                        *ck = 0.0;
-                    }
-                }
-                let mut back = [0.0; N];
-                transform(basis, &c, &mut back, true);
-                for &u in &self.unknowns {
-                    block[u] = back[u];
+        )
+    }
+
+    /// `SNAP_ROUNDS` rounds of: zero the AC coefficients the quantiser `steps` round to 0, then
+    /// put the fixed pixels back; updates `self.x`.
+    fn snap(&mut self, known: &Known, steps: &[f64; N]) {
+        let mut block = known.values;
+        for (&u, &value) in self.unknowns.iter().zip(&self.x) {
+            block[u] = value;
+        }
+        for _ in 0..SNAP_ROUNDS {
+            let mut c = [0.0; N];
+            transform(&self.basis, &block, &mut c, false);
+            for (ck, q) in c.iter_mut().zip(steps).skip(1) {
+                if ck.abs() < 0.5 * q {
+                    *ck = 0.0;
                 }
             }
-            for (x, &u) in self.x.iter_mut().zip(&self.unknowns) {
-                *x = block[u];
+            let mut back = [0.0; N];
+            transform(&self.basis, &c, &mut back, true);
+            for &u in &self.unknowns {
+                block[u] = back[u];
             }
         }
-        for (&u, &value) in self.unknowns.iter().zip(&self.x) {
-            let (x, y) = (u % SIDE, u / SIDE);
-            if x < rect.w && y < rect.h && !is_fixed[u] {
-                image[(rect.y0 + y) * width + rect.x0 + x] = value as f32;
-            }
+        for (x, &u) in self.x.iter_mut().zip(&self.unknowns) {
+            *x = block[u];
         }
     }
+}
+
+/// One block's fixed pixels, read from the image.
+struct Known {
+    /// Fixed values at their place in the block, 0 elsewhere.
+    values: [f64; N],
+    is_fixed: [bool; N],
+    /// Mean of the fixed values: where CG starts the unknowns.
+    mean: f64,
+}
+
+/// The energy's operator DᵀWD applied to a block: DCT, weight each coefficient, inverse DCT.
+fn apply_energy(basis: &[f64; N], weight: &[f64; N], block: &[f64; N], out: &mut [f64; N]) {
+    let mut coefficients = [0.0; N];
+    transform(basis, block, &mut coefficients, false);
+    coefficients
+        .iter_mut()
+        .zip(weight)
+        .for_each(|(c, w)| *c *= w);
+    transform(basis, &coefficients, out, true);
 }
 
 /// Projection rounds of `snap` (see the module doc).

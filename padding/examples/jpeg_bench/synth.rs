@@ -225,7 +225,27 @@ impl Layout {
 
 /// Triangles grouped by dominant normal axis and sign, then split into edge-connected pieces.
 fn make_charts(first: &[Point], triangles: &[[usize; 3]]) -> Vec<Chart> {
-    let label: Vec<usize> = triangles
+    let mut label = normal_labels(first, triangles);
+    let neighbours = edge_neighbours(triangles);
+    let pieces = merge_small_pieces(&mut label, &neighbours);
+    let mut by_root: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (t, &p) in pieces.iter().enumerate() {
+        by_root.entry(p).or_default().push(t);
+    }
+    let mut charts: Vec<Chart> = by_root
+        .into_values()
+        .map(|tris| {
+            let axis = label[tris[0]] / 2;
+            project_chart(tris, axis, first, triangles)
+        })
+        .collect();
+    charts.sort_by(|a, b| (b.max.1 - b.min.1).total_cmp(&(a.max.1 - a.min.1)));
+    charts
+}
+
+/// Per triangle, the dominant axis of its normal and its sign: `axis * 2 + (negative)`.
+fn normal_labels(first: &[Point], triangles: &[[usize; 3]]) -> Vec<usize> {
+    triangles
         .iter()
         .map(|&[a, b, c]| {
             let (p, q, r) = (first[a], first[b], first[c]);
@@ -241,8 +261,12 @@ fn make_charts(first: &[Point], triangles: &[[usize; 3]]) -> Vec<Chart> {
                 .unwrap_or(0);
             axis * 2 + usize::from(n[axis] < 0.0)
         })
-        .collect();
-    let mut label = label;
+        .collect()
+}
+
+/// Per triangle, the triangles sharing an edge with it (each pair found through the edge's
+/// first triangle).
+fn edge_neighbours(triangles: &[[usize; 3]]) -> Vec<Vec<usize>> {
     let mut edge_owner: HashMap<(usize, usize), usize> = HashMap::new();
     let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); triangles.len()];
     for (t, tri) in triangles.iter().enumerate() {
@@ -259,19 +283,25 @@ fn make_charts(first: &[Point], triangles: &[[usize; 3]]) -> Vec<Chart> {
             }
         }
     }
-    // Pieces under MIN_TRIANGLES join the largest neighbouring piece (as an atlas builder merges
-    // slivers), which stops hundreds of one-triangle charts from each taking a block.
+    neighbours
+}
+
+/// The pieces (see [`components`]) after pieces under MIN_TRIANGLES take the label of their
+/// largest neighbouring piece, for up to 6 rounds (as an atlas builder merges slivers), which stops
+/// hundreds of one-triangle charts from each taking a block. Updates `label`.
+fn merge_small_pieces(label: &mut [usize], neighbours: &[Vec<usize>]) -> Vec<usize> {
     const MIN_TRIANGLES: usize = 24;
-    let mut pieces = components(&label, &neighbours);
+    let triangles = label.len();
+    let mut pieces = components(label, neighbours);
     for _ in 0..6 {
         let sizes = pieces
             .iter()
-            .fold(vec![0usize; triangles.len()], |mut sizes, &p| {
+            .fold(vec![0usize; triangles], |mut sizes, &p| {
                 sizes[p] += 1;
                 sizes
             });
         let mut relabel: HashMap<usize, (usize, usize)> = HashMap::new();
-        for t in 0..triangles.len() {
+        for t in 0..triangles {
             if sizes[pieces[t]] >= MIN_TRIANGLES {
                 continue;
             }
@@ -288,65 +318,63 @@ fn make_charts(first: &[Point], triangles: &[[usize; 3]]) -> Vec<Chart> {
         if relabel.is_empty() {
             break;
         }
-        for t in 0..triangles.len() {
+        for t in 0..triangles {
             if let Some(&(_, l)) = relabel.get(&pieces[t]) {
                 label[t] = l;
             }
         }
-        pieces = components(&label, &neighbours);
+        pieces = components(label, neighbours);
     }
-    let mut by_root: HashMap<usize, Vec<usize>> = HashMap::new();
-    for (t, &p) in pieces.iter().enumerate() {
-        by_root.entry(p).or_default().push(t);
-    }
-    let mut charts: Vec<Chart> = by_root
-        .into_values()
-        .map(|tris| {
-            let axis = label[tris[0]] / 2;
-            let unit = |c: usize| -> Point { std::array::from_fn(|i| f64::from(u8::from(i == c))) };
-            let plane = [unit((axis + 1) % 3), unit((axis + 2) % 3)];
-            let corners: Vec<(f64, f64)> = tris
-                .iter()
-                .flat_map(|&t| triangles[t])
-                .map(|v| project(&plane, first[v]))
-                .collect();
-            let n = corners.len() as f64;
-            let (mu, mv) = corners
-                .iter()
-                .fold((0.0, 0.0), |(a, b), &(u, v)| (a + u / n, b + v / n));
-            let (suu, svv, suv) = corners.iter().fold((0.0, 0.0, 0.0), |(a, b, c), &(u, v)| {
-                (
-                    a + (u - mu) * (u - mu),
-                    b + (v - mv) * (v - mv),
-                    c + (u - mu) * (v - mv),
-                )
-            });
-            let angle = 0.5 * (2.0 * suv).atan2(suu - svv);
-            let (sin, cos) = angle.sin_cos();
-            let directions = [
-                std::array::from_fn(|i| cos * plane[0][i] + sin * plane[1][i]),
-                std::array::from_fn(|i| -sin * plane[0][i] + cos * plane[1][i]),
-            ];
-            let mut min = (f64::MAX, f64::MAX);
-            let mut max = (f64::MIN, f64::MIN);
-            for &t in &tris {
-                for &v in &triangles[t] {
-                    let (u, w) = project(&directions, first[v]);
-                    min = (min.0.min(u), min.1.min(w));
-                    max = (max.0.max(u), max.1.max(w));
-                }
-            }
-            Chart {
-                triangles: tris,
-                directions,
-                min,
-                max,
-                origin: (0, 0),
-            }
-        })
+    pieces
+}
+
+/// The chart of triangles `tris` projected along `axis`, turned to its 2-D principal axes.
+fn project_chart(
+    tris: Vec<usize>,
+    axis: usize,
+    first: &[Point],
+    triangles: &[[usize; 3]],
+) -> Chart {
+    let unit = |c: usize| -> Point { std::array::from_fn(|i| f64::from(u8::from(i == c))) };
+    let plane = [unit((axis + 1) % 3), unit((axis + 2) % 3)];
+    let corners: Vec<(f64, f64)> = tris
+        .iter()
+        .flat_map(|&t| triangles[t])
+        .map(|v| project(&plane, first[v]))
         .collect();
-    charts.sort_by(|a, b| (b.max.1 - b.min.1).total_cmp(&(a.max.1 - a.min.1)));
-    charts
+    let n = corners.len() as f64;
+    let (mu, mv) = corners
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(u, v)| (a + u / n, b + v / n));
+    let (suu, svv, suv) = corners.iter().fold((0.0, 0.0, 0.0), |(a, b, c), &(u, v)| {
+        (
+            a + (u - mu) * (u - mu),
+            b + (v - mv) * (v - mv),
+            c + (u - mu) * (v - mv),
+        )
+    });
+    let angle = 0.5 * (2.0 * suv).atan2(suu - svv);
+    let (sin, cos) = angle.sin_cos();
+    let directions = [
+        std::array::from_fn(|i| cos * plane[0][i] + sin * plane[1][i]),
+        std::array::from_fn(|i| -sin * plane[0][i] + cos * plane[1][i]),
+    ];
+    let mut min = (f64::MAX, f64::MAX);
+    let mut max = (f64::MIN, f64::MIN);
+    for &t in &tris {
+        for &v in &triangles[t] {
+            let (u, w) = project(&directions, first[v]);
+            min = (min.0.min(u), min.1.min(w));
+            max = (max.0.max(u), max.1.max(w));
+        }
+    }
+    Chart {
+        triangles: tris,
+        directions,
+        min,
+        max,
+        origin: (0, 0),
+    }
 }
 
 fn project(directions: &[Point; 2], p: Point) -> (f64, f64) {
