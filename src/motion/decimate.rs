@@ -60,8 +60,9 @@
 //! rigidly, E_l ≈ 0), in 2.5 s (segmentation only: not encoded, so the partition coder's path for
 //! more than 256 clusters is untested by this).
 
+use super::partition::{compact, Partition};
 use super::refine::refine_borders;
-use super::segment::{compact, feature_frames, welded_adjacency, Partition, SampledMotion};
+use super::sampled_motion::{feature_frames, welded_adjacency, SampledMotion};
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::AnimatedMesh;

@@ -10,16 +10,19 @@
 mod affine;
 mod decimate;
 mod fit;
+mod partition;
 mod predict;
 mod refine;
+mod sampled_motion;
 mod segment;
 mod skinning;
 
 pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_BITS};
 pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
 pub use fit::AffineCoefficients;
+pub use partition::Partition;
 pub use predict::{energy, residuals};
-pub use segment::{segment, Partition, SegmentOptions, MIN_CLUSTER_SIZE};
+pub use segment::{segment, SegmentOptions, MIN_CLUSTER_SIZE};
 pub use skinning::{
     cluster_neighbours, predict_frame, PredictorKind, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT,
     WEIGHT_BITS,

@@ -25,7 +25,7 @@
 
 use super::affine::AffineTrack;
 use super::fit::{apply, UnitFrame};
-use super::segment::Partition;
+use super::partition::Partition;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
 use nalgebra::{DMatrix, DVector};
