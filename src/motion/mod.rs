@@ -10,20 +10,19 @@
 mod affine;
 mod decimate;
 mod fit;
+mod kmeans;
 mod partition;
-mod predict;
+mod predictor;
 mod refine;
+mod residual;
 mod sampled_motion;
-mod segment;
 mod skinning;
 
 pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_BITS};
 pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
 pub use fit::AffineCoefficients;
+pub use kmeans::{segment, SegmentOptions, MIN_CLUSTER_SIZE};
 pub use partition::Partition;
-pub use predict::{energy, residuals};
-pub use segment::{segment, SegmentOptions, MIN_CLUSTER_SIZE};
-pub use skinning::{
-    cluster_neighbours, predict_frame, PredictorKind, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT,
-    WEIGHT_BITS,
-};
+pub use predictor::{predict_frame, PredictorKind};
+pub use residual::{energy, residuals};
+pub use skinning::{cluster_neighbours, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT, WEIGHT_BITS};

@@ -1,4 +1,5 @@
-//! Motion-based segmentation (MCGV §3.1): per-vertex affine motion of its k-ring, clustered by k-means.
+//! Segmentation by k-means (MCGV §3.1): each vertex is described by the affine motion of its k-ring,
+//! the descriptors are clustered by k-means, then borders are refined and tiny clusters dissolved.
 
 use super::fit::{apply, AffineSolver};
 use super::partition::{compact, Partition};
