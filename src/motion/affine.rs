@@ -2,7 +2,7 @@
 //! decoded frame 0 (eq. 2), quantised for the stream, and applied with the dequantised coefficients.
 
 use super::fit::{apply, AffineCoefficients, AffineSolver, UnitFrame};
-use super::segment::Partition;
+use super::partition::Partition;
 use crate::error::{Error, Result};
 use crate::mesh::Point;
 use rayon::prelude::*;

@@ -6,21 +6,34 @@
 //! ```text
 //! segment(mesh) | decimate(mesh) ─► Partition ─► AffineTrack::fit(frames, decoded frame 0) ─► predict(i) ─► residuals
 //! ```
+//!
+//! - `sampled_motion`: frame 0 and sampled frames in unit coordinates, the seam-welded vertex graph
+//! - `kmeans`: segmentation by k-means of per-vertex ring motion (MCGV §3.1)
+//! - `decimate`: segmentation by half-edge collapses (skinning paper §3.1)
+//! - `refine`: border refinement by trajectory prediction error, shared by both segmentations
+//! - `partition`: the cluster id per vertex that segmentation yields
+//! - `fit`: regularised least-squares affine fits and the unit frame
+//! - `affine`: the piecewise affine predictor, fitted and quantised (MCGV §3.2)
+//! - `skinning`: the skinning predictor's per-vertex weights (follow-up paper §3.2)
+//! - `predictor`: which predictor a stream uses, and the one prediction both codec sides call
+//! - `residual`: prediction residuals and their energy
 
 mod affine;
 mod decimate;
 mod fit;
-mod predict;
+mod kmeans;
+mod partition;
+mod predictor;
 mod refine;
-mod segment;
+mod residual;
+mod sampled_motion;
 mod skinning;
 
 pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_BITS};
 pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
 pub use fit::AffineCoefficients;
-pub use predict::{energy, residuals};
-pub use segment::{segment, Partition, SegmentOptions, MIN_CLUSTER_SIZE};
-pub use skinning::{
-    cluster_neighbours, predict_frame, PredictorKind, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT,
-    WEIGHT_BITS,
-};
+pub use kmeans::{segment, SegmentOptions, MIN_CLUSTER_SIZE};
+pub use partition::Partition;
+pub use predictor::{predict_frame, PredictorKind};
+pub use residual::{energy, residuals};
+pub use skinning::{cluster_neighbours, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT, WEIGHT_BITS};

@@ -2,7 +2,7 @@
 //! predict a vertex's trajectory over the sampled frames.
 
 use super::fit::{apply, AffineCoefficients, AffineSolver};
-use super::segment::{SampledMotion, RING_LAMBDA};
+use super::sampled_motion::{SampledMotion, SAMPLED_FIT_LAMBDA};
 use crate::mesh::topology::VertexAdjacency;
 use rayon::prelude::*;
 
@@ -18,7 +18,7 @@ fn cluster_tracks(
                 return None;
             }
             let source: Vec<[f64; 3]> = m.iter().map(|&v| motion.rest[v]).collect();
-            let solver = AffineSolver::new(&source, RING_LAMBDA);
+            let solver = AffineSolver::new(&source, SAMPLED_FIT_LAMBDA);
             Some(
                 motion
                     .frames

@@ -25,7 +25,7 @@
 
 use super::affine::AffineTrack;
 use super::fit::{apply, UnitFrame};
-use super::segment::Partition;
+use super::partition::Partition;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
 use nalgebra::{DMatrix, DVector};
@@ -41,27 +41,6 @@ pub const DEFAULT_RIDGE: f64 = 1e-4;
 /// Largest weight magnitude kept; larger fits (from near-degenerate normal matrices) are clamped,
 /// which keeps the 16-bit step fine for the ordinary weights of the stream.
 pub const MAX_WEIGHT: f64 = 8.0;
-
-/// The predictors an encoder can choose; recorded in the stream header.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum PredictorKind {
-    /// One affine map per cluster and frame (MCGV eq. 3; the follow-up paper's eq. 8).
-    #[default]
-    Affine,
-    /// Per-vertex weights over the own and neighbouring clusters' maps (follow-up paper eq. 7–10).
-    Skinning,
-}
-
-impl PredictorKind {
-    /// The name used on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            PredictorKind::Affine => "affine",
-            PredictorKind::Skinning => "skinning",
-        }
-    }
-}
 
 /// For every cluster, the sorted clusters joined to it by a mesh edge (itself excluded).
 pub fn cluster_neighbours(partition: &Partition, triangles: &[Triangle]) -> Vec<Vec<u32>> {
@@ -307,21 +286,6 @@ impl SkinningWeights {
             offset += len;
         }
         n
-    }
-}
-
-/// Frame `frame` as the stream's predictor sees it: the skinning blend when `weights` are given,
-/// else the piecewise affine prediction. Encoder and decoder both predict through this function.
-pub fn predict_frame(
-    track: &AffineTrack,
-    weights: Option<&SkinningWeights>,
-    frame: usize,
-    reference: &[Point],
-    partition: &Partition,
-) -> Result<Vec<Point>> {
-    match weights {
-        Some(w) => w.try_predict(frame, track, reference, partition),
-        None => track.try_predict(frame, reference, partition),
     }
 }
 

@@ -1,10 +1,13 @@
-//! Motion-based segmentation (MCGV §3.1): per-vertex affine motion of its k-ring, clustered by k-means.
+//! Segmentation by k-means (MCGV §3.1): each vertex is described by the affine motion of its k-ring,
+//! the descriptors are clustered by k-means, then borders are refined and tiny clusters dissolved.
 
-use super::fit::{apply, AffineSolver, UnitFrame};
+use super::fit::{apply, AffineSolver};
+use super::partition::{compact, Partition};
 use super::refine::{assign_by_trajectory, refine_borders};
+use super::sampled_motion::{welded_adjacency, SampledMotion, SAMPLED_FIT_LAMBDA};
 use crate::error::{Error, Result};
 use crate::mesh::topology::{KRingScratch, VertexAdjacency};
-use crate::mesh::{AnimatedMesh, Triangle};
+use crate::mesh::AnimatedMesh;
 use linfa::traits::{Fit, Predict};
 use linfa::DatasetBase;
 use linfa_clustering::{KMeans, KMeansInit};
@@ -15,10 +18,6 @@ use rayon::prelude::*;
 
 /// Fewest vertices a cluster needs so that its affine map (12 unknowns, 3 equations per vertex) is determined.
 pub const MIN_CLUSTER_SIZE: usize = 4;
-
-/// Regularisation of the per-vertex fits, relative to the ring's spread: large enough that nearly
-/// flat rings do not turn noise into wild out-of-plane coefficients, small enough not to bias real motion.
-pub(super) const RING_LAMBDA: f64 = 1e-3;
 
 /// How to segment.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -51,66 +50,6 @@ impl Default for SegmentOptions {
             max_iterations: 20,
             refine_passes: 4,
         }
-    }
-}
-
-/// A cluster id per vertex. Labels are compact: every cluster in `0..clusters()` has at least one vertex.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Partition {
-    labels: Vec<u32>,
-    clusters: usize,
-}
-
-impl Partition {
-    /// Checks and wraps labels (e.g. read from a stream): at least one vertex, every label below
-    /// `clusters`, and every cluster used.
-    pub fn from_labels(labels: Vec<u32>, clusters: usize) -> Result<Self> {
-        if labels.is_empty() {
-            return Err(Error::Stream("partition has no vertices".into()));
-        }
-        let mut used = vec![false; clusters];
-        for (v, &l) in labels.iter().enumerate() {
-            match used.get_mut(l as usize) {
-                Some(u) => *u = true,
-                None => {
-                    return Err(Error::Stream(format!(
-                        "partition: vertex {v} has cluster {l}, but there are only {clusters}"
-                    )))
-                }
-            }
-        }
-        if let Some(k) = used.iter().position(|&u| !u) {
-            return Err(Error::Stream(format!(
-                "partition: cluster {k} of {clusters} has no vertex"
-            )));
-        }
-        Ok(Self { labels, clusters })
-    }
-
-    /// The cluster of each vertex.
-    pub fn labels(&self) -> &[u32] {
-        &self.labels
-    }
-
-    /// Number of clusters.
-    pub fn clusters(&self) -> usize {
-        self.clusters
-    }
-
-    /// Number of vertices.
-    pub fn vertex_count(&self) -> usize {
-        self.labels.len()
-    }
-
-    /// The vertices of each cluster, in increasing order.
-    pub fn members(&self) -> Vec<Vec<u32>> {
-        let mut members = vec![Vec::new(); self.clusters];
-        for (v, &l) in self.labels.iter().enumerate() {
-            if let Some(m) = members.get_mut(l as usize) {
-                m.push(v as u32);
-            }
-        }
-        members
     }
 }
 
@@ -186,67 +125,6 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
     compact(labels)
 }
 
-/// Most copies of one position that are welded: seams make a few; more is collapsed geometry
-/// (e.g. hidden parts parked at one point), and welding it would join unrelated parts through one hub.
-const MAX_WELD_GROUP: usize = 8;
-
-/// The mesh's vertex adjacency, plus an edge between vertices at the very same frame-0 position
-/// that stay together (within float noise) in every sampled frame. Exporters split vertices along
-/// UV and normal seams (glTF meshes often fall into dozens of pieces, a triangle soup at worst);
-/// without these edges the rings would stop at every seam, down to a lone flat triangle.
-pub(super) fn welded_adjacency(mesh: &AnimatedMesh, motion: &SampledMotion) -> VertexAdjacency {
-    let mut groups: std::collections::HashMap<[u32; 3], Vec<u32>> =
-        std::collections::HashMap::new();
-    for (v, p) in mesh.frame(0).iter().enumerate() {
-        groups
-            .entry(p.map(f32::to_bits))
-            .or_default()
-            .push(v as u32);
-    }
-    let together = |a: u32, b: u32| {
-        motion.frames.iter().all(|f| {
-            let (p, q) = (f[a as usize], f[b as usize]);
-            (0..3).all(|i| (p[i] - q[i]).abs() <= 1e-6)
-        })
-    };
-    let mut edges: Vec<Triangle> = mesh.triangles().to_vec();
-    for group in groups
-        .values()
-        .filter(|g| (2..=MAX_WELD_GROUP).contains(&g.len()))
-    {
-        for &v in &group[1..] {
-            if together(group[0], v) {
-                // A degenerate triangle contributes just the edge.
-                edges.push([group[0], v, v]);
-            }
-        }
-    }
-    VertexAdjacency::new(mesh.vertex_count(), &edges)
-}
-
-/// Frame 0 and the sampled frames of an animation, in the unit frame of frame 0.
-pub(super) struct SampledMotion {
-    /// Frame 0.
-    pub(super) rest: Vec<[f64; 3]>,
-    /// The sampled frames.
-    pub(super) frames: Vec<Vec<[f64; 3]>>,
-}
-
-impl SampledMotion {
-    /// Frame 0 and up to `wanted` evenly spread frames (see [`feature_frames`]), in unit coordinates.
-    pub(super) fn new(mesh: &AnimatedMesh, wanted: usize) -> Self {
-        let unit = UnitFrame::of(mesh.frame(0));
-        let to_unit = |f: &[crate::mesh::Point]| f.iter().map(|p| unit.to_unit(p)).collect();
-        Self {
-            rest: to_unit(mesh.frame(0)),
-            frames: feature_frames(mesh.frame_count(), wanted)
-                .into_iter()
-                .map(|f| to_unit(mesh.frame(f)))
-                .collect(),
-        }
-    }
-}
-
 /// The vertices whose ring moves affinely, up to the typical deviation: those whose ring misfit is
 /// at most a few times the median. The others straddle parts that move differently (seams); their
 /// torn fits are far-off points that would pull k-means centroids away from the real parts.
@@ -289,7 +167,7 @@ fn motion_features(
                 let ring = scratch.k_ring(adjacency, v, ring);
                 source.clear();
                 source.extend(ring.iter().map(|&u| rest[u as usize]));
-                let solver = AffineSolver::new(source, RING_LAMBDA);
+                let solver = AffineSolver::new(source, SAMPLED_FIT_LAMBDA);
                 let mut error = 0.0;
                 for (slot, target) in row.chunks_exact_mut(12).zip(&motion.frames) {
                     let h = solver.solve(ring.iter().map(|&u| target[u as usize]));
@@ -320,16 +198,6 @@ fn motion_features(
     let features = Array2::from_shape_vec((v_count, dim), data)
         .unwrap_or_else(|_| Array2::zeros((v_count, dim)));
     (features, misfit)
-}
-
-/// Up to `wanted` frames spread evenly over `1..frame_count` (frame 0 is the identity for every vertex).
-pub(super) fn feature_frames(frame_count: usize, wanted: usize) -> Vec<usize> {
-    if frame_count <= 1 {
-        return vec![0];
-    }
-    let last = frame_count - 1;
-    let m = wanted.min(last);
-    (1..=m).map(|j| (j * last + m / 2) / m).collect()
 }
 
 /// RMS distance of the feature rows to their mean: the scale k-means' tolerance is relative to.
@@ -393,42 +261,5 @@ fn dissolve_small_clusters(
                 *s += 1;
             }
         }
-    }
-}
-
-/// Renumbers labels `0..n` in order of first appearance.
-pub(super) fn compact(labels: Vec<usize>) -> Result<Partition> {
-    let mut map = std::collections::HashMap::new();
-    let compact: Vec<u32> = labels
-        .into_iter()
-        .map(|l| {
-            let next = map.len() as u32;
-            *map.entry(l).or_insert(next)
-        })
-        .collect();
-    Partition::from_labels(compact, map.len())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn feature_frames_are_spread_and_distinct() {
-        assert_eq!(feature_frames(1, 64), vec![0]);
-        assert_eq!(feature_frames(5, 64), vec![1, 2, 3, 4]);
-        let f = feature_frames(201, 64);
-        assert_eq!(f.len(), 64);
-        assert_eq!(f.last(), Some(&200));
-        assert!(f.windows(2).all(|w| w[0] < w[1]));
-    }
-
-    #[test]
-    fn partition_rejects_bad_labels() {
-        assert!(Partition::from_labels(vec![0, 2], 2).is_err());
-        assert!(Partition::from_labels(vec![0, 0], 2).is_err());
-        assert!(Partition::from_labels(vec![], 1).is_err());
-        let p = Partition::from_labels(vec![1, 0, 1], 2).unwrap();
-        assert_eq!(p.members(), vec![vec![1], vec![0, 2]]);
     }
 }

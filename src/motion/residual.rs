@@ -1,4 +1,4 @@
-//! Prediction residuals (MCGV eq. 4): what the geometry images carry.
+//! Prediction residuals (MCGV eq. 4), what the geometry images carry, and their energy.
 
 use crate::mesh::Point;
 
