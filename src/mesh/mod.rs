@@ -6,7 +6,7 @@
 pub mod io;
 pub mod topology;
 
-mod gltf_import;
+mod gltf;
 mod obj;
 mod pc2;
 
