@@ -43,11 +43,14 @@ impl FrameTimes {
         let rate = fps.unwrap_or_else(|| keyframe_rate(channels).unwrap_or(FALLBACK_FPS));
         let count = ((end - start).max(0.0) * rate + 1e-6).floor() + 1.0;
         if !(count.is_finite() && count * vertex_count as f64 <= MAX_POSITIONS) {
-            return Err(Error::Mesh(format!(
-                "{}: {:.3} s at {rate} frames/s is {count} frames of {vertex_count} vertices: too many, lower --fps",
-                path.display(),
-                end - start,
-            )));
+            return Err(Error::option(
+                "fps",
+                format!(
+                    "too high for {}: {:.3} s at {rate} frames/s is {count} frames of {vertex_count} vertices, too many to hold; give a lower rate",
+                    path.display(),
+                    end - start,
+                ),
+            ));
         }
         Ok(Self {
             start,
