@@ -1,9 +1,9 @@
 //! Reading and writing animations in every form the tool takes: OBJ sequences, PC2 + base OBJ, glTF.
 //!
-//! The formats themselves live in [`super::obj`], [`super::pc2`] and [`super::gltf_import`]; this
+//! The formats themselves live in [`super::obj`], [`super::pc2`] and [`super::gltf`]; this
 //! module picks one from the input's name and writes files so that a failure never leaves half of one.
 
-use super::{gltf_import, obj, pc2, AnimatedMesh};
+use super::{gltf, obj, pc2, AnimatedMesh};
 use crate::error::{Error, Result};
 use crate::output::write_atomic;
 use std::path::{Path, PathBuf};
@@ -42,7 +42,7 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
     }
     match extension.as_deref() {
         Some("pc2") => pc2::read_pc2_animation(path, opts.base.as_deref()),
-        Some("gltf") | Some("glb") => gltf_import::read_gltf(path, opts.fps, opts.clip.as_deref()),
+        Some("gltf") | Some("glb") => gltf::read_gltf(path, opts.fps, opts.clip.as_deref()),
         _ => obj::read_sequence(&obj::frame_files(input)?),
     }
 }
@@ -61,7 +61,7 @@ pub fn input_files(input: &str, opts: &ReadOptions) -> Result<Vec<PathBuf>> {
                 .clone()
                 .unwrap_or_else(|| path.with_extension("obj")),
         ]),
-        Some("gltf") | Some("glb") => Ok(gltf_import::files(path)),
+        Some("gltf") | Some("glb") => Ok(gltf::files(path)),
         _ => obj::frame_files(input),
     }
 }
@@ -86,7 +86,7 @@ pub fn parse_gltf(
     fps: Option<f64>,
     clip: Option<&str>,
 ) -> Result<AnimatedMesh> {
-    gltf_import::parse_gltf(bytes, name, fps, clip)
+    gltf::parse_gltf(bytes, name, fps, clip)
 }
 
 /// Writes one OBJ per frame into `dir` as `frame_0000.obj`, … (created if missing).

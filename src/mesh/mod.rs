@@ -7,7 +7,7 @@ pub mod io;
 mod summary;
 pub mod topology;
 
-mod gltf_import;
+mod gltf;
 mod obj;
 mod pc2;
 

@@ -32,77 +32,18 @@ pub(crate) fn read_obj(path: &Path) -> Result<ObjFrame> {
 
 /// Parses OBJ text; `path` only names the file in error messages.
 pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
-    let at =
-        |line: usize, what: String| Error::Mesh(format!("{}: line {line}: {what}", path.display()));
     let mut positions: Vec<Point> = Vec::new();
     // Corners keep the 1-based or negative OBJ index until all positions are known, because a face
     // may name a vertex defined further down.
     let mut triangles: Vec<[(i64, usize); 3]> = Vec::new();
     let mut corners: Vec<i64> = Vec::new();
     for (line_no, line) in logical_lines(text) {
+        let at = |what: String| line_error(path, line_no, what);
         let mut words = line.split_whitespace();
         match words.next() {
-            Some("v") => {
-                let mut p = [0f32; 3];
-                for c in &mut p {
-                    let word = words
-                        .next()
-                        .ok_or_else(|| at(line_no, "a vertex needs three coordinates".into()))?;
-                    *c = word
-                        .parse()
-                        .map_err(|_| at(line_no, format!("`{word}` is not a number")))?;
-                }
-                // An optional fourth value is the homogeneous w (three more would be a colour).
-                let rest: Vec<&str> = words.collect();
-                if rest.len() == 1 {
-                    let w: f32 = rest[0]
-                        .parse()
-                        .map_err(|_| at(line_no, format!("`{}` is not a number", rest[0])))?;
-                    if w == 0.0 {
-                        return Err(at(line_no, "vertex has w = 0".into()));
-                    }
-                    p.iter_mut().for_each(|c| *c /= w);
-                }
-                if p.iter().any(|c| !c.is_finite()) {
-                    return Err(at(
-                        line_no,
-                        format!(
-                            "vertex {} has a coordinate that is not a finite number ({} {} {})",
-                            positions.len() + 1,
-                            p[0],
-                            p[1],
-                            p[2]
-                        ),
-                    ));
-                }
-                positions.push(p);
-            }
+            Some("v") => positions.push(parse_vertex(words, positions.len()).map_err(at)?),
             Some("f") => {
-                corners.clear();
-                for word in words {
-                    let index = word.split('/').next().unwrap_or("");
-                    let index: i64 = index
-                        .parse()
-                        .map_err(|_| at(line_no, format!("`{word}` is not a vertex reference")))?;
-                    if index == 0 {
-                        return Err(at(line_no, "vertex index 0 (OBJ counts from 1)".into()));
-                    }
-                    // A negative index counts back from the last vertex read so far.
-                    corners.push(if index < 0 {
-                        positions.len() as i64 + index + 1
-                    } else {
-                        index
-                    });
-                }
-                if corners.len() < 3 {
-                    return Err(at(
-                        line_no,
-                        format!(
-                            "a face needs at least 3 vertices, this one has {}",
-                            corners.len()
-                        ),
-                    ));
-                }
+                parse_face(words, positions.len(), &mut corners).map_err(at)?;
                 for k in 1..corners.len() - 1 {
                     triangles.push([
                         (corners[0], line_no),
@@ -124,14 +65,104 @@ pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
             positions.len()
         )));
     }
-    let v = positions.len() as i64;
-    let triangles = triangles
+    let triangles = resolve_corners(triangles, positions.len(), path)?;
+    Ok(ObjFrame {
+        positions,
+        triangles,
+    })
+}
+
+/// An error on line `line` of the file at `path`.
+fn line_error(path: &Path, line: usize, what: String) -> Error {
+    Error::Mesh(format!("{}: line {line}: {what}", path.display()))
+}
+
+/// The position of a `v` line (the words after `v`), divided by its homogeneous w if it has one;
+/// `read` is the number of vertices before it.
+fn parse_vertex<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    read: usize,
+) -> std::result::Result<Point, String> {
+    let mut p = [0f32; 3];
+    for c in &mut p {
+        let word = words
+            .next()
+            .ok_or_else(|| "a vertex needs three coordinates".to_string())?;
+        *c = word
+            .parse()
+            .map_err(|_| format!("`{word}` is not a number"))?;
+    }
+    // An optional fourth value is the homogeneous w (three more would be a colour).
+    let rest: Vec<&str> = words.collect();
+    if rest.len() == 1 {
+        let w: f32 = rest[0]
+            .parse()
+            .map_err(|_| format!("`{}` is not a number", rest[0]))?;
+        if w == 0.0 {
+            return Err("vertex has w = 0".into());
+        }
+        p.iter_mut().for_each(|c| *c /= w);
+    }
+    if p.iter().any(|c| !c.is_finite()) {
+        return Err(format!(
+            "vertex {} has a coordinate that is not a finite number ({} {} {})",
+            read + 1,
+            p[0],
+            p[1],
+            p[2]
+        ));
+    }
+    Ok(p)
+}
+
+/// The corners of an `f` line (the words after `f`) into `corners` as 1-based indices, negative
+/// ones resolved against the `read` vertices so far; a face needs at least three.
+fn parse_face<'a>(
+    words: impl Iterator<Item = &'a str>,
+    read: usize,
+    corners: &mut Vec<i64>,
+) -> std::result::Result<(), String> {
+    corners.clear();
+    for word in words {
+        let index = word.split('/').next().unwrap_or("");
+        let index: i64 = index
+            .parse()
+            .map_err(|_| format!("`{word}` is not a vertex reference"))?;
+        if index == 0 {
+            return Err("vertex index 0 (OBJ counts from 1)".into());
+        }
+        // A negative index counts back from the last vertex read so far.
+        corners.push(if index < 0 {
+            read as i64 + index + 1
+        } else {
+            index
+        });
+    }
+    if corners.len() < 3 {
+        return Err(format!(
+            "a face needs at least 3 vertices, this one has {}",
+            corners.len()
+        ));
+    }
+    Ok(())
+}
+
+/// The triangles' 1-based corners (each with its line number) as 0-based indices into the `v`
+/// positions of the file.
+fn resolve_corners(
+    triangles: Vec<[(i64, usize); 3]>,
+    v: usize,
+    path: &Path,
+) -> Result<Vec<Triangle>> {
+    let v = v as i64;
+    triangles
         .into_iter()
         .map(|tri| {
             let mut out = [0u32; 3];
             for (o, (index, line_no)) in out.iter_mut().zip(tri) {
                 if index < 1 || index > v {
-                    return Err(at(
+                    return Err(line_error(
+                        path,
                         line_no,
                         format!("face refers to vertex {index}, but the file has {v} vertices"),
                     ));
@@ -140,11 +171,7 @@ pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
             }
             Ok(out)
         })
-        .collect::<Result<Vec<_>>>()?;
-    Ok(ObjFrame {
-        positions,
-        triangles,
-    })
+        .collect()
 }
 
 /// Lines with their 1-based numbers, a trailing `\` joining a line to the next, comments removed.

@@ -28,11 +28,14 @@ pub(crate) fn read_pc2_animation(path: &Path, base: Option<&Path>) -> Result<Ani
         None => {
             let beside = path.with_extension("obj");
             if !beside.is_file() {
-                return Err(Error::Usage(format!(
-                    "{}: a PC2 cache holds no faces; give the base mesh with --base (looked for {})",
-                    path.display(),
-                    beside.display()
-                )));
+                return Err(Error::option(
+                    "base",
+                    format!(
+                        "needed for {}: a PC2 cache holds no faces, and no base mesh is beside it (looked for {})",
+                        path.display(),
+                        beside.display()
+                    ),
+                ));
             }
             beside
         }

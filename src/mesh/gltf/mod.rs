@@ -1,0 +1,106 @@
+//! glTF 2.0 animations baked to frames: node (TRS) animation, morph targets and skinning.
+//!
+//! Every mesh primitive drawn by the scene becomes part of one animated mesh, in world space, in
+//! scene order. Primitives of one node that share their vertex data (the same position, joint,
+//! weight and morph accessors, as multi-material meshes do) share their vertices too. Point and
+//! line primitives are skipped. The `gltf` crate parses and validates; the posing (sampling the
+//! channels, node hierarchy, morphing, linear blend skinning) is the glTF 2.0 specification's, written
+//! out here because no maintained crate bakes glTF animation without a renderer attached.
+//!
+//! This module holds the entry points ([`read_gltf`], [`parse_gltf`], [`files`]) and the pipeline
+//! that runs the steps in order: [`validate`] the document, read the clip's [`channels`], gather the
+//! scene's [`geometry`] (each part read by [`primitive`]) and its [`skin`]s, then for every frame time
+//! ([`sample`]) pose the [`nodes`] and bake the positions.
+
+mod channels;
+mod geometry;
+mod nodes;
+mod primitive;
+mod sample;
+mod skin;
+mod validate;
+
+use super::AnimatedMesh;
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// The file's buffers, loaded.
+type Buffers<'d> = &'d [gltf::buffer::Data];
+
+/// The bytes of one buffer, for the gltf crate's readers.
+fn buffer_data<'d>(buffers: Buffers<'d>, buffer: gltf::Buffer) -> Option<&'d [u8]> {
+    buffers.get(buffer.index()).map(|d| &d.0[..])
+}
+
+/// Reads `path` and bakes the chosen clip (name or index, default the first) at `fps` (default the
+/// clip's keyframe rate if plausible, else 30).
+pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Result<AnimatedMesh> {
+    // Read whole and parsed from memory: gltf's own reader allocates what a GLB header claims (up to
+    // 4 GB for a 12-byte file) before reading it.
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let gltf = validate::from_slice(&bytes, path)?;
+    bake(gltf, path.parent(), path, fps, clip)
+}
+
+/// The glTF file and the buffer files beside it that it refers to (those that can be told without
+/// reading them); an unreadable file is just itself, reading it reports the error.
+pub(crate) fn files(path: &Path) -> Vec<PathBuf> {
+    let mut out = vec![path.to_path_buf()];
+    let gltf = std::fs::read(path)
+        .ok()
+        .and_then(|bytes| validate::from_slice(&bytes, path).ok());
+    if let (Some(gltf), Some(folder)) = (gltf, path.parent()) {
+        for buffer in gltf.document.buffers() {
+            if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+                if !uri.contains(':') {
+                    out.push(folder.join(uri));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Parses a `.gltf` or `.glb` held in memory and bakes it like [`read_gltf`]; `path` only names
+/// errors. Nothing is read from disk, so buffers must be embedded (GLB chunk or `data:` URI).
+pub(crate) fn parse_gltf(
+    bytes: &[u8],
+    path: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+) -> Result<AnimatedMesh> {
+    let gltf = validate::from_slice(bytes, path)?;
+    bake(gltf, None, path, fps, clip)
+}
+
+/// Bakes a parsed glTF; buffer files are looked up in `folder` (none: only embedded buffers).
+fn bake(
+    gltf: gltf::Gltf,
+    folder: Option<&Path>,
+    path: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+) -> Result<AnimatedMesh> {
+    let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
+    let gltf::Gltf { document, blob } = gltf;
+    validate::check_buffer_uris(&document).map_err(fail)?;
+    let buffers =
+        gltf::import_buffers(&document, folder, blob).map_err(|e| fail(format!("buffer: {e}")))?;
+    let data = buffers.as_slice();
+
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+        .ok_or_else(|| fail("no scene".into()))?;
+    let animation = channels::pick_clip(&document, clip).map_err(fail)?;
+    let channels = channels::read_channels(&animation, data).map_err(fail)?;
+    let geometry = geometry::Geometry::gather(&document, &scene, data).map_err(fail)?;
+    let skins = skin::read_skins(&document, data).map_err(fail)?;
+
+    let times = sample::FrameTimes::new(&channels, fps, geometry.vertex_count, path)?;
+    let pose = nodes::Pose::new(&document);
+    let frames = times
+        .map(|time| geometry.bake(&pose.at(time, &channels), &skins))
+        .collect();
+    AnimatedMesh::new(geometry.triangles, frames).map_err(|e| fail(e.to_string()))
+}
