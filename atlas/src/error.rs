@@ -28,7 +28,7 @@ pub enum AtlasError {
     #[error("invalid atlas option: {0}")]
     InvalidOptions(String),
     /// The mesh has more vertices than the lattice has pixels.
-    #[error("{vertices} vertices do not fit a {width}×{height} lattice; use --lattice {suggest}x{suggest}")]
+    #[error("{vertices} vertices do not fit a {width}×{height} lattice; a {suggest}x{suggest} lattice would fit")]
     TooManyVertices {
         /// Vertices in the mesh.
         vertices: usize,
@@ -40,7 +40,7 @@ pub enum AtlasError {
         suggest: u32,
     },
     /// Even at the smallest scale the charts' blocks do not fit.
-    #[error("{charts} charts need at least {blocks} blocks of {block}×{block} but the {width}×{height} lattice has {available}; use --lattice {suggest}x{suggest}")]
+    #[error("{charts} charts need at least {blocks} blocks of {block}×{block} but the {width}×{height} lattice has {available}; a {suggest}x{suggest} lattice would fit")]
     ChartsDoNotFit {
         /// Number of charts.
         charts: usize,

@@ -215,7 +215,7 @@ impl Problem {
         if components > opts.max_clusters {
             return Err(Error::Usage(format!(
                 "decimation: the mesh has {components} connected components (seams welded) and each needs \
-                 its own cluster, more than the cap of {}; use --segmentation kmeans",
+                 its own cluster, more than the cap of {}; k-means segmentation takes any mesh",
                 opts.max_clusters
             )));
         }
