@@ -151,9 +151,13 @@ pub enum PredictorChoice {
 pub struct DecodeArgs {
     /// The .mcgv file.
     pub input: PathBuf,
-    /// Output: a folder for an OBJ sequence (frame_0000.obj …), or a file ending in .pc2.
+    /// Output: a folder for an OBJ sequence (frame_0000.obj …), a file ending in .pc2, or a glTF
+    /// file ending in .glb or .gltf (morph targets, one per frame).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// glTF output: frames per second of the animation (the stream does not record the source's).
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
     /// Decode only this frame (numbered from 0).
     #[arg(long)]
     pub frame: Option<usize>,
@@ -222,7 +226,8 @@ pub struct ConvertArgs {
     /// The animation (any input form).
     pub input: String,
     /// Output: a file ending in .pc2 (the base OBJ with the faces is written beside it, same stem),
-    /// or a folder for an OBJ sequence (frame_0000.obj …).
+    /// a glTF file ending in .glb or .gltf (morph targets at --fps, default 30), or a folder for an
+    /// OBJ sequence (frame_0000.obj …).
     #[arg(short, long)]
     pub output: PathBuf,
     /// How to read the input.

@@ -8,8 +8,10 @@
 
 use crate::args::ConvertArgs;
 use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::gltf_write::is_gltf_path;
 use mcgv_video::mesh::{
-    read_animation, write_obj_frame, write_obj_sequence, write_pc2, ReadOptions,
+    read_animation, write_gltf, write_obj_frame, write_obj_sequence, write_pc2, GltfOptions,
+    ReadOptions,
 };
 use std::path::Path;
 
@@ -22,7 +24,14 @@ fn is_pc2(path: &Path) -> bool {
 /// Runs `convert`.
 pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
     let mesh = read_animation(&args.input, &ReadOptions::from(&args.input_args))?;
-    if is_pc2(&args.output) {
+    if is_gltf_path(&args.output) {
+        super::decode::warn_if_many_targets(mesh.frame_count());
+        let options = GltfOptions {
+            fps: args.input_args.fps.unwrap_or(30.0),
+            ..GltfOptions::default()
+        };
+        write_gltf(&mesh, None, &args.output, &options)?;
+    } else if is_pc2(&args.output) {
         // A PC2 holds no faces: the base OBJ beside it (same stem) is what `--base` defaults to.
         let base = args.output.with_extension("obj");
         if Path::new(&args.input) == base {

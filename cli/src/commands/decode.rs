@@ -4,8 +4,9 @@ use crate::args::DecodeArgs;
 use crate::progress;
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::gltf_write::{is_gltf_path, MANY_MORPH_TARGETS};
 use mcgv_video::mesh::io::write_obj_sequence_from;
-use mcgv_video::mesh::{write_pc2, AnimatedMesh};
+use mcgv_video::mesh::{write_gltf, write_pc2, AnimatedMesh, GltfOptions};
 use std::path::Path;
 use std::time::Instant;
 
@@ -36,6 +37,16 @@ where
     }
 }
 
+/// Tells on stderr when a glTF output gets more morph targets than viewers load comfortably.
+pub fn warn_if_many_targets(frames: usize) {
+    if frames > MANY_MORPH_TARGETS + 1 {
+        eprintln!(
+            "mcgv-video: warning: {} morph targets (one per frame after the first); viewers load more than {MANY_MORPH_TARGETS} slowly",
+            frames - 1
+        );
+    }
+}
+
 /// Runs `decode`.
 pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
     let start = Instant::now();
@@ -60,7 +71,14 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             mesh
         }
     };
-    if is_pc2(&args.output) {
+    if is_gltf_path(&args.output) {
+        warn_if_many_targets(mesh.frame_count());
+        let options = GltfOptions {
+            fps: args.fps,
+            ..GltfOptions::default()
+        };
+        write_gltf(&mesh, None, &args.output, &options)?;
+    } else if is_pc2(&args.output) {
         write_pc2(&mesh, &args.output)?;
     } else {
         let first = args.frame.unwrap_or(0);
