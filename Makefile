@@ -10,7 +10,7 @@ APT_PACKAGES := pkg-config clang libclang-dev libavcodec-dev libavformat-dev lib
 	fonts-dejavu-core
 PY_PACKAGES := pymeshlab DracoPy numpy zstandard
 
-.PHONY: help deps apt-deps venv demo test bench fuzz clean
+.PHONY: help deps apt-deps venv node-tools demo test bench fuzz clean
 
 help:
 	@echo "make demo   encode a sample animation both ways and print size and error"
@@ -18,6 +18,7 @@ help:
 	@echo "make bench  rate-distortion and speed tables and plots (bench-out/)"
 	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
 	@echo "make deps   install Debian packages and the reference-tool virtualenv (done by demo/test)"
+	@echo "make node-tools  install the glTF validator into scripts/node (done by test)"
 
 deps: apt-deps venv
 
@@ -37,11 +38,22 @@ $(VENV)/.done: Makefile
 	$(VENV)/bin/pip install -q --disable-pip-version-check $(PY_PACKAGES)
 	touch $@
 
+# Node tools of the tests (the Khronos glTF-Validator), pinned by scripts/node/package-lock.json and
+# installed into scripts/node/node_modules. Debian's nodejs and npm are installed only if `node` is missing.
+NODE_DIR := scripts/node
+node-tools: $(NODE_DIR)/node_modules/.done
+
+$(NODE_DIR)/node_modules/.done: $(NODE_DIR)/package.json $(NODE_DIR)/package-lock.json
+	@command -v node >/dev/null && command -v npm >/dev/null || { \
+		$(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq nodejs npm >/dev/null; }
+	cd $(NODE_DIR) && npm ci --no-audit --no-fund --loglevel=error
+	touch $@
+
 demo: deps
 	$(CARGO) build --release --quiet
 	bash scripts/demo.sh
 
-test: deps
+test: deps node-tools
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets --quiet -- -D warnings
 	MCGV_PYTHON=$(abspath $(PY)) $(CARGO) test --workspace --quiet
@@ -84,4 +96,4 @@ fuzz: apt-deps
 
 clean:
 	$(CARGO) clean
-	rm -rf $(VENV) bench-out demo-out
+	rm -rf $(VENV) bench-out demo-out $(NODE_DIR)/node_modules

@@ -6,6 +6,7 @@ mod common;
 mod codec;
 mod convert;
 mod eval;
+mod gltf;
 mod info;
 mod outputs;
 mod segmentation;
