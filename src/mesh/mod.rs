@@ -37,6 +37,7 @@ pub type Triangle = [u32; 3];
 pub struct AnimatedMesh {
     triangles: Vec<Triangle>,
     frames: Vec<Vec<Point>>,
+    attributes: Attributes,
 }
 
 impl AnimatedMesh {
@@ -74,7 +75,24 @@ impl AnimatedMesh {
                 )));
             }
         }
-        Ok(Self { triangles, frames })
+        Ok(Self {
+            triangles,
+            frames,
+            attributes: Attributes::default(),
+        })
+    }
+
+    /// The same mesh with texture coordinates and materials (checked against its vertices and
+    /// triangles).
+    pub fn with_attributes(mut self, attributes: Attributes) -> Result<Self> {
+        attributes.check(self.vertex_count(), self.triangles.len())?;
+        self.attributes = attributes;
+        Ok(self)
+    }
+
+    /// Texture coordinates and materials (empty for inputs that have none).
+    pub fn attributes(&self) -> &Attributes {
+        &self.attributes
     }
 
     /// The triangles, shared by every frame.
@@ -159,6 +177,14 @@ impl AnimatedMesh {
             .iter()
             .map(|f| order.iter().map(|&old| f[old as usize]).collect())
             .collect();
-        Ok(Self { triangles, frames })
+        let mut attributes = self.attributes.clone();
+        for set in &mut attributes.texcoords {
+            *set = order.iter().map(|&old| set[old as usize]).collect();
+        }
+        Ok(Self {
+            triangles,
+            frames,
+            attributes,
+        })
     }
 }

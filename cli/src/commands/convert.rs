@@ -30,7 +30,7 @@ pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
             fps: args.input_args.fps.unwrap_or(30.0),
             ..GltfOptions::default()
         };
-        write_gltf(&mesh, None, &args.output, &options)?;
+        write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
     } else if is_pc2(&args.output) {
         // A PC2 holds no faces: the base OBJ beside it (same stem) is what `--base` defaults to.
         let base = args.output.with_extension("obj");

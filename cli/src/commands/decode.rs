@@ -63,6 +63,7 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             }
             let positions = decoder.decode_frame(f)?;
             AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
+                .with_attributes(decoder.attributes().clone())?
         }
         None => {
             let pb = progress::bar(frames as u64, "decode", quiet);
@@ -77,7 +78,7 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             fps: args.fps,
             ..GltfOptions::default()
         };
-        write_gltf(&mesh, None, &args.output, &options)?;
+        write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
     } else if is_pc2(&args.output) {
         write_pc2(&mesh, &args.output)?;
     } else {

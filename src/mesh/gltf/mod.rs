@@ -102,5 +102,8 @@ fn bake(
     let frames = times
         .map(|time| geometry.bake(&pose.at(time, &channels), &skins))
         .collect();
-    AnimatedMesh::new(geometry.triangles, frames).map_err(|e| fail(e.to_string()))
+    let attributes = geometry.attributes(&document);
+    AnimatedMesh::new(geometry.triangles, frames)
+        .and_then(|mesh| mesh.with_attributes(attributes))
+        .map_err(|e| fail(e.to_string()))
 }

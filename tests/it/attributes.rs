@@ -1,0 +1,114 @@
+//! Texture coordinates and materials through the stream: UVs come back within half a quantisation
+//! step, material groups exactly, whatever order the first-frame coder puts triangles in.
+
+use crate::common::{decode_all, encode_bytes, read_media};
+use mcgv_video::stream::attributes::{decode_attributes, encode_attributes};
+use mcgv_video::{AnimatedMesh, Attributes, Codec, EncodeOptions};
+
+/// Largest UV error over every set, in units of the set's quantisation step at `bits`.
+fn uv_error_in_steps(source: &Attributes, back: &Attributes, order: &[u32], bits: u8) -> f64 {
+    assert_eq!(source.texcoords.len(), back.texcoords.len());
+    let mut worst = 0.0f64;
+    for (set, decoded) in source.texcoords.iter().zip(&back.texcoords) {
+        for a in 0..2 {
+            let lo = set.iter().map(|uv| uv[a]).fold(f32::INFINITY, f32::min);
+            let hi = set.iter().map(|uv| uv[a]).fold(f32::NEG_INFINITY, f32::max);
+            let step = f64::from(hi - lo) / f64::from((1u32 << bits) - 1);
+            for (new, &old) in order.iter().enumerate() {
+                let e = f64::from((decoded[new][a] - set[old as usize][a]).abs());
+                worst = worst.max(e / step.max(f64::MIN_POSITIVE));
+            }
+        }
+    }
+    worst
+}
+
+/// Each triangle's material keyed by its (sorted) vertices, in the source's vertex numbering.
+fn material_of(mesh: &AnimatedMesh, order: &[u32]) -> Vec<([u32; 3], String)> {
+    let a = mesh.attributes();
+    let mut out: Vec<_> = mesh
+        .triangles()
+        .iter()
+        .zip(&a.materials)
+        .map(|(t, &m)| {
+            let mut k = t.map(|v| order[v as usize]);
+            k.sort_unstable();
+            (k, a.material_names[m as usize].clone())
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn the_samples_have_uvs_and_materials() {
+    for name in ["CesiumMan.glb", "Fox.glb"] {
+        let mesh = read_media(name);
+        let a = mesh.attributes();
+        assert_eq!(a.texcoords.len(), 1, "{name}");
+        assert!(!a.materials.is_empty(), "{name}");
+    }
+}
+
+#[test]
+fn the_part_round_trips_within_half_a_step_at_every_bit_depth() {
+    let mesh = read_media("CesiumMan.glb");
+    let identity: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+    for bits in [8, 12, 16] {
+        let bytes = encode_attributes(
+            mesh.attributes(),
+            mesh.triangles(),
+            mesh.vertex_count(),
+            bits,
+        )
+        .unwrap();
+        let back = decode_attributes(&bytes, mesh.triangles(), mesh.vertex_count()).unwrap();
+        let steps = uv_error_in_steps(mesh.attributes(), &back, &identity, bits);
+        assert!(steps <= 0.5 + 1e-3, "{bits} bits: {steps} steps");
+        assert_eq!(back.materials, mesh.attributes().materials);
+        assert_eq!(back.material_names, mesh.attributes().material_names);
+    }
+}
+
+#[test]
+fn a_stream_keeps_uvs_and_material_groups_with_and_without_reordering() {
+    let mesh = read_media("CesiumMan.glb");
+    for reorder in [false, true] {
+        let options = EncodeOptions {
+            codec: Codec::Tdct,
+            reorder,
+            ..EncodeOptions::default()
+        };
+        let encoded = mcgv_video::encode(&mesh, &options).unwrap();
+        let order = encoded
+            .report
+            .permutation
+            .clone()
+            .unwrap_or_else(|| (0..mesh.vertex_count() as u32).collect());
+        let back = decode_all(encoded.to_bytes()).unwrap();
+        let steps = uv_error_in_steps(mesh.attributes(), back.attributes(), &order, 12);
+        assert!(steps <= 0.5 + 1e-3, "reorder {reorder}: {steps} steps");
+        let identity: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+        assert_eq!(material_of(&back, &order), material_of(&mesh, &identity));
+    }
+}
+
+#[test]
+fn inputs_without_attributes_get_no_part_and_a_corrupt_part_is_an_error() {
+    let mesh = read_media("CesiumMan.glb");
+    let (triangles, frames) = mesh.clone().into_parts();
+    let bare = AnimatedMesh::new(triangles, frames).unwrap();
+    let options = EncodeOptions {
+        codec: Codec::Tdct,
+        ..EncodeOptions::default()
+    };
+    let bytes = encode_bytes(&bare, &options);
+    assert!(!crate::common::parts(&bytes)
+        .iter()
+        .any(|(t, _, _)| &t.0 == b"ATTR"));
+    let part =
+        encode_attributes(mesh.attributes(), mesh.triangles(), mesh.vertex_count(), 12).unwrap();
+    for cut in [1, part.len() / 2, part.len() - 1] {
+        assert!(decode_attributes(&part[..cut], mesh.triangles(), mesh.vertex_count()).is_err());
+    }
+}
