@@ -27,5 +27,9 @@ for codec in jpeg mpeg4 tdct; do
         -v r="$(field rmse)" -v h="$(field hausdorff)" -v t0="$t0" -v t1="$t1" -v t2="$t2" \
         'BEGIN { printf "%-7s %-14s %10d %8.3f %12.3f %12.5f %8.2f %8.2f\n", c, s, b, bpvf, r * 1e4, h, t1 - t0, t2 - t1 }'
 done
+glb="$out/$(basename "${sample%.*}")-decoded.glb"
+"$bin" decode "$out/sample-tdct.mcgv" -o "$glb" --quiet
 echo
 echo "streams and decoded OBJ frames are in $out/; look inside with: $bin inspect $out/sample-jpeg.mcgv --png $out/png"
+echo "the tdct stream decoded to glTF (morph targets, UVs): $glb; drop it on https://gltf-viewer.donmccurdy.com/"
+echo "or open it in Blender (File > Import > glTF 2.0) and play the timeline"
