@@ -24,13 +24,21 @@ $versions.
   after Brotli (quality 11), what a web server sends. Decoded back by @gltf-transform/core and
   meshoptimizer's decoder (scripts/node/gltf_frames.mjs, node world matrix applied), keys and
   targets checked equal to the frames, vertices matched to the originals over all frames (gltfpack
-  renumbers and welds: the log of the run prints how many decoded vertices were used).
+  renumbers and welds: the log of the run prints how many decoded vertices were used). gltfpack
+  quantises to 16 bits at most, on one grid for positions and deltas (frame 0's box padded by the
+  largest delta): on chickenCrossing, which walks across the scene, that grid is many times frame 0's
+  diagonal and 16 bits stay above RMSE 5e-5 (— in the equal-error table).
 - **meshopt-fm / meshopt-vm**: meshoptimizer's vertex codec (format 1, level 3) on positions quantised
   to N bits over the animation's bounding cube, frame-major (glTF's order) or vertex-major (trajectories,
   temporal deltas), faces by its index codec, all zstd level 19.
 - **dynapack-ac**: the dynapack peer's quantisation, traversal and extended Lorenzo predictor (same
   residuals), coded by constriction's range coder with an adaptive context model (coordinate x
   magnitude class of the same residual in the previous frame), as the paper codes them, instead of zstd.
+  Measured against the zstd dynapack at the same setting: 9–18 % smaller at qp 10–14 on the OBJ
+  sequences but horse-gallop and on CesiumMan; −12 % to +7 % on Fox, Horse, RiggedSimple and
+  RiggedFigure; larger on the small three.js samples Flamingo, Parrot and Stork (+3–14 %) and on
+  horse-gallop (+48–56 %: its gallop repeats, and zstd's long matches find the repeat where a context
+  model does not). Both are kept; the equal-error table takes whichever needs fewer bits.
 - **draco, zstd, pca, dynapack**: as before (scripts/peers.py). Draco renumbers vertices per frame, so
   it has no vertex RMSE and no KG error (— in the tables).
 
@@ -49,21 +57,26 @@ sequences came from an earlier \`make bench\`):
 
 \`\`\`
 make node-deps venv
+run() { nice -n 10 .venv/bin/python scripts/peers.py run "\$@"; }
 export PEERS_CODECS="gltfpack gltfpack-br dynapack-ac meshopt-vm meshopt-fm"
 PEERS_SETTINGS="gltfpack=vp 10,vp 12,vp 14;gltfpack-br=vp 10,vp 12,vp 14;dynapack-ac=qp 10,qp 12,qp 14;meshopt-vm=qp 10,qp 12,qp 14;meshopt-fm=qp 10,qp 12,qp 14" \\
-  nice -n 10 .venv/bin/python scripts/peers.py run a.csv bench-out/media/{pdance,chickenCrossing,pcow}
-PEERS_SETTINGS=(the same) nice -n 10 .venv/bin/python scripts/peers.py run b.csv \\
-  bench-out/media/{horse-collapse,walking_cat} media/{CesiumMan,RiggedSimple,RiggedFigure,Fox}.glb \\
-  bench-out/media/horse-gallop SHARED/threejs_{Flamingo,Horse,Parrot,Stork}/*.glb
-PEERS_SETTINGS="gltfpack=vp 8,vp 16;gltfpack-br=vp 8,vp 16;dynapack-ac=qp 8,qp 16;meshopt-vm=qp 8,qp 16;meshopt-fm=qp 8,qp 16" \\
-  nice -n 10 .venv/bin/python scripts/peers.py run d.csv (all of the above)
-PEERS_CODECS="zstd pca dynapack" nice -n 10 .venv/bin/python scripts/peers.py run c.csv \\
-  media/*.glb SHARED/threejs_*/*.glb
+  run a.csv bench-out/media/{pdance,chickenCrossing,pcow}      # stopped in pcow; e.csv measured pcow
+PEERS_SETTINGS=(the same) run e.csv bench-out/media/pcow
+PEERS_SETTINGS=(the same) run b.csv bench-out/media/{horse-collapse,walking_cat} \\
+  media/{CesiumMan,RiggedSimple,RiggedFigure,Fox}.glb bench-out/media/horse-gallop SHARED/threejs_{Flamingo,Horse,Parrot,Stork}/*.glb
+PEERS_SETTINGS="gltfpack=;gltfpack-br=;dynapack-ac=qp 8;meshopt-vm=qp 8;meshopt-fm=qp 8" run d.csv \\
+  (b.csv's inputs but RiggedFigure, whose qp 10 is above RMSE 2e-4 already)
+PEERS_SETTINGS="gltfpack=vp 16;gltfpack-br=vp 16;dynapack-ac=qp 16;meshopt-vm=qp 16;meshopt-fm=qp 16" \\
+  run d.csv bench-out/media/chickenCrossing
+PEERS_CODECS="gltfpack gltfpack-br" PEERS_SETTINGS="gltfpack=vp 16;gltfpack-br=vp 16" run f.csv bench-out/media/pcow
+PEERS_CODECS="zstd pca dynapack" run c.csv media/*.glb SHARED/threejs_*/*.glb      # default settings
 scripts/peers_page.sh docs/bench/peers.md docs/bench/peers.skipped.csv docs/bench/sweep*.csv docs/bench/peers.csv
+target/release/examples/rd_plot docs/bench docs/bench/sweep*.csv docs/bench/peers.csv
 \`\`\`
 
 (A first run at the default settings, vp 10–16, was stopped after horse-collapse's gltfpack rows and
-pdance's gltfpack vp 10 row, to measure fewer settings; those rows were kept.)
+pdance's gltfpack vp 10 row, to measure fewer settings; those rows were kept. The settings past 10–14
+were added where a codec's points did not bracket RMSE 2e-4 or 5e-5.)
 
 EOF
 echo "#### Inputs a peer could not take"
