@@ -38,11 +38,9 @@ The peers:
   the animation's bounding cube): each vertex predicted from the same frame's parallelogram plus the
   previous frame's parallelogram error, traversal by face adjacency; residuals zstd-coded instead of
   Dynapack's arithmetic coder.
-- dynapack-ac: the same residuals with an adaptive arithmetic coder, as the paper (peers_dynapack_ac.py).
-- gltfpack, gltfpack-br, meshopt-fm, meshopt-vm: glTF morph targets packed by gltfpack (raw, and after
-  Brotli) and meshoptimizer's vertex codec on quantised frames or trajectories (peers_meshopt.py,
-  with the Node tools of scripts/node). gltfpack renumbers and welds vertices: the driver matches them
-  back (match_gltfpack) before measuring.
+- dynapack-ac (peers_dynapack_ac.py): the same residuals, adaptive arithmetic coder, as the paper.
+- gltfpack, gltfpack-br, meshopt-fm, meshopt-vm (peers_meshopt.py, Node tools in scripts/node): glTF
+  morph targets packed by gltfpack (raw, Brotli'd), meshoptimizer's vertex codec; see that module.
 """
 import hashlib
 import json
