@@ -8,18 +8,20 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PACKAGES := pkg-config clang libclang-dev libavcodec-dev libavformat-dev libavutil-dev \
 	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools time \
 	fonts-dejavu-core
-PY_PACKAGES := pymeshlab DracoPy numpy zstandard
+PY_PACKAGES := pymeshlab DracoPy numpy zstandard constriction brotli
+# Node tools of the bench's glTF peers (gltfpack, @gltf-transform, meshoptimizer), pinned by its lockfile.
+NODE_DIR := scripts/node
 
-.PHONY: help deps apt-deps venv demo test bench fuzz clean
+.PHONY: help deps apt-deps venv node-deps demo test bench fuzz clean
 
 help:
 	@echo "make demo   encode a sample animation both ways and print size and error"
 	@echo "make test   format check, clippy, all tests"
 	@echo "make bench  rate-distortion and speed tables and plots (bench-out/)"
 	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
-	@echo "make deps   install Debian packages and the reference-tool virtualenv (done by demo/test)"
+	@echo "make deps   install Debian packages, the reference-tool virtualenv and the bench's Node tools (done by demo/test)"
 
-deps: apt-deps venv
+deps: apt-deps venv node-deps
 
 # Skipped when every package is already installed; apt-get update only when something is missing.
 apt-deps:
@@ -37,6 +39,16 @@ $(VENV)/.done: Makefile
 	$(VENV)/bin/pip install -q --disable-pip-version-check $(PY_PACKAGES)
 	touch $@
 
+# Debian's nodejs and npm only when there is no node at all; then the lockfile's packages into
+# scripts/node/node_modules (npm ci), again only when package.json or the lockfile changed.
+node-deps: $(NODE_DIR)/node_modules/.done
+
+$(NODE_DIR)/node_modules/.done: $(NODE_DIR)/package.json $(NODE_DIR)/package-lock.json
+	@command -v node >/dev/null && command -v npm >/dev/null || { \
+		$(SUDO) apt-get update -qq && DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq nodejs npm >/dev/null; }
+	cd $(NODE_DIR) && npm ci --no-audit --no-fund --loglevel=error
+	touch $@
+
 demo: deps
 	$(CARGO) build --release --quiet
 	bash scripts/demo.sh
@@ -45,6 +57,7 @@ test: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets --quiet -- -D warnings
 	MCGV_PYTHON=$(abspath $(PY)) $(CARGO) test --workspace --quiet
+	$(PY) scripts/test_peers.py
 
 bench: deps
 	$(CARGO) build --release --quiet
@@ -84,4 +97,4 @@ fuzz: apt-deps
 
 clean:
 	$(CARGO) clean
-	rm -rf $(VENV) bench-out demo-out
+	rm -rf $(VENV) bench-out demo-out $(NODE_DIR)/node_modules
