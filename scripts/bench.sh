@@ -43,4 +43,15 @@ csvs+=(bench-out/peers.csv)
 cargo run --release --quiet --example rd_plot -- bench-out/plots "${csvs[@]}"
 "$py" scripts/rd_table.py "${csvs[@]}" > bench-out/table.md
 MCGV_PYTHON=$py bash scripts/peers_page.sh bench-out/peers.md bench-out/peers.skipped.csv "${csvs[@]}"
-echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md, peers.md"
+# The results pages in docs/ are made here: the tables, the peers page, the CSVs and the plots.
+{
+    echo "# Rate-distortion tables"
+    echo
+    echo "Written by \`make bench\` (\`scripts/rd_table.py\` over ${csvs[*]#bench-out/}, copied beside this"
+    echo "page); the narrative and older measurements are in [../results.md](../results.md)."
+    echo
+    cat bench-out/table.md
+} > docs/bench/tables.md
+cp "${csvs[@]}" bench-out/peers.md docs/bench/
+cp bench-out/plots/*.png docs/bench/
+echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md, peers.md; docs/bench/ updated"
