@@ -212,36 +212,8 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
         header.lattice_width as usize,
         header.lattice_height as usize,
     );
-    let frames: Vec<usize> = if args.frames.is_empty() {
-        vec![0]
-    } else {
-        args.frames.clone()
-    };
-    if let Some(&bad) = frames.iter().find(|&&f| f >= header.frames as usize) {
-        return Err(Error::Usage(format!(
-            "--frames {bad}: the stream has frames 0 to {}",
-            header.frames - 1
-        )));
-    }
-
-    // The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
-    let mut atlas_rgb = vec![0u8; w * h * 3];
-    for y in 0..h {
-        for x in 0..w {
-            if x % 8 == 0 || y % 8 == 0 {
-                atlas_rgb[(y * w + x) * 3..][..3].copy_from_slice(&[40, 40, 40]);
-            }
-        }
-    }
-    for (v, &[u, py]) in decoder.vertex_pixels().iter().enumerate() {
-        let c = cluster_colour(decoder.partition().labels()[v]);
-        atlas_rgb[(py as usize * w + u as usize) * 3..][..3].copy_from_slice(&c);
-    }
-    let atlas_path = dir.join("atlas.png");
-    image::RgbImage::from_raw(w as u32, h as u32, atlas_rgb)
-        .ok_or_else(|| Error::Usage("atlas image size".into()))?
-        .save(&atlas_path)
-        .map_err(|e| Error::Usage(format!("{}: {e}", atlas_path.display())))?;
+    let frames = selected_frames(args, header.frames)?;
+    write_atlas_png(decoder, &dir.join("atlas.png"), w, h)?;
     crate::render::render_partition_png(
         decoder.reference(),
         decoder.triangles(),
@@ -261,25 +233,80 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
     }
 
     if let Some(original) = &args.original {
-        let mesh = read_animation(original, &(&args.input_args).into())?;
-        for images in mcgv_video::inspect::encoder_images(decoder, &mesh, &frames)? {
-            let f = images.frame;
-            save_levels(
-                &dir.join(format!("frame_{f:04}_raw.png")),
-                &images.raw,
-                w,
-                h,
-            )?;
-            save_levels(
-                &dir.join(format!("frame_{f:04}_padded.png")),
-                &images.padded,
-                w,
-                h,
-            )?;
-        }
+        write_encoder_pngs(decoder, args, original, dir, &frames, w, h)?;
     }
     if !quiet {
         eprintln!("images written to {}", dir.display());
+    }
+    Ok(())
+}
+
+/// The frames `--frames` asks for (frame 0 when none), each one the stream has.
+fn selected_frames(args: &InspectArgs, stream_frames: u32) -> Result<Vec<usize>> {
+    let frames: Vec<usize> = if args.frames.is_empty() {
+        vec![0]
+    } else {
+        args.frames.clone()
+    };
+    if let Some(&bad) = frames.iter().find(|&&f| f >= stream_frames as usize) {
+        return Err(Error::Usage(format!(
+            "--frames {bad}: the stream has frames 0 to {}",
+            stream_frames - 1
+        )));
+    }
+    Ok(frames)
+}
+
+/// The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
+fn write_atlas_png<R: std::io::Read + std::io::Seek>(
+    decoder: &Decoder<R>,
+    atlas_path: &Path,
+    w: usize,
+    h: usize,
+) -> Result<()> {
+    let mut atlas_rgb = vec![0u8; w * h * 3];
+    for y in 0..h {
+        for x in 0..w {
+            if x % 8 == 0 || y % 8 == 0 {
+                atlas_rgb[(y * w + x) * 3..][..3].copy_from_slice(&[40, 40, 40]);
+            }
+        }
+    }
+    for (v, &[u, py]) in decoder.vertex_pixels().iter().enumerate() {
+        let c = cluster_colour(decoder.partition().labels()[v]);
+        atlas_rgb[(py as usize * w + u as usize) * 3..][..3].copy_from_slice(&c);
+    }
+    image::RgbImage::from_raw(w as u32, h as u32, atlas_rgb)
+        .ok_or_else(|| Error::Usage("atlas image size".into()))?
+        .save(atlas_path)
+        .map_err(|e| Error::Usage(format!("{}: {e}", atlas_path.display())))
+}
+
+/// The encoder's raw and padded images of `frames`, made from the `original` animation.
+fn write_encoder_pngs<R: std::io::Read + std::io::Seek>(
+    decoder: &mut Decoder<R>,
+    args: &InspectArgs,
+    original: &str,
+    dir: &Path,
+    frames: &[usize],
+    w: usize,
+    h: usize,
+) -> Result<()> {
+    let mesh = read_animation(original, &(&args.input_args).into())?;
+    for images in mcgv_video::inspect::encoder_images(decoder, &mesh, frames)? {
+        let f = images.frame;
+        save_levels(
+            &dir.join(format!("frame_{f:04}_raw.png")),
+            &images.raw,
+            w,
+            h,
+        )?;
+        save_levels(
+            &dir.join(format!("frame_{f:04}_padded.png")),
+            &images.padded,
+            w,
+            h,
+        )?;
     }
     Ok(())
 }
