@@ -4,13 +4,12 @@ use crate::args::InspectArgs;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::error::{Error, Result};
 use mcgv_video::geometry_image::tile;
-use mcgv_video::mesh::read_animation;
 use mcgv_video::{codec::Codec, stream::header::Header};
 use std::path::Path;
 
 /// Runs `inspect`.
 pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
-    let mut decoder = Decoder::open(&args.input)?;
+    let mut decoder = Decoder::open(&args.input).map_err(|e| super::in_file(&args.input, e))?;
     let header = decoder.header().clone();
     let total = decoder.container().file_len();
     let parts = mcgv_video::inspect::part_bytes(&decoder);
@@ -53,34 +52,37 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "band_bytes": (!bands.is_empty()).then_some(&bands),
             "step": decoder.band_step(),
         });
-        println!("{value}");
-        return Ok(());
+        return outln!("{value}");
     }
-    println!("{}", summary(&header, &args.input));
-    println!(
+    outln!("{}", summary(&header, &args.input))?;
+    outln!(
         "{:<22} {:>12} {:>14} {:>7} {:>8}",
-        "part", "bytes", "bits", "%", "bpvf"
-    );
+        "part",
+        "bytes",
+        "bits",
+        "%",
+        "bpvf"
+    )?;
     for (name, bytes) in &parts {
-        println!(
+        outln!(
             "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
             name,
             bytes,
             bytes * 8,
             100.0 * *bytes as f64 / total as f64,
             *bytes as f64 * 8.0 / vf
-        );
+        )?;
     }
-    println!(
+    outln!(
         "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
         "total",
         total,
         total * 8,
         100.0,
         bpvf
-    );
+    )?;
     if !bands.is_empty() {
-        print!("{}", band_table(&bands, decoder.bands_decoded()));
+        out!("{}", band_table(&bands, decoder.bands_decoded()))?;
     }
     Ok(())
 }
@@ -261,7 +263,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
     }
 
     if let Some(original) = &args.original {
-        let mesh = read_animation(original, &(&args.input_args).into())?;
+        let mesh = super::read_input(original, &(&args.input_args).into(), quiet)?;
         for images in mcgv_video::inspect::encoder_images(decoder, &mesh, &frames)? {
             let f = images.frame;
             save_levels(
