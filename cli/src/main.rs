@@ -2,6 +2,7 @@
 
 #[macro_use]
 mod output;
+mod annotate;
 mod args;
 mod commands;
 mod progress;
