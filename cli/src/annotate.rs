@@ -117,7 +117,7 @@ pub fn residual_picture(
         draw_text(&mut image, x0 as i64, text_y, &lo, INK);
         let right = (x0 + w) as i64 - 8 * hi.len() as i64;
         draw_text(&mut image, right, text_y + LINE as i64, &hi, INK);
-        let step = format!("1 level {}", units((range.max - range.min) / 255.0));
+        let step = format!("1 level {:.1e}", (range.max - range.min) / 255.0);
         draw_text(&mut image, x0 as i64, text_y + 2 * LINE as i64, &step, INK);
     }
     image
