@@ -186,6 +186,34 @@ fn save_residuals(
         .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
 }
 
+/// The atlas as the decoder sees it, with a legend of the cluster colours.
+fn write_atlas<R: std::io::Read + std::io::Seek>(decoder: &Decoder<R>, path: &Path) -> Result<()> {
+    let header = decoder.header();
+    let (w, h) = (
+        header.lattice_width as usize,
+        header.lattice_height as usize,
+    );
+    // The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
+    let mut atlas_rgb = vec![0u8; w * h * 3];
+    for y in 0..h {
+        for x in 0..w {
+            if x % 8 == 0 || y % 8 == 0 {
+                atlas_rgb[(y * w + x) * 3..][..3].copy_from_slice(&[40, 40, 40]);
+            }
+        }
+    }
+    for (v, &[u, py]) in decoder.vertex_pixels().iter().enumerate() {
+        let c = annotate::cluster_colour(decoder.partition().labels()[v]);
+        atlas_rgb[(py as usize * w + u as usize) * 3..][..3].copy_from_slice(&c);
+    }
+    let atlas = image::RgbImage::from_raw(w as u32, h as u32, atlas_rgb)
+        .ok_or_else(|| Error::Usage("atlas image size".into()))?;
+    let note = "vertex pixels by cluster; grid: 8x8 blocks";
+    annotate::with_legend(&atlas, header.clusters, note)
+        .save(path)
+        .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
+}
+
 fn write_pngs<R: std::io::Read + std::io::Seek>(
     decoder: &mut Decoder<R>,
     args: &InspectArgs,
@@ -210,26 +238,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
         )));
     }
 
-    // The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
-    let mut atlas_rgb = vec![0u8; w * h * 3];
-    for y in 0..h {
-        for x in 0..w {
-            if x % 8 == 0 || y % 8 == 0 {
-                atlas_rgb[(y * w + x) * 3..][..3].copy_from_slice(&[40, 40, 40]);
-            }
-        }
-    }
-    for (v, &[u, py]) in decoder.vertex_pixels().iter().enumerate() {
-        let c = annotate::cluster_colour(decoder.partition().labels()[v]);
-        atlas_rgb[(py as usize * w + u as usize) * 3..][..3].copy_from_slice(&c);
-    }
-    let atlas_path = dir.join("atlas.png");
-    let atlas = image::RgbImage::from_raw(w as u32, h as u32, atlas_rgb)
-        .ok_or_else(|| Error::Usage("atlas image size".into()))?;
-    let note = "vertex pixels by cluster; grid: 8x8 blocks";
-    annotate::with_legend(&atlas, header.clusters, note)
-        .save(&atlas_path)
-        .map_err(|e| Error::Usage(format!("{}: {e}", atlas_path.display())))?;
+    write_atlas(decoder, &dir.join("atlas.png"))?;
     crate::render::render_partition_png(
         decoder.reference(),
         decoder.triangles(),
