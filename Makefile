@@ -12,13 +12,15 @@ PY_PACKAGES := pymeshlab DracoPy numpy zstandard constriction brotli
 # Node tools of the bench's glTF peers (gltfpack, @gltf-transform, meshoptimizer), pinned by its lockfile.
 NODE_DIR := scripts/node
 
-.PHONY: help deps apt-deps venv node-deps demo test bench fuzz clean
+.PHONY: help deps apt-deps venv node-deps demo test bench fuzz install clean
+PREFIX ?= /usr/local
 
 help:
 	@echo "make demo   encode a sample animation both ways and print size and error"
 	@echo "make test   format check, clippy, all tests"
 	@echo "make bench  rate-distortion and speed tables and plots (bench-out/)"
 	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
+	@echo "make install  the binary, shell completions and man page under PREFIX (default /usr/local)"
 	@echo "make deps   install Debian packages, the reference-tool virtualenv and the bench's Node tools (done by demo/test)"
 
 deps: apt-deps venv node-deps
@@ -94,6 +96,20 @@ fuzz: apt-deps
 			fuzz/logs/$$t.log | head -5; \
 	done; \
 	exit $$status
+
+# The completions and the man page come from the binary itself (clap_complete, clap_mangen), so they
+# always match its flags. DESTDIR for staged installs (packaging).
+install: apt-deps
+	$(CARGO) build --release --quiet -p mcgv-video-cli
+	install -Dm755 target/release/mcgv-video $(DESTDIR)$(PREFIX)/bin/mcgv-video
+	@bin=target/release/mcgv-video; dest=$(DESTDIR)$(PREFIX)/share; \
+	mkdir -p $$dest/bash-completion/completions $$dest/zsh/site-functions \
+		$$dest/fish/vendor_completions.d $$dest/man/man1 && \
+	$$bin completions bash >$$dest/bash-completion/completions/mcgv-video && \
+	$$bin completions zsh >$$dest/zsh/site-functions/_mcgv-video && \
+	$$bin completions fish >$$dest/fish/vendor_completions.d/mcgv-video.fish && \
+	$$bin man >$$dest/man/man1/mcgv-video.1 && \
+	echo "installed $(DESTDIR)$(PREFIX)/bin/mcgv-video, its completions and man page"
 
 clean:
 	$(CARGO) clean
