@@ -56,6 +56,6 @@ pub use encoder::{
 };
 pub use error::{Error, Result};
 pub use geometry_image::Lattice;
-pub use mesh::{read_animation, AnimatedMesh, ReadOptions};
+pub use mesh::{read_animation, AnimatedMesh, Attributes, ReadOptions};
 pub use motion::PredictorKind;
 pub use progress::{Progress, Silent};

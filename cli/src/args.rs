@@ -212,9 +212,13 @@ pub struct DecodeArgs {
     pub input: PathBuf,
     /// Output, by its name: `DIR/` (or an existing folder, or a name without extension) for OBJ
     /// frames frame_0000.obj …; `X.pc2` for a point cache with its base `X.obj` beside it;
-    /// `X.obj` with --frame for that one frame. Missing parent folders are created.
+    /// `X.obj` with --frame for that one frame; `X.glb` or `X.gltf` for a glTF asset (morph
+    /// targets, one per frame). Missing parent folders are created.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// glTF output: frames per second of the animation (the stream does not record the source's).
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
     /// Decode only this frame (numbered from 0).
     #[arg(long)]
     pub frame: Option<usize>,
@@ -286,7 +290,8 @@ pub struct ConvertArgs {
     /// The animation (any input form).
     pub input: String,
     /// Output, by its name: `X.pc2` (the base OBJ with the faces is written beside it, same stem),
-    /// or `DIR/` (an existing folder, or a name without extension) for OBJ frames frame_0000.obj ….
+    /// `X.glb` or `X.gltf` (morph targets at --fps, default 30), or `DIR/` (an existing folder, or
+    /// a name without extension) for OBJ frames frame_0000.obj ….
     #[arg(short, long)]
     pub output: PathBuf,
     /// Write into a folder that already holds files, removing the frame_*.obj of an earlier run.

@@ -49,6 +49,8 @@ pub enum OutputKind {
     ObjFile,
     /// A PC2 point cache with its base OBJ beside it.
     Pc2,
+    /// A glTF 2.0 asset (`.glb` binary or `.gltf` with the buffer embedded): morph targets.
+    Gltf,
 }
 
 /// The kind of animation output `path` names; `one_frame` when a single frame is written
@@ -93,16 +95,9 @@ pub fn animation_output(path: &Path, one_frame: bool) -> Result<OutputKind> {
     }
 }
 
-/// glTF output: refused until a glTF writer exists (switch it on here, the one place that decides).
-fn gltf_output(path: &Path) -> Result<OutputKind> {
-    Err(Error::option(
-        "output",
-        format!(
-            "{}: writing glTF is not supported yet; name a X.pc2 (with its base X.obj) or a \
-             folder DIR/ of OBJ frames",
-            path.display()
-        ),
-    ))
+/// glTF output (the one place that decides whether it is written).
+fn gltf_output(_path: &Path) -> Result<OutputKind> {
+    Ok(OutputKind::Gltf)
 }
 
 /// Creates the missing parent folders of an output file.
@@ -187,7 +182,9 @@ mod tests {
         assert_eq!(kind("out", false).unwrap(), OutputKind::ObjFolder);
         assert_eq!(kind("x.PC2", false).unwrap(), OutputKind::Pc2);
         assert_eq!(kind("f.obj", true).unwrap(), OutputKind::ObjFile);
-        for bad in ["f.obj", "x.glb", "x.gltf", "x.txt", "-"] {
+        assert_eq!(kind("x.glb", false).unwrap(), OutputKind::Gltf);
+        assert_eq!(kind("x.GLTF", true).unwrap(), OutputKind::Gltf);
+        for bad in ["f.obj", "x.txt", "-"] {
             assert!(kind(bad, false).is_err(), "{bad}");
         }
     }

@@ -3,6 +3,8 @@
 //! Readers and writers for OBJ sequences, PC2 point caches and glTF live in the submodules;
 //! [`topology`] holds the adjacency helpers the later stages need.
 
+mod attributes;
+pub mod gltf_write;
 pub mod io;
 mod summary;
 pub mod topology;
@@ -11,7 +13,9 @@ mod gltf;
 mod obj;
 mod pc2;
 
+pub use attributes::Attributes;
 pub use gltf::Clip;
+pub use gltf_write::{write_gltf, GltfOptions};
 pub use io::{
     clips, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_sequence,
     write_pc2, ReadOptions,

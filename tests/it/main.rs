@@ -8,6 +8,7 @@ mod codec;
 mod decimate;
 mod first_frame;
 mod fuzz_regressions;
+mod gltf_write;
 mod hostile_meshes;
 mod mesh_io;
 mod metrics_reference;

@@ -7,9 +7,11 @@
 //! Positions are `f32` in both forms, so nothing is lost.
 
 use crate::args::ConvertArgs;
-use crate::output::{animation_output, prepare_frame_folder, write_pc2_with_base, OutputKind};
+use crate::output::{
+    animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
+};
 use mcgv_video::error::Result;
-use mcgv_video::mesh::{write_obj_sequence, ReadOptions};
+use mcgv_video::mesh::{write_gltf, write_obj_sequence, GltfOptions, ReadOptions};
 
 /// Runs `convert`.
 pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
@@ -18,6 +20,15 @@ pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
     match kind {
         OutputKind::Pc2 => {
             write_pc2_with_base(&mesh, &args.output, Some(&args.input))?;
+        }
+        OutputKind::Gltf => {
+            create_parent(&args.output)?;
+            super::decode::warn_if_many_targets(mesh.frame_count());
+            let options = GltfOptions {
+                fps: args.input_args.fps.unwrap_or(30.0),
+                ..GltfOptions::default()
+            };
+            write_gltf(&mesh, None, &args.output, &options)?;
         }
         OutputKind::ObjFolder | OutputKind::ObjFile => {
             prepare_frame_folder(&args.output, args.force)?;

@@ -7,8 +7,9 @@ use crate::output::{
 use crate::progress;
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::gltf_write::MANY_MORPH_TARGETS;
 use mcgv_video::mesh::io::write_obj_sequence_from;
-use mcgv_video::mesh::{write_obj_frame, AnimatedMesh};
+use mcgv_video::mesh::{write_gltf, write_obj_frame, AnimatedMesh, GltfOptions};
 use std::fs::File;
 use std::io::BufReader;
 use std::time::Instant;
@@ -30,6 +31,16 @@ where
             "mcgv-video: warning: stream truncated: decoded {} of {} temporal-DCT bands, a coarser animation",
             decoder.bands_decoded(),
             decoder.bands_total()
+        );
+    }
+}
+
+/// Tells on stderr when a glTF output gets more morph targets than viewers load comfortably.
+pub fn warn_if_many_targets(frames: usize) {
+    if frames > MANY_MORPH_TARGETS + 1 {
+        eprintln!(
+            "mcgv-video: warning: {} morph targets (one per frame after the first); viewers load more than {MANY_MORPH_TARGETS} slowly",
+            frames - 1
         );
     }
 }
@@ -63,6 +74,15 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
         OutputKind::ObjFolder => {
             prepare_frame_folder(&args.output, args.force)?;
             write_obj_sequence_from(&mesh, &args.output, args.frame.unwrap_or(0))?;
+        }
+        OutputKind::Gltf => {
+            create_parent(&args.output)?;
+            warn_if_many_targets(mesh.frame_count());
+            let options = GltfOptions {
+                fps: args.fps,
+                ..GltfOptions::default()
+            };
+            write_gltf(&mesh, None, &args.output, &options)?;
         }
     }
     if !quiet {

@@ -7,6 +7,7 @@ mod codec;
 mod convert;
 mod eval;
 mod frictions;
+mod gltf;
 mod info;
 mod outputs;
 mod segmentation;

@@ -125,7 +125,12 @@ impl Channel {
     /// The (interpolated) value at `time`, clamped to the first and last keys.
     pub(super) fn sample(&self, time: f64) -> Vec<f64> {
         let last = self.times.len() - 1;
-        let next = self.times.partition_point(|&t| (t as f64) <= time);
+        // STEP keys are compared at f32, the precision key times are stored in: a sample at a key's
+        // time (f / fps computed in f64) shows that key even when the stored time rounded up.
+        let next = match self.interpolation {
+            Interpolation::Step => self.times.partition_point(|&t| t <= time as f32),
+            _ => self.times.partition_point(|&t| (t as f64) <= time),
+        };
         if next == 0 {
             return self.key_value(0);
         }
