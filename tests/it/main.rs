@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod cloth;
 mod codec;
 mod decimate;
 mod first_frame;
@@ -17,3 +18,4 @@ mod range_floor;
 mod roundtrip;
 mod skinning;
 mod tdct;
+mod tdct_spatial;
