@@ -148,6 +148,21 @@ impl ContainerWriter {
         self.add(part.tag, part.bytes, part.checksum);
     }
 
+    /// The file's length in bytes, without serialising it.
+    pub fn len(&self) -> u64 {
+        let parts: usize = self
+            .parts
+            .iter()
+            .map(|(_, p, _)| PART_HEADER_LEN + p.len())
+            .sum();
+        (FILE_HEADER_LEN + parts) as u64
+    }
+
+    /// Whether the container holds no part.
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+
     /// Bytes each part takes in the file (payload plus its part header), by part name, in file order.
     pub fn part_sizes(&self) -> Vec<(String, u64)> {
         self.parts
@@ -453,6 +468,16 @@ mod tests {
         w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
         w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked);
         w.to_bytes()
+    }
+
+    #[test]
+    fn length_without_serialising_is_the_files() {
+        let mut w = ContainerWriter::new();
+        assert!(w.is_empty());
+        assert_eq!(w.len(), w.to_bytes().len() as u64);
+        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
+        w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked);
+        assert_eq!(w.len(), w.to_bytes().len() as u64);
     }
 
     #[test]
