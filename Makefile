@@ -8,19 +8,22 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PACKAGES := pkg-config clang libclang-dev libavcodec-dev libavformat-dev libavutil-dev \
 	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools time \
 	fonts-dejavu-core
-PY_PACKAGES := pymeshlab DracoPy numpy zstandard
+PY_PACKAGES := pymeshlab DracoPy numpy zstandard constriction brotli
+# Node tools of the bench's glTF peers (gltfpack, @gltf-transform, meshoptimizer), pinned by its lockfile.
+NODE_DIR := scripts/node
 
-.PHONY: help deps apt-deps venv node-tools demo test bench fuzz clean
+.PHONY: help deps apt-deps venv node-deps demo test bench fuzz install clean
+PREFIX ?= /usr/local
 
 help:
 	@echo "make demo   encode a sample animation both ways and print size and error"
 	@echo "make test   format check, clippy, all tests"
 	@echo "make bench  rate-distortion and speed tables and plots (bench-out/)"
 	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
-	@echo "make deps   install Debian packages and the reference-tool virtualenv (done by demo/test)"
-	@echo "make node-tools  install the glTF validator into scripts/node (done by test)"
+	@echo "make install  the binary, shell completions and man page under PREFIX (default /usr/local)"
+	@echo "make deps   install Debian packages, the reference-tool virtualenv and the bench's Node tools (done by demo/test)"
 
-deps: apt-deps venv
+deps: apt-deps venv node-deps
 
 # Skipped when every package is already installed; apt-get update only when something is missing.
 apt-deps:
@@ -38,10 +41,9 @@ $(VENV)/.done: Makefile
 	$(VENV)/bin/pip install -q --disable-pip-version-check $(PY_PACKAGES)
 	touch $@
 
-# Node tools of the tests (the Khronos glTF-Validator), pinned by scripts/node/package-lock.json and
-# installed into scripts/node/node_modules. Debian's nodejs and npm are installed only if `node` is missing.
-NODE_DIR := scripts/node
-node-tools: $(NODE_DIR)/node_modules/.done
+# Debian's nodejs and npm only when there is no node at all; then the lockfile's packages into
+# scripts/node/node_modules (npm ci), again only when package.json or the lockfile changed.
+node-deps: $(NODE_DIR)/node_modules/.done
 
 $(NODE_DIR)/node_modules/.done: $(NODE_DIR)/package.json $(NODE_DIR)/package-lock.json
 	@command -v node >/dev/null && command -v npm >/dev/null || { \
@@ -53,10 +55,11 @@ demo: deps
 	$(CARGO) build --release --quiet
 	bash scripts/demo.sh
 
-test: deps node-tools
+test: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets --quiet -- -D warnings
 	MCGV_PYTHON=$(abspath $(PY)) $(CARGO) test --workspace --quiet
+	$(PY) scripts/test_peers.py
 
 bench: deps
 	$(CARGO) build --release --quiet
@@ -93,6 +96,20 @@ fuzz: apt-deps
 			fuzz/logs/$$t.log | head -5; \
 	done; \
 	exit $$status
+
+# The completions and the man page come from the binary itself (clap_complete, clap_mangen), so they
+# always match its flags. DESTDIR for staged installs (packaging).
+install: apt-deps
+	$(CARGO) build --release --quiet -p mcgv-video-cli
+	install -Dm755 target/release/mcgv-video $(DESTDIR)$(PREFIX)/bin/mcgv-video
+	@bin=target/release/mcgv-video; dest=$(DESTDIR)$(PREFIX)/share; \
+	mkdir -p $$dest/bash-completion/completions $$dest/zsh/site-functions \
+		$$dest/fish/vendor_completions.d $$dest/man/man1 && \
+	$$bin completions bash >$$dest/bash-completion/completions/mcgv-video && \
+	$$bin completions zsh >$$dest/zsh/site-functions/_mcgv-video && \
+	$$bin completions fish >$$dest/fish/vendor_completions.d/mcgv-video.fish && \
+	$$bin man >$$dest/man/man1/mcgv-video.1 && \
+	echo "installed $(DESTDIR)$(PREFIX)/bin/mcgv-video, its completions and man page"
 
 clean:
 	$(CARGO) clean

@@ -126,6 +126,11 @@ fn look(codec: &str, fallback: usize) -> Look {
         "draco" => RGBColor(214, 39, 40),
         "pca" => RGBColor(44, 160, 44),
         "dynapack" => RGBColor(148, 103, 189),
+        "dynapack-ac" => RGBColor(227, 119, 194),
+        "gltfpack" => RGBColor(188, 189, 34),
+        "gltfpack-br" => RGBColor(107, 110, 0),
+        "meshopt-fm" => RGBColor(0, 0, 128),
+        "meshopt-vm" => RGBColor(255, 200, 0),
         "zstd" => RGBColor(60, 60, 60),
         _ => pick(),
     };

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # `make bench`: the motion bench (segmentation + prediction speed and residual energy), then a rate
-# sweep of mcgv-video (JPEG and MPEG-4) and of the peer codecs (Draco, zstd, PCA, Dynapack-style) over
+# sweep of mcgv-video (JPEG and MPEG-4) and of the peer codecs (Draco, zstd, PCA, Dynapack-style with
+# zstd and with an arithmetic coder, gltfpack raw and Brotli'd, meshoptimizer's vertex codec) over
 # media/ and, when present, ../shared/media, then a shorter sweep of the encoder variants (skinning
 # predictor, decimation segmentation, both; JPEG q 10 and 50, MPEG-4 qscale 4 and 16, TDCT q 10 and 50
-# when the binary has it), then one RD plot per sequence and the README tables:
-#   bench-out/motion.txt, sweep.csv, sweep-variants.csv, peers.csv, plots/SEQUENCE.png, table.md
+# when the binary has it), then one RD plot per sequence, the README tables and the peers' page:
+#   bench-out/motion.txt, sweep.csv, sweep-variants.csv, peers.csv, peers.skipped.csv (what a peer
+#   could not take, and why), plots/SEQUENCE.png, table.md, peers.md
 # MCGV_PYTHON is the virtualenv's python (`make bench` passes it). BENCH_VARIANTS overrides the
 # variants (scripts/sweep.sh VARIANTS); empty skips the variant sweep.
 set -euo pipefail
@@ -27,7 +29,7 @@ if [ -d "$shared" ]; then
     for glb in "$shared"/threejs_*/*.glb; do inputs+=("$glb"); done
 fi
 cargo bench --quiet --bench motion -- "${inputs[@]}" | tee bench-out/motion.txt
-rm -f bench-out/sweep.csv bench-out/sweep-variants.csv bench-out/peers.csv
+rm -f bench-out/sweep.csv bench-out/sweep-variants.csv bench-out/peers.csv bench-out/peers.skipped.csv
 VARIANTS=default bash scripts/sweep.sh bench-out/sweep.csv "${inputs[@]}"
 csvs=(bench-out/sweep.csv)
 variants=${BENCH_VARIANTS-"skinning decimation skinning+decimation"}
@@ -40,4 +42,16 @@ MCGV_BIN=target/release/mcgv-video "$py" scripts/peers.py run bench-out/peers.cs
 csvs+=(bench-out/peers.csv)
 cargo run --release --quiet --example rd_plot -- bench-out/plots "${csvs[@]}"
 "$py" scripts/rd_table.py "${csvs[@]}" > bench-out/table.md
-echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md"
+MCGV_PYTHON=$py bash scripts/peers_page.sh bench-out/peers.md bench-out/peers.skipped.csv "${csvs[@]}"
+# The results pages in docs/ are made here: the tables, the peers page, the CSVs and the plots.
+{
+    echo "# Rate-distortion tables"
+    echo
+    echo "Written by \`make bench\` (\`scripts/rd_table.py\` over ${csvs[*]#bench-out/}, copied beside this"
+    echo "page); the narrative and older measurements are in [../results.md](../results.md)."
+    echo
+    cat bench-out/table.md
+} > docs/bench/tables.md
+cp "${csvs[@]}" bench-out/peers.md docs/bench/
+cp bench-out/plots/*.png docs/bench/
+echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md, peers.md; docs/bench/ updated"

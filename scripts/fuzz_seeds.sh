@@ -25,6 +25,10 @@ tdct=(--codec tdct --clusters 4 --fps 6 --quality 10 --quiet)
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/tdct.mcgv" "${tdct[@]}"
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/tdct-skinning.mcgv" --predictor skinning \
 	"${tdct[@]}"
+# Spatial prediction of the bands (issue 18): RiggedSimple's bands never pick the one-ring mean,
+# CesiumMan's do; a few frames keep the seed small.
+"$bin" encode "$media/CesiumMan.glb" -o "$out/decode_stream/tdct-spatial.mcgv" --codec tdct --clusters 4 \
+	--fps 2 --quality 90 --quiet
 # Decimation finds K itself, so it takes no --clusters.
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-decimation.mcgv" --codec jpeg \
 	--segmentation decimation --lattice 64x64 --fps 6 --quiet

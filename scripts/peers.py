@@ -7,7 +7,7 @@ Usage (with the virtualenv `make venv` makes):
   peers.py decode CODEC STREAM OUT.pc2            one decoding (writes OUT.obj, the faces, beside it)
 
 Environment for `run`: MCGV_BIN (default target/release/mcgv-video), PEERS_WORK (scratch folder,
-default bench-out/peers-work), PEERS_CODECS (default "draco zstd pca dynapack"), PEERS_DRACO_QP (default "8 10 12 14 16": Draco
+default bench-out/peers-work), PEERS_CODECS (default: ALL_CODECS below), PEERS_DRACO_QP (default "8 10 12 14 16": Draco
 is the slowest peer to measure, see below), PEERS_SETTINGS (e.g. "dynapack=qp 6,qp 8;pca=basis 32":
 other settings for the codecs named).
 
@@ -38,7 +38,11 @@ The peers:
   the animation's bounding cube): each vertex predicted from the same frame's parallelogram plus the
   previous frame's parallelogram error, traversal by face adjacency; residuals zstd-coded instead of
   Dynapack's arithmetic coder.
+- dynapack-ac (peers_dynapack_ac.py): the same residuals, adaptive arithmetic coder, as the paper.
+- gltfpack, gltfpack-br, meshopt-fm, meshopt-vm (peers_meshopt.py, Node tools in scripts/node): glTF
+  morph targets packed by gltfpack (raw, Brotli'd), meshoptimizer's vertex codec; see that module.
 """
+import hashlib
 import json
 import os
 import shutil
@@ -58,7 +62,13 @@ SETTINGS = {
     "zstd": ["level 19"],
     "pca": ["basis 2", "basis 4", "basis 8", "basis 16", "basis 32", "basis 64"],
     "dynapack": ["qp 8", "qp 10", "qp 12", "qp 14", "qp 16"],
+    "dynapack-ac": ["qp 8", "qp 10", "qp 12", "qp 14", "qp 16"],
+    "gltfpack": ["vp 10", "vp 12", "vp 14", "vp 16"],
+    "gltfpack-br": ["vp 10", "vp 12", "vp 14", "vp 16"],
+    "meshopt-fm": ["qp 10", "qp 12", "qp 14", "qp 16"],
+    "meshopt-vm": ["qp 10", "qp 12", "qp 14", "qp 16"],
 }
+ALL_CODECS = "draco zstd pca dynapack dynapack-ac gltfpack gltfpack-br meshopt-fm meshopt-vm"
 # PEERS_SETTINGS="dynapack=qp 6,qp 8;pca=basis 32" replaces the settings of the codecs it names.
 for _item in filter(None, os.environ.get("PEERS_SETTINGS", "").split(";")):
     _codec, _, _list = _item.partition("=")
@@ -313,7 +323,9 @@ def traversal(nv, faces):
     return tuple(np.array(x, dtype=np.int64) for x in (order, kind, pa, pb, pc))
 
 
-def dynapack_encode(frames, faces, bits):
+def dynapack_residuals(frames, faces, bits):
+    """Quantised positions' prediction residuals (F x V x 3, vertices in traversal order), the grid's
+    low corner and step: the part of the encoder the zstd and the arithmetic-coded variants share."""
     nf, nv, _ = frames.shape
     flat = frames.reshape(-1, 3).astype(np.float64)
     low = flat.min(axis=0)
@@ -325,7 +337,12 @@ def dynapack_encode(frames, faces, bits):
     one, par = kind == 1, kind == 2
     pred[:, order[one]] = d[:, a[one]]
     pred[:, order[par]] = d[:, a[par]] + d[:, b[par]] - d[:, c[par]]
-    residual = (d - pred)[:, order]                              # in traversal order
+    return (d - pred)[:, order], low, step
+
+
+def dynapack_encode(frames, faces, bits):
+    nf, nv, _ = frames.shape
+    residual, low, step = dynapack_residuals(frames, faces, bits)
     head = struct.pack("<IIId", nf, nv, faces.shape[0], step) + low.astype("<f8").tobytes()
     return head + pack_faces(faces) + pack_ints(residual)
 
@@ -337,7 +354,12 @@ def dynapack_decode(buf):
     at += 24
     faces, at = unpack_faces(buf, at)
     residual, at = unpack_ints(buf, at)
-    residual = residual.reshape(nf, nv, 3)
+    return dynapack_rebuild(residual.reshape(nf, nv, 3), faces, low, step), faces
+
+
+def dynapack_rebuild(residual, faces, low, step):
+    """Positions from the residuals of dynapack_residuals()."""
+    nf, nv, _ = residual.shape
     order, kind, a, b, c = traversal(nv, faces)
     d = np.zeros((nf, nv, 3), np.int64)
     # The recurrence is linear in the frames, so each vertex is decoded for all frames at once.
@@ -350,7 +372,17 @@ def dynapack_decode(buf):
         else:
             d[:, v] = residual[:, i] + d[:, a[i]] + d[:, b[i]] - d[:, c[i]]
     q = np.cumsum(d, axis=0)
-    return (low + q * step).astype(np.float32), faces
+    return (low + q * step).astype(np.float32)
+
+
+def extra_codecs():
+    """The peers of issue 19, in modules of their own: codec -> (encode, decode), where
+    encode(frames, faces, value) -> bytes and decode(bytes) -> (frames, faces, info or None)."""
+    import peers_dynapack_ac
+    import peers_meshopt
+    table = {c: (e, peers_meshopt.decoders()[c]) for c, e in peers_meshopt.encoders().items()}
+    table["dynapack-ac"] = (peers_dynapack_ac.encode, lambda b: peers_dynapack_ac.decode(b) + (None,))
+    return table
 
 
 def encode(codec, setting, src, stream):
@@ -365,32 +397,60 @@ def encode(codec, setting, src, stream):
         data = pca_encode(frames, faces, value)
     elif codec == "dynapack":
         data = dynapack_encode(frames, faces, value)
+    elif codec in extra_codecs():
+        data = extra_codecs()[codec][0](frames, faces, value)
     else:
         die(f"unknown codec {codec}")
     Path(stream).write_bytes(data)
 
 
 def decode(codec, stream, out):
+    """Writes OUT.pc2 + OUT.obj; for gltfpack, in the decoder's own vertex order, with OUT.json
+    (keys, targets and key times) for the driver's checks and matching (match_gltfpack)."""
     buf = Path(stream).read_bytes()
     decoders = {"draco": draco_decode, "zstd": zstd_decode, "pca": pca_decode,
                 "dynapack": dynapack_decode}
-    if codec not in decoders:
-        die(f"unknown codec {codec}")
     if codec == "draco":
         write_meshes(out, draco_decode(buf))
         return
-    frames, faces = decoders[codec](buf)
+    if codec in decoders:
+        frames, faces = decoders[codec](buf)
+    elif codec in extra_codecs():
+        frames, faces, info = extra_codecs()[codec][1](buf)
+        if info is not None:
+            Path(out).with_suffix(".json").write_text(json.dumps(info))
+    else:
+        die(f"unknown codec {codec}")
     write_recon(out, frames, faces)
 
 
+def match_gltfpack(original, recon):
+    """Checks gltfpack's keys and targets against the original's frames, then rewrites the decoded
+    PC2 in the original's vertex order (each original vertex takes the decoded vertex nearest over all
+    frames) with the original's faces, so that `mcgv-video eval` compares vertex with vertex.
+    Returns how many distinct decoded vertices were used."""
+    import peers_meshopt
+    frames = read_pc2(original)
+    decoded = read_pc2(recon)
+    peers_meshopt.check_keys(json.loads(Path(recon).with_suffix(".json").read_text()), frames.shape[0])
+    index = peers_meshopt.match(frames, decoded)
+    write_recon(recon, decoded[:, index], read_faces(Path(original).with_suffix(".obj")))
+    return len(np.unique(index))
+
+
 # ---------------------------------------------------------------- the driver
+
+class Failure(Exception):
+    """A peer that cannot take an input: `run` notes why in OUT.skipped.csv and goes on."""
+
 
 def timed(cmd, time_file):
     """Runs cmd under GNU time; returns (wall s, cpu s, peak RSS kB). Fails loudly."""
     full = ["/usr/bin/time", "-f", "%e %U %S %M", "-o", str(time_file)] + [str(c) for c in cmd]
     result = subprocess.run(full, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if result.returncode != 0:
-        die(f"{' '.join(map(str, cmd))} failed:\n{result.stderr}")
+        last = (result.stderr.strip().splitlines() or ["no message"])[-1]
+        raise Failure(f"{' '.join(map(str, cmd[2:5]))}: {last}")
     wall, user, system, rss = Path(time_file).read_text().split()[-4:]
     return float(wall), float(user) + float(system), int(rss)
 
@@ -454,12 +514,13 @@ def fmt(value, spec):
 def run(out_csv, inputs):
     binary = os.environ.get("MCGV_BIN", "target/release/mcgv-video")
     work = Path(os.environ.get("PEERS_WORK", "bench-out/peers-work"))
-    codecs = os.environ.get("PEERS_CODECS", "draco zstd pca dynapack").split()
+    codecs = os.environ.get("PEERS_CODECS", ALL_CODECS).split()
     work.mkdir(parents=True, exist_ok=True)
     out = Path(out_csv)
     if not out.exists() or out.stat().st_size == 0:
         out.write_text(SCHEMA + "\n")
-    me = [sys.executable, os.path.abspath(__file__)]
+    # Rows already in OUT.csv are not measured again, so an interrupted run resumes where it stopped.
+    done = {tuple(line.split(",")[:3]) for line in out.read_text().splitlines()[1:]}
     for input_path in inputs:
         name = sequence_name(input_path)
         seq = work / name
@@ -477,23 +538,55 @@ def run(out_csv, inputs):
                            check=True)
         for codec in codecs:
             for setting in SETTINGS[codec]:
-                if codec == "pca" and int(setting.split()[1]) >= nf:
-                    continue    # as many shapes as frames is no compression
-                stream, recon = seq / f"{codec}.bin", seq / f"{codec}_recon.pc2"
-                ew, ec, em = timed(me + ["encode", codec, setting, original, stream], seq / "time")
-                dw, dc, dm = timed(me + ["decode", codec, stream, recon], seq / "time")
-                if codec == "draco":
-                    m = evaluate_frames(binary, original_frames, original, read_meshes(recon), seq / "draco_frames")
-                else:
-                    m = evaluate(binary, original, recon)
-                size = stream.stat().st_size
-                row = (f"{name},{codec},{setting},{size},{size * 8 / (nv * nf):.4f},"
-                       f"{fmt(m['rmse'], '.6e')},{fmt(m.get('vertex_rmse'), '.6e')},"
-                       f"{fmt(m.get('kg_error'), '.5f')},{fmt(m['hausdorff'], '.6e')},"
-                       f"{ew},{dw},{ec:.2f},{dc:.2f},{em},{dm},{nf},{nv}")
+                if codec == "pca" and int(setting.split()[1]) >= nf or (name, codec, setting) in done:
+                    continue    # as many shapes as frames is no compression; measured already
+                try:
+                    row = measure(binary, seq, codec, setting, original_frames)
+                except Failure as e:
+                    skipped = out.with_suffix(".skipped.csv")
+                    with skipped.open("a") as f:
+                        f.write(f"{name},{codec},{setting},\"{str(e).replace(chr(34), chr(39))}\"\n")
+                    print(f"{name}: {codec} {setting} skipped: {e}", file=sys.stderr)
+                    continue
                 print(row, flush=True)
                 with out.open("a") as f:
                     f.write(row + "\n")
+
+
+EVALUATED = {}
+
+
+def measure(binary, seq, codec, setting, original_frames):
+    """One encoding and decoding of seq/original.pc2, measured: the CSV row."""
+    me = [sys.executable, os.path.abspath(__file__)]
+    original, name = seq / "original.pc2", seq.name
+    nf, nv = read_pc2(original).shape[:2]
+    stream, recon = seq / f"{codec}.bin", seq / f"{codec}_recon.pc2"
+    ew, ec, em = timed(me + ["encode", codec, setting, original, stream], seq / "time")
+    dw, dc, dm = timed(me + ["decode", codec, stream, recon], seq / "time")
+    if codec.startswith("gltfpack"):
+        import peers_meshopt
+        try:
+            used = match_gltfpack(original, recon)
+        except peers_meshopt.PeerError as e:
+            raise Failure(str(e)) from e
+        print(f"{name}: {codec} {setting}: {used} of {nv} vertices after welding", file=sys.stderr)
+    if codec == "draco":
+        m = evaluate_frames(binary, original_frames, original, read_meshes(recon), seq / "draco_frames")
+    else:
+        # Codecs that decode to the same frames and triangles (gltfpack and gltfpack-br; dynapack,
+        # dynapack-ac and meshopt on one grid) share one measurement.
+        tri = read_faces(recon.with_suffix(".obj"))
+        turn = (tri.argmin(axis=1)[:, None] + np.arange(3)) % 3     # lowest corner first
+        tri = np.take_along_axis(tri, turn, axis=1)
+        key = hashlib.sha1(recon.read_bytes() + tri.tobytes()).hexdigest()
+        m = EVALUATED.get(key) or evaluate(binary, original, recon)
+        EVALUATED[key] = m
+    size = stream.stat().st_size
+    return (f"{name},{codec},{setting},{size},{size * 8 / (nv * nf):.4f},"
+            f"{fmt(m['rmse'], '.6e')},{fmt(m.get('vertex_rmse'), '.6e')},"
+            f"{fmt(m.get('kg_error'), '.5f')},{fmt(m['hausdorff'], '.6e')},"
+            f"{ew},{dw},{ec:.2f},{dc:.2f},{em},{dm},{nf},{nv}")
 
 
 def main():

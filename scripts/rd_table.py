@@ -26,6 +26,7 @@ from collections import defaultdict
 PAPER_RATES = (2.2, 4.0, 8.0)
 OURS = ("jpeg", "mpeg4", "tdct")   # mcgv-video's image codecs; a variant is CODEC+VARIANT
 VARIANTS = ("", "skinning", "decimation", "skinning+decimation")   # column order of the variant table
+TARGETS = (2e-4, 5e-5)   # RMSE targets of the equal-error table
 GRID = 200  # rates per sequence at which codecs are compared for the closing line
 
 
@@ -43,6 +44,7 @@ def read(paths):
                     die(f"{path}: no column {need}")
             for r in reader:
                 r["bpvf"], r["rmse"] = float(r["bpvf"]), float(r["rmse"])
+                r["kg"] = float(r["kg_error"]) if r.get("kg_error") else None
                 rows.append(r)
     if not rows:
         die("no rows")
@@ -72,6 +74,30 @@ def at_rate(front, rate):
     return front[0][1] if rate == front[0][0] else None
 
 
+def kg_at_rate(points, rate):
+    """KG error at `rate`, interpolated like at_rate on the RMSE frontier's points that carry one;
+    None where the codec's vertices do not correspond (no KG) or outside the measured range."""
+    front = frontier([(b, e) for b, e, k in points if e > 0])
+    kg = {(b, e): k for b, e, k in points}
+    for (b0, e0), (b1, e1) in zip(front, front[1:]):
+        if b0 <= rate <= b1:
+            k0, k1 = kg[(b0, e0)], kg[(b1, e1)]
+            if not k0 or not k1:
+                return None
+            t = (math.log(rate) - math.log(b0)) / (math.log(b1) - math.log(b0))
+            return math.exp(math.log(k0) + t * (math.log(k1) - math.log(k0)))
+    return kg.get(front[0]) if front and rate == front[0][0] else None
+
+
+def bits_at_error(front, target):
+    """The rate at which a frontier reaches RMSE `target`, log-log interpolated; None outside."""
+    for (b0, e0), (b1, e1) in zip(front, front[1:]):
+        if e1 <= target <= e0:
+            t = (math.log(target) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(b0) + t * (math.log(b1) - math.log(b0)))
+    return None
+
+
 def e4(value):
     return "—" if value is None else f"{value * 1e4:.3g}"
 
@@ -99,29 +125,40 @@ def label(codec):
     return f"mcgv-video {codec}" if ours(codec) else codec
 
 
+def cell(points, front, rate):
+    """RMSE x 1e-4 (KG error) at `rate`; the KG part left out where the codec has none."""
+    e = at_rate(front, rate)
+    if e is None:
+        return "—"
+    kg = kg_at_rate(points, rate)
+    return e4(e) + ("" if kg is None else f" ({kg:.3g})")
+
+
 def sequence_section(name, rows):
     by_codec = defaultdict(list)
     for r in rows:
-        by_codec[r["codec"]].append((r["bpvf"], r["rmse"]))
+        by_codec[r["codec"]].append((r["bpvf"], r["rmse"], r["kg"]))
     frames, vertices = rows[0].get("frames", "?"), rows[0].get("vertices", "?")
     out = [f"#### {name} (V = {vertices}, F = {frames})", "",
-           "| codec | points | bpvf measured | RMSE ×1e-4 at 2.2 | at 4 | at 8 | lowest RMSE ×1e-4 (at bpvf) |",
+           "RMSE ×1e-4 of the bbox diagonal (KG error in parentheses where vertices correspond):", "",
+           "| codec | points | bpvf measured | at 2.2 bpvf | at 4 | at 8 | lowest RMSE ×1e-4 (KG) at bpvf |",
            "|---|---|---|---|---|---|---|"]
     fronts = {}
     for codec in sorted(by_codec, key=order):
         pts = by_codec[codec]
         lo, hi = min(p[0] for p in pts), max(p[0] for p in pts)
-        if all(e == 0 for _, e in pts):
+        if all(p[1] == 0 for p in pts):
             out.append(f"| {label(codec)} | {len(pts)} | {lo:.3g} | lossless | lossless | lossless | "
-                       f"0 (at {lo:.3g}) |")
+                       f"0 (0) at {lo:.3g} |")
             continue
-        front = frontier([p for p in pts if p[1] > 0])
+        front = frontier([p[:2] for p in pts if p[1] > 0])
         fronts[codec] = front
-        cells = " | ".join(e4(at_rate(front, r)) for r in PAPER_RATES)
-        best_b, best_e = min(pts, key=lambda p: (p[1], p[0]))
+        cells = " | ".join(cell(pts, front, r) for r in PAPER_RATES)
+        best_b, best_e, best_k = min(pts, key=lambda p: (p[1], p[0]))
+        kg = "" if best_k is None else f" ({best_k:.3g})"
         out.append(f"| {label(codec)} | {len(pts)} | {lo:.3g}–{hi:.3g} | {cells} | "
-                   f"{e4(best_e)} (at {best_b:.3g}) |")
-    lossless = min((b for c, pts in by_codec.items() for b, e in pts if e == 0), default=None)
+                   f"{e4(best_e)}{kg} at {best_b:.3g} |")
+    lossless = min((b for c, pts in by_codec.items() for b, e, _k in pts if e == 0), default=None)
     out += ["", closing_line(fronts, lossless), ""]
     if any(ours(c) and split(c)[1] for c in by_codec):
         out += [best_series_line(fronts), ""] + variant_table(rows) + [""]
@@ -193,9 +230,10 @@ def variant_table(rows):
         row = []
         for v in cols:
             r = cells[k].get(v)
-            row.append("—" if r is None else f"{r['bpvf']:.3g} / {r['rmse'] * 1e4:.3g}")
+            kg = "" if r is None or r["kg"] is None else f" / {r['kg']:.3g}"
+            row.append("—" if r is None else f"{r['bpvf']:.3g} / {r['rmse'] * 1e4:.3g}{kg}")
         out.append(f"| {k[0]} {k[1]} | " + " | ".join(row) + " |")
-    return ["bpvf / RMSE ×1e-4 per variant at the same settings:", ""] + out
+    return ["bpvf / RMSE ×1e-4 / KG error per variant at the same settings:", ""] + out
 
 
 def closing_line(fronts, lossless):
@@ -239,8 +277,11 @@ def closing_line(fronts, lossless):
 def speed_section(name, rows):
     out = [f"#### Speed and peak memory: {name} (V = {rows[0].get('vertices')}, "
            f"F = {rows[0].get('frames')}), whole process (GNU time)", "",
-           "| codec | setting | bpvf | encode frames/s | decode frames/s | encode CPU s | decode CPU s "
-           "| encode peak MB | decode peak MB |", "|---|---|---|---|---|---|---|---|---|"]
+           "Frames per CPU-second (user + system, steadier than wall time on a shared machine) and per "
+           "wall second:", "",
+           "| codec | setting | bpvf | RMSE ×1e-4 | KG | encode frames/CPU s | decode frames/CPU s "
+           "| encode frames/s | decode frames/s | encode peak MB | decode peak MB |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
     frames = float(rows[0]["frames"])
     for r in sorted(rows, key=lambda r: (order(r["codec"]), r["bpvf"])):
         def rate(key):
@@ -249,10 +290,64 @@ def speed_section(name, rows):
 
         def mb(key):
             return f"{int(r[key]) / 1024:.0f}" if r.get(key) else "—"
-        out.append(f"| {label(r['codec'])} | {r['setting']} | {r['bpvf']:.3g} | {rate('encode_s')} | "
-                   f"{rate('decode_s')} | {r.get('encode_cpu_s') or '—'} | {r.get('decode_cpu_s') or '—'} | "
-                   f"{mb('encode_rss_kb')} | {mb('decode_rss_kb')} |")
+        kg = "—" if r["kg"] is None else f"{r['kg']:.3g}"
+        out.append(f"| {label(r['codec'])} | {r['setting']} | {r['bpvf']:.3g} | {e4(r['rmse'])} | {kg} | "
+                   f"{rate('encode_cpu_s')} | {rate('decode_cpu_s')} | {rate('encode_s')} | "
+                   f"{rate('decode_s')} | {mb('encode_rss_kb')} | {mb('decode_rss_kb')} |")
     return out + [""]
+
+
+def equal_error(by_seq, targets=TARGETS):
+    """Per sequence, the bits (bpvf) mcgv-video's best series and the strongest peer need to reach
+    each target RMSE, and their ratio; then every codec's bits and KG error at those targets."""
+    head = " | ".join(f"RMSE {t:.0e}: mcgv-video | strongest peer | peer / mcgv-video" for t in targets)
+    out = ["#### Bits at equal error", "",
+           "bpvf needed to reach an RMSE (fraction of the bbox diagonal) of " +
+           " and ".join(f"{t:.0e}" for t in targets) + ", read off each codec's rate-distortion frontier "
+           "(log-log interpolation between measured points, never extrapolated; — where a codec's "
+           "points do not bracket the target). mcgv-video is its best series there (any image codec "
+           "and encoder variant); the strongest peer is the peer needing the fewest bits. A ratio above 1 "
+           "means mcgv-video needs fewer bits.", "",
+           f"| sequence | {head} |", "|---|" + "---|---|---|" * len(targets)]
+    detail = ["", "Every codec (bpvf, and KG error at that point where vertices correspond):", "",
+              "| sequence | codec | " + " | ".join(f"bpvf at {t:.0e} (KG)" for t in targets) + " |",
+              "|---|---|" + "---|" * len(targets)]
+    for name in sorted(by_seq, key=str.lower):
+        needs = codec_bits(by_seq[name], targets)
+        cells = []
+        for i in range(len(targets)):
+            mine = best(needs, i, ours)
+            peer = best(needs, i, lambda c: not ours(c))
+            ratio = f"{peer[1] / mine[1]:.2f}" if mine and peer else "—"
+            cells.append(f"{show(mine)} | {show(peer)} | {ratio}")
+        out.append(f"| {name} | " + " | ".join(cells) + " |")
+        for codec in sorted(needs, key=order):
+            detail.append(f"| {name} | {label(codec)} | " + " | ".join(
+                "—" if b is None else f"{b:.3g}" + ("" if k is None else f" ({k:.3g})") for b, k in needs[codec]) + " |")
+    return out + detail + [""]
+
+
+def codec_bits(rows, targets):
+    """codec -> [(bpvf, KG there) or (None, None)] per target."""
+    pts = defaultdict(list)
+    for r in rows:
+        if r["rmse"] > 0:
+            pts[r["codec"]].append((r["bpvf"], r["rmse"], r["kg"]))
+    needs = {}
+    for codec, p in pts.items():
+        front = frontier([q[:2] for q in p])
+        bits = [bits_at_error(front, t) for t in targets]
+        needs[codec] = [(b, None if b is None else kg_at_rate(p, b)) for b in bits]
+    return needs
+
+
+def best(needs, i, which):
+    found = [(v[i][0], c) for c, v in needs.items() if which(c) and v[i][0] is not None]
+    return None if not found else (min(found)[1], min(found)[0])
+
+
+def show(pick):
+    return "—" if pick is None else f"{pick[1]:.3g} ({pick[0]})"
 
 
 def main():
@@ -268,7 +363,7 @@ def main():
     by_seq = defaultdict(list)
     for r in rows:
         by_seq[r["sequence"]].append(r)
-    lines = []
+    lines = equal_error(by_seq)
     for name in sorted(by_seq, key=str.lower):
         lines += sequence_section(name, by_seq[name])
     if speed is None:

@@ -27,8 +27,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut tmp = builder.tempfile_in(dir).map_err(|e| Error::io(path, e))?;
-    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    // The temporary file's name is an internal detail: errors name the target (and, when it is
+    // missing, its folder) with the bare reason, not tempfile's "at path .mcgv-partial-…".
+    let bare = |e: std::io::Error| match e.kind() {
+        std::io::ErrorKind::NotFound => Error::io(
+            path,
+            std::io::Error::new(
+                e.kind(),
+                format!("the folder {} does not exist", dir.display()),
+            ),
+        ),
+        kind => Error::io(path, std::io::Error::from(kind)),
+    };
+    let mut tmp = builder.tempfile_in(dir).map_err(bare)?;
+    tmp.write_all(bytes).map_err(bare)?;
+    tmp.persist(path).map_err(|e| bare(e.error))?;
     Ok(())
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 /// mcgv-video: compress animated triangle meshes into one `.mcgv` file (Multi-Chart Geometry Video).
 #[derive(Debug, Parser)]
-#[command(name = "mcgv-video", version, about, long_about = None)]
+#[command(name = "mcgv-video", version, about, long_about = None, after_help = MAIN_EXAMPLES)]
 pub struct Cli {
     /// The command to run.
     #[command(subcommand)]
@@ -15,21 +15,63 @@ pub struct Cli {
     pub quiet: bool,
 }
 
+const MAIN_EXAMPLES: &str = "Examples:
+  mcgv-video encode media/CesiumMan.glb -o cesium.mcgv
+  mcgv-video decode cesium.mcgv -o cesium.pc2
+  mcgv-video eval media/CesiumMan.glb cesium.mcgv";
+
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Compress an animation (OBJ sequence, PC2 + OBJ, glTF) into a .mcgv file.
+    #[command(after_help = "Examples:
+  mcgv-video encode media/CesiumMan.glb -o cesium.mcgv
+  mcgv-video encode 'frames/*.obj' -o walk.mcgv --quality 70
+  mcgv-video encode media/Fox.glb --clip all -o fox.mcgv   # fox-Survey.mcgv, fox-Walk.mcgv, ...")]
     Encode(EncodeArgs),
-    /// Decode a .mcgv file to an OBJ sequence (a folder) or a PC2 point cache.
+    /// Decode a .mcgv file to an OBJ sequence (a folder), one OBJ or a PC2 point cache.
+    #[command(after_help = "Examples:
+  mcgv-video decode cesium.mcgv -o frames/
+  mcgv-video decode cesium.mcgv -o cesium.pc2        # also writes cesium.obj, its base mesh
+  mcgv-video decode cesium.mcgv --frame 10 -o frame10.obj")]
     Decode(DecodeArgs),
     /// Show a .mcgv file's bit budget per part; optionally write its images as PNG.
+    #[command(after_help = "Examples:
+  mcgv-video inspect cesium.mcgv
+  mcgv-video inspect cesium.mcgv --json
+  mcgv-video inspect cesium-jpeg.mcgv --png pictures/ --frames 0,10   # see docs/reading-inspect-pictures.md")]
     Inspect(InspectArgs),
     /// Compare two animations (any input form, or a .mcgv) and print the error measures.
+    #[command(after_help = "Examples:
+  mcgv-video eval media/CesiumMan.glb cesium.mcgv
+  mcgv-video eval media/CesiumMan.glb frames/ --json
+  mcgv-video eval media/CesiumMan.glb cesium.mcgv --bands 4")]
     Eval(EvalArgs),
-    /// Print vertices, frames, faces, components, manifoldness and bounding box of an animation.
+    /// Print vertices, frames, faces, components, manifoldness, bounding box and glTF clips.
+    #[command(after_help = "Examples:
+  mcgv-video info media/Fox.glb
+  mcgv-video info 'frames/*.obj' --json
+  mcgv-video info cache.pc2 --base cache.obj")]
     Info(InfoArgs),
     /// Rewrite an animation (any input form) losslessly as a PC2 + base OBJ or an OBJ folder.
+    #[command(after_help = "Examples:
+  mcgv-video convert media/CesiumMan.glb -o cesium.pc2   # also writes cesium.obj
+  mcgv-video convert media/Fox.glb --clip Walk -o walk/")]
     Convert(ConvertArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish or powershell) to stdout.
+    #[command(after_help = "Examples:
+  mcgv-video completions bash > /usr/local/share/bash-completion/completions/mcgv-video
+  mcgv-video completions zsh > ~/.zfunc/_mcgv-video
+  mcgv-video completions fish > ~/.config/fish/completions/mcgv-video.fish")]
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff) to stdout.
+    #[command(after_help = "Examples:
+  mcgv-video man > /usr/local/share/man/man1/mcgv-video.1
+  mcgv-video man | man -l -")]
+    Man,
 }
 
 /// How to read an animation: options that apply to every input form.
@@ -38,7 +80,8 @@ pub struct InputArgs {
     /// Rate at which glTF animations are baked to frames (default: the animation's keyframe rate, or 30).
     #[arg(long)]
     pub fps: Option<f64>,
-    /// glTF animation (clip) to bake, by name or index (default: the first).
+    /// glTF animation (clip) to bake, by name or index (default: the first; `info` lists them);
+    /// `encode --clip all` writes one stream per clip.
     #[arg(long)]
     pub clip: Option<String>,
     /// Base OBJ giving the connectivity of a PC2 point cache (default: the .obj beside the .pc2).
@@ -51,11 +94,12 @@ pub struct InputArgs {
 pub struct EncodeArgs {
     /// Input animation: a folder or glob of .obj files, a .pc2 (with --base), or a .gltf/.glb.
     pub input: String,
-    /// Output .mcgv file.
+    /// Output .mcgv file, or `-` for stdout. Missing parent folders are created.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Image codec for the residuals.
-    #[arg(long, value_enum, default_value_t = CodecChoice::Jpeg)]
+    /// Residual coder: tdct is the smallest at equal error; jpeg decodes any frame on its own;
+    /// mpeg4 suits hardware video decoders.
+    #[arg(long, value_enum, default_value_t = CodecChoice::Tdct)]
     pub codec: CodecChoice,
     /// Rate knob for every codec, 1..100 (higher = better quality, more bits; default 50).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
@@ -85,12 +129,13 @@ pub struct EncodeArgs {
     /// Grown until the charts fit.
     #[arg(long, default_value = "auto")]
     pub lattice: String,
-    /// How free pixels of the geometry images are filled.
-    #[arg(long)]
+    /// jpeg, mpeg4: how free pixels of the geometry images are filled [default: snap for jpeg,
+    /// biharmonic for mpeg4].
+    #[arg(long, value_parser = padding_methods())]
     pub padding: Option<String>,
-    /// MPEG-4 group of pictures: an I-frame every N frames.
-    #[arg(long, default_value_t = 50)]
-    pub gop: usize,
+    /// mpeg4: group of pictures, an I-frame every N frames [default: 50].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub gop: Option<u64>,
     /// Let the first-frame coder reorder vertices for fewer bits (default keeps the input order).
     #[arg(long)]
     pub reorder: bool,
@@ -119,6 +164,20 @@ pub struct EncodeArgs {
     pub input_args: InputArgs,
 }
 
+/// The padding methods `--padding` takes (the padding crate's names).
+fn padding_methods() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new([
+        "snap",
+        "biharmonic",
+        "cg",
+        "midgrey",
+        "mean",
+        "pushpull",
+        "laplace",
+        "dct",
+    ])
+}
+
 /// The motion segmentations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum SegmentationChoice {
@@ -128,7 +187,7 @@ pub enum SegmentationChoice {
     Decimation,
 }
 
-/// The residual image codecs.
+/// The residual coders.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum CodecChoice {
     /// JPEG per frame: every frame decodes on its own.
@@ -154,8 +213,10 @@ pub enum PredictorChoice {
 pub struct DecodeArgs {
     /// The .mcgv file.
     pub input: PathBuf,
-    /// Output: a folder for an OBJ sequence (frame_0000.obj …), a file ending in .pc2, or a glTF
-    /// file ending in .glb or .gltf (morph targets, one per frame).
+    /// Output, by its name: `DIR/` (or an existing folder, or a name without extension) for OBJ
+    /// frames frame_0000.obj …; `X.pc2` for a point cache with its base `X.obj` beside it;
+    /// `X.obj` with --frame for that one frame; `X.glb` or `X.gltf` for a glTF asset (morph
+    /// targets, one per frame). Missing parent folders are created.
     #[arg(short, long)]
     pub output: PathBuf,
     /// glTF output: frames per second of the animation (the stream does not record the source's).
@@ -164,6 +225,9 @@ pub struct DecodeArgs {
     /// Decode only this frame (numbered from 0).
     #[arg(long)]
     pub frame: Option<usize>,
+    /// Decode into a folder that already holds files, removing the frame_*.obj of an earlier decode.
+    #[arg(long, short = 'y')]
+    pub force: bool,
     /// tdct streams: decode only the first N temporal-DCT bands (a coarser, progressive preview).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub bands: Option<u64>,
@@ -228,11 +292,14 @@ pub struct InfoArgs {
 pub struct ConvertArgs {
     /// The animation (any input form).
     pub input: String,
-    /// Output: a file ending in .pc2 (the base OBJ with the faces is written beside it, same stem),
-    /// a glTF file ending in .glb or .gltf (morph targets at --fps, default 30), or a folder for an
-    /// OBJ sequence (frame_0000.obj …).
+    /// Output, by its name: `X.pc2` (the base OBJ with the faces is written beside it, same stem),
+    /// `X.glb` or `X.gltf` (morph targets at --fps, default 30), or `DIR/` (an existing folder, or
+    /// a name without extension) for OBJ frames frame_0000.obj ….
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Write into a folder that already holds files, removing the frame_*.obj of an earlier run.
+    #[arg(long, short = 'y')]
+    pub force: bool,
     /// How to read the input.
     #[command(flatten)]
     pub input_args: InputArgs,

@@ -1,19 +1,23 @@
 //! The `mcgv-video` command: maps flags, progress bars and JSON onto the `mcgv_video` library.
 
+#[macro_use]
+mod output;
+mod annotate;
 mod args;
 mod commands;
 mod progress;
 mod render;
 
 use args::{Cli, Command};
-use clap::Parser;
+use clap::{CommandFactory, Parser};
 
 fn main() {
     std::process::exit(run());
 }
 
-/// Runs the CLI and returns the process exit code: 0 on success, 1 on error (message on stderr),
-/// 2 on a usage error (clap's own).
+/// Runs the CLI and returns the process exit code: 0 on success (and when stdout's reader went
+/// away), 1 on a runtime error, 2 on a usage error (a malformed command line, an option that does
+/// not apply or has a bad value); the message goes to stderr.
 fn run() -> i32 {
     // A panic anywhere (a dependency's bug, caught where it can be) is reported in one line, like
     // every other error, instead of a backtrace.
@@ -22,11 +26,7 @@ fn run() -> i32 {
     }));
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
-            let _ = e.print();
-            return code;
-        }
+        Err(e) => return clap_error(&e),
     };
     let result = match &cli.command {
         Command::Encode(a) => commands::encode::run(a, cli.quiet),
@@ -35,14 +35,58 @@ fn run() -> i32 {
         Command::Eval(a) => commands::eval::run(a, cli.quiet),
         Command::Info(a) => commands::info::run(a, cli.quiet),
         Command::Convert(a) => commands::convert::run(a, cli.quiet),
+        Command::Completions { shell } => completions(*shell),
+        Command::Man => man(),
     };
     match result {
         Ok(()) => 0,
+        Err(e) if output::is_closed_pipe(&e) => 0,
         Err(e) => {
             eprintln!("mcgv-video: error: {}", render(&e));
-            1
+            match e {
+                mcgv_video::Error::InvalidOption { .. } => 2,
+                _ => 1,
+            }
         }
     }
+}
+
+/// Prints clap's message (help and version to stdout, exit 0; usage errors to stderr, exit 2),
+/// with a hint when extra arguments look like an unquoted glob the shell expanded.
+fn clap_error(e: &clap::Error) -> i32 {
+    let _ = e.print();
+    if !e.use_stderr() {
+        return 0;
+    }
+    if e.kind() == clap::error::ErrorKind::UnknownArgument {
+        let extra = e
+            .get(clap::error::ContextKind::InvalidArg)
+            .map(|v| v.to_string())
+            .unwrap_or_default();
+        if !extra.starts_with('-') {
+            eprintln!(
+                "hint: the shell expanded a pattern into several files; quote it so that \
+                 mcgv-video reads the frames itself, e.g. 'frames/*.obj'"
+            );
+        }
+    }
+    2
+}
+
+/// Writes the completion script of `shell` to stdout.
+fn completions(shell: clap_complete::Shell) -> mcgv_video::Result<()> {
+    let mut buffer = Vec::new();
+    clap_complete::generate(shell, &mut Cli::command(), "mcgv-video", &mut buffer);
+    outln!("{}", String::from_utf8_lossy(&buffer).trim_end())
+}
+
+/// Writes the man page (roff) to stdout.
+fn man() -> mcgv_video::Result<()> {
+    let mut buffer = Vec::new();
+    clap_mangen::Man::new(Cli::command())
+        .render(&mut buffer)
+        .map_err(|e| mcgv_video::Error::io("stdout", e))?;
+    out!("{}", String::from_utf8_lossy(&buffer))
 }
 
 /// An error as the command line says it: an invalid option by its flag, not its field name.

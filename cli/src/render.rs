@@ -30,7 +30,9 @@ pub fn render_partition_png(
         )));
     }
     let image = render(positions, triangles, labels, size)?;
-    image
+    let clusters = labels.iter().max().map_or(0, |&k| k + 1);
+    let note = "frame 0 along -z (x right, y up); colour = motion cluster";
+    crate::annotate::with_legend(&image, clusters, note)
         .save(path)
         .map_err(|e| Error::io(path, std::io::Error::other(e)))
 }
@@ -98,20 +100,9 @@ fn facing(a: &Point, b: &Point, c: &Point) -> f32 {
     }
 }
 
-/// Well-separated hues: the golden-ratio sequence.
+/// The cluster's colour, shared with the atlas picture and the legends.
 fn cluster_colour(label: u32) -> [f32; 3] {
-    let h = (label as f32 * 0.618_034).fract() * 6.0;
-    let (s, v) = (0.65, 0.95);
-    let f = h.fract();
-    let (p, q, t) = (v * (1.0 - s), v * (1.0 - s * f), v * (1.0 - s * (1.0 - f)));
-    match h as u32 {
-        0 => [v, t, p],
-        1 => [q, v, p],
-        2 => [p, v, t],
-        3 => [p, q, v],
-        4 => [t, p, v],
-        _ => [v, p, q],
-    }
+    crate::annotate::cluster_colour(label).map(|c| c as f32 / 255.0)
 }
 
 fn shade(colour: [f32; 3], facing: f32) -> Rgb<u8> {
@@ -215,7 +206,12 @@ mod tests {
         let path = dir.path().join("partition.png");
         render_partition_png(&positions, &triangles, &labels, 64, &path).unwrap();
         let image = image::open(&path).unwrap().to_rgb8();
-        assert_eq!(image.dimensions(), (64, 64));
+        // The 64×64 drawing, and the legend below it.
+        assert!(
+            image.width() >= 64 && image.height() > 64,
+            "{:?}",
+            image.dimensions()
+        );
         let mut colours: Vec<[u8; 3]> = image.pixels().map(|p| p.0).collect();
         colours.sort();
         colours.dedup();

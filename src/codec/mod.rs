@@ -34,6 +34,9 @@ use crate::stream::container::{ContainerReader, Part};
 use crate::stream::header::Header;
 use std::io::{Read, Seek};
 
+/// The stream id of the first temporal-DCT format (bands without spatial prediction), refused.
+const RETIRED_TDCT_ID: u8 = 2;
+
 /// The residual codec recorded in the stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -51,17 +54,25 @@ impl Codec {
     /// Every codec, in the order of their stream ids.
     pub const ALL: [Codec; 3] = [Codec::Jpeg, Codec::Mpeg4, Codec::Tdct];
 
-    /// The codec's id in the stream header.
+    /// The codec's id in the stream header. The temporal DCT's is 3 since its bands are coded with
+    /// spatial prediction (issue 18): id 2 was the format before, which this build refuses.
     pub fn id(self) -> u8 {
         match self {
             Codec::Jpeg => 0,
             Codec::Mpeg4 => 1,
-            Codec::Tdct => 2,
+            Codec::Tdct => 3,
         }
     }
 
     /// The codec of a stream id.
     pub fn from_id(id: u8) -> Result<Self> {
+        if id == RETIRED_TDCT_ID {
+            return Err(Error::Stream(format!(
+                "codec id {id} is the temporal-DCT format from before spatial prediction of the \
+                 bands, which this version of mcgv-video no longer decodes: re-encode the animation \
+                 (`--codec tdct`) from its source"
+            )));
+        }
         Codec::ALL
             .into_iter()
             .find(|c| c.id() == id)
@@ -234,5 +245,20 @@ pub trait ResidualDecoder<R> {
     /// The temporal-DCT bands, for codecs that code them.
     fn bands(&self) -> Option<&tdct::Bands> {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stream_ids_round_trip_and_the_old_tdct_format_is_refused() {
+        for codec in Codec::ALL {
+            assert_eq!(Codec::from_id(codec.id()).unwrap(), codec);
+        }
+        let old = Codec::from_id(RETIRED_TDCT_ID).unwrap_err().to_string();
+        assert!(old.contains("re-encode"), "{old}");
+        assert!(Codec::from_id(4).is_err());
     }
 }

@@ -80,8 +80,7 @@ pub fn encode_with_progress(
     progress: &dyn Progress,
 ) -> Result<Encoded> {
     opts.check(mesh)?;
-    let mut clock = Stopwatch::default();
-    clock.restart();
+    let mut clock = Stopwatch::new();
     progress.stage("first frame");
     let (ff, permuted) = analysis::first_frame(mesh, opts)?;
     let mesh = permuted.as_ref().unwrap_or(mesh);
@@ -113,35 +112,43 @@ pub fn encode_with_progress(
     let container = assemble(&header, leading, mesh, &partition, &prediction, parts)?;
     clock.lap("side information");
     let report = EncodeReport {
+        parts: container.part_sizes(),
+        bytes: container.len(),
+        bpvf: container.len() as f64 * 8.0 / (mesh.vertex_count() * mesh.frame_count()) as f64,
+        header,
+        charts: atlas.as_ref().map_or(0, |s| s.charts),
+        packing_efficiency: atlas.as_ref().map_or(0.0, |s| s.packing_efficiency),
+        moved_vertices: atlas.as_ref().map_or(0, |s| s.moved_vertices),
+        l2_stretch: atlas.as_ref().map_or(0.0, |s| s.l2_stretch),
         stage_seconds: clock.stages,
-        ..report(header, &container, atlas.as_ref(), segmentation)
+        segmentation,
+        permutation: ff.permutation,
     };
-    Ok(Encoded {
-        container,
-        report: EncodeReport {
-            permutation: ff.permutation,
-            ..report
-        },
-    })
+    Ok(Encoded { container, report })
 }
 
 /// Seconds per stage.
-#[derive(Default)]
 struct Stopwatch {
     stages: Vec<(String, f64)>,
-    start: Option<Instant>,
+    start: Instant,
 }
 
 impl Stopwatch {
+    fn new() -> Self {
+        Self {
+            stages: Vec::new(),
+            start: Instant::now(),
+        }
+    }
+
     fn lap(&mut self, name: &str) {
-        let start = self.start.unwrap_or_else(Instant::now);
         self.stages
-            .push((name.to_string(), start.elapsed().as_secs_f64()));
+            .push((name.to_string(), self.start.elapsed().as_secs_f64()));
         self.restart();
     }
 
     fn restart(&mut self) {
-        self.start = Some(Instant::now());
+        self.start = Instant::now();
     }
 }
 
@@ -209,27 +216,4 @@ fn assemble(
     let mut container = ContainerWriter::new();
     parts.into_iter().for_each(|p| container.push(p));
     Ok(container)
-}
-
-/// The figures of an encoding.
-fn report(
-    header: Header,
-    container: &ContainerWriter,
-    atlas: Option<&atlas::AtlasStats>,
-    segmentation: SegmentationReport,
-) -> EncodeReport {
-    let bytes = container.to_bytes().len() as u64;
-    EncodeReport {
-        parts: container.part_sizes(),
-        bpvf: bytes as f64 * 8.0 / (header.vertices as f64 * header.frames as f64),
-        header,
-        bytes,
-        charts: atlas.map_or(0, |s| s.charts),
-        packing_efficiency: atlas.map_or(0.0, |s| s.packing_efficiency),
-        moved_vertices: atlas.map_or(0, |s| s.moved_vertices),
-        l2_stretch: atlas.map_or(0.0, |s| s.l2_stretch),
-        stage_seconds: Vec::new(),
-        segmentation,
-        permutation: None,
-    }
 }

@@ -105,20 +105,7 @@ pub fn encode(
     opts: &FirstFrameOptions,
 ) -> Result<EncodedFirstFrame> {
     let vertex_count = positions.len();
-    if vertex_count as u64 > MAX_ELEMENTS || triangles.len() as u64 > MAX_ELEMENTS {
-        return Err(Error::Usage(format!(
-            "first frame too large: {vertex_count} vertices"
-        )));
-    }
-    if let Some((t, _)) = triangles
-        .iter()
-        .enumerate()
-        .find(|(_, tri)| tri.iter().any(|&v| v as usize >= vertex_count))
-    {
-        return Err(Error::Mesh(format!(
-            "triangle {t} indexes a vertex past {vertex_count}"
-        )));
-    }
+    check_encode_input(triangles, vertex_count)?;
     let grid = Grid::fit(positions, opts.bits)?;
     let cells: Vec<Cell> = positions.iter().map(|&p| grid.quantise(p)).collect();
     let (traversable, mut degenerate): (Vec<Triangle>, Vec<Triangle>) = triangles
@@ -127,21 +114,7 @@ pub fn encode(
 
     let mut connectivity = Encoder::new();
     let mut geometry = Encoder::new();
-    let mut models = Models::default();
-    let mut oracle = Oracle::new(&traversable, vertex_count);
-    let state = traversal::run(
-        &mut connectivity,
-        Some(&mut oracle),
-        traversable.len(),
-        vertex_count,
-        &mut models,
-    )?;
-    // Vertices in no traversed triangle follow, in input order.
-    for v in 0..vertex_count as u32 {
-        if oracle.to_traversal.get(v as usize) == Some(&UNASSIGNED) {
-            oracle.assign(v);
-        }
-    }
+    let (state, oracle) = encode_traversal(&mut connectivity, &traversable, vertex_count)?;
     let traversal_cells: Vec<Cell> = oracle
         .from_traversal
         .iter()
@@ -154,36 +127,26 @@ pub fn encode(
         vertex_count,
         &traversal_cells,
     )?;
-    for tri in degenerate.iter_mut() {
-        for v in tri.iter_mut() {
-            *v = oracle.to_traversal.get(*v as usize).copied().unwrap_or(0);
-        }
-    }
+    to_traversal_indices(&mut degenerate, &oracle.to_traversal);
     code_degenerate(&mut connectivity, &mut degenerate, vertex_count)?;
 
-    let mut order_stream = Vec::new();
-    if !opts.reorder {
-        let mut order_coder = Encoder::new();
-        let all: Vec<Triangle> = state.triangles.iter().chain(&degenerate).copied().collect();
-        let adjacency = VertexAdjacency::new(vertex_count, &all);
-        order::code_order(
-            &mut order_coder,
-            &mut oracle.from_traversal.clone(),
-            &adjacency,
-        )?;
-        order_stream = order_coder.finish()?;
-    }
-    let traversal_positions: Vec<Point> =
-        decoded_cells.iter().map(|&c| grid.dequantise(c)).collect();
-    let (decoded_positions, permutation) = if opts.reorder {
-        (traversal_positions, Some(oracle.from_traversal.clone()))
+    let order_stream = if opts.reorder {
+        Vec::new()
     } else {
-        let mut out = vec![[0.0; 3]; vertex_count];
-        for (t, &input) in oracle.from_traversal.iter().enumerate() {
-            out[input as usize] = traversal_positions[t];
-        }
-        (out, None)
+        encode_order(
+            &state.triangles,
+            &degenerate,
+            &oracle.from_traversal,
+            vertex_count,
+        )?
     };
+    let (decoded_positions, permutation) = place_decoded_positions(
+        &grid,
+        &decoded_cells,
+        &oracle.from_traversal,
+        vertex_count,
+        opts.reorder,
+    );
 
     let connectivity = connectivity.finish()?;
     let geometry = geometry.finish()?;
@@ -200,14 +163,8 @@ pub fn encode(
             order_stream.len() as u32,
         ],
     };
-    let mut bytes = header.to_bytes();
-    bytes.extend_from_slice(&connectivity);
-    bytes.extend_from_slice(&geometry);
-    bytes.extend_from_slice(&order_stream);
-    let crc = crc32fast::hash(&bytes);
-    bytes.splice(HEADER_LEN - 4..HEADER_LEN - 4, crc.to_le_bytes());
     Ok(EncodedFirstFrame {
-        bytes,
+        bytes: assemble(&header, &connectivity, &geometry, &order_stream),
         decoded_positions,
         permutation,
         sizes: StreamSizes {
@@ -217,6 +174,105 @@ pub fn encode(
             order: order_stream.len(),
         },
     })
+}
+
+/// Refuses inputs too large for the header and triangles indexing past the vertices.
+fn check_encode_input(triangles: &[Triangle], vertex_count: usize) -> Result<()> {
+    if vertex_count as u64 > MAX_ELEMENTS || triangles.len() as u64 > MAX_ELEMENTS {
+        return Err(Error::Usage(format!(
+            "first frame too large: {vertex_count} vertices"
+        )));
+    }
+    if let Some((t, _)) = triangles
+        .iter()
+        .enumerate()
+        .find(|(_, tri)| tri.iter().any(|&v| v as usize >= vertex_count))
+    {
+        return Err(Error::Mesh(format!(
+            "triangle {t} indexes a vertex past {vertex_count}"
+        )));
+    }
+    Ok(())
+}
+
+/// Codes the traversal of the non-degenerate triangles into `connectivity`; the oracle it
+/// returns numbers every vertex, those in no traversed triangle last, in input order.
+fn encode_traversal<'a>(
+    connectivity: &mut Encoder,
+    traversable: &'a [Triangle],
+    vertex_count: usize,
+) -> Result<(traversal::Traversal, Oracle<'a>)> {
+    let mut models = Models::default();
+    let mut oracle = Oracle::new(traversable, vertex_count);
+    let state = traversal::run(
+        connectivity,
+        Some(&mut oracle),
+        traversable.len(),
+        vertex_count,
+        &mut models,
+    )?;
+    // Vertices in no traversed triangle follow, in input order.
+    for v in 0..vertex_count as u32 {
+        if oracle.to_traversal.get(v as usize) == Some(&UNASSIGNED) {
+            oracle.assign(v);
+        }
+    }
+    Ok((state, oracle))
+}
+
+/// Renumbers the degenerate triangles' input indices to traversal indices.
+fn to_traversal_indices(degenerate: &mut [Triangle], to_traversal: &[u32]) {
+    for tri in degenerate.iter_mut() {
+        for v in tri.iter_mut() {
+            *v = to_traversal.get(*v as usize).copied().unwrap_or(0);
+        }
+    }
+}
+
+/// Codes the traversal → input permutation over the adjacency of all triangles.
+fn encode_order(
+    traversed: &[Triangle],
+    degenerate: &[Triangle],
+    from_traversal: &[u32],
+    vertex_count: usize,
+) -> Result<Vec<u8>> {
+    let mut order_coder = Encoder::new();
+    let all: Vec<Triangle> = traversed.iter().chain(degenerate).copied().collect();
+    let adjacency = VertexAdjacency::new(vertex_count, &all);
+    order::code_order(&mut order_coder, &mut from_traversal.to_vec(), &adjacency)?;
+    order_coder.finish()
+}
+
+/// The positions the decoder will return, and the permutation when it numbers vertices in
+/// traversal order (`reorder`); otherwise back in input order.
+fn place_decoded_positions(
+    grid: &Grid,
+    decoded_cells: &[Cell],
+    from_traversal: &[u32],
+    vertex_count: usize,
+    reorder: bool,
+) -> (Vec<Point>, Option<Vec<u32>>) {
+    let traversal_positions: Vec<Point> =
+        decoded_cells.iter().map(|&c| grid.dequantise(c)).collect();
+    if reorder {
+        return (traversal_positions, Some(from_traversal.to_vec()));
+    }
+    let mut out = vec![[0.0; 3]; vertex_count];
+    for (t, &input) in from_traversal.iter().enumerate() {
+        out[input as usize] = traversal_positions[t];
+    }
+    (out, None)
+}
+
+/// The header, with its crc32 over everything, then the three streams.
+fn assemble(header: &Header, connectivity: &[u8], geometry: &[u8], order: &[u8]) -> Vec<u8> {
+    let mut bytes = header.to_bytes();
+    bytes.extend_from_slice(connectivity);
+    bytes.extend_from_slice(geometry);
+    bytes.extend_from_slice(order);
+    let crc = crc32fast::hash(&bytes);
+    bytes.splice(HEADER_LEN - 4..HEADER_LEN - 4, crc.to_le_bytes());
+    bytes
 }
 
 /// Decodes a first frame: its triangles and positions.

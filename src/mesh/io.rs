@@ -66,6 +66,19 @@ pub fn input_files(input: &str, opts: &ReadOptions) -> Result<Vec<PathBuf>> {
     }
 }
 
+/// The clips (animations) of a `.gltf`/`.glb` file with their frame counts and rates at `fps`
+/// (default: each clip's keyframe rate, else 30); an empty list for the other input forms.
+pub fn clips(input: &str, fps: Option<f64>) -> Result<Vec<gltf::Clip>> {
+    let path = Path::new(input);
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match extension.as_deref() {
+        Some("gltf") | Some("glb") => gltf::clips(path, fps),
+        _ => Ok(Vec::new()),
+    }
+}
+
 /// Parses one OBJ held in memory as a one-frame animation; `name` only labels errors.
 pub fn parse_obj(text: &str, name: &Path) -> Result<AnimatedMesh> {
     let frame = obj::parse_obj(text, name)?;

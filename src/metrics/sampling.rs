@@ -101,10 +101,14 @@ impl SamplingPlan {
     /// Plans the samples of `triangles`, choosing each face's subdivision from its size at
     /// `positions` (the reference frame) and the `spacing`.
     pub fn new(triangles: &[Triangle], positions: &[Point], spacing: f64) -> Self {
-        let mut samples: Vec<Planned> = Vec::with_capacity(4 * triangles.len());
-        let mut shares: Vec<Vec<(u32, f64)>> = Vec::with_capacity(4 * triangles.len());
-        let mut shared: FxHashMap<Shared, usize> = FxHashMap::default();
-        shared.reserve(2 * triangles.len() + positions.len());
+        let mut planner = Planner {
+            samples: Vec::with_capacity(4 * triangles.len()),
+            shares: Vec::with_capacity(4 * triangles.len()),
+            shared: FxHashMap::default(),
+        };
+        planner
+            .shared
+            .reserve(2 * triangles.len() + positions.len());
         for (f, t) in triangles.iter().enumerate() {
             let c = [
                 position(positions, t[0]),
@@ -112,81 +116,12 @@ impl SamplingPlan {
                 position(positions, t[2]),
             ];
             let n = level(longest_edge(&c), spacing);
-            let m = 2 * n;
             let sub = 1.0 / (n * n) as f64;
             let face = f as u32;
-            // Corners and edge midpoints of the sub-triangles: the lattice of step 1/(2n).
-            for i in 0..=m {
-                for j in 0..=(m - i) {
-                    let k = m - i - j;
-                    let zeros = [i, j, k].iter().filter(|&&x| x == 0).count();
-                    let corner = i % 2 == 0 && j % 2 == 0 && k % 2 == 0;
-                    // Sub-triangles meeting at a corner: 1 at a face corner, 3 on a face edge,
-                    // 6 inside; sharing a midpoint: 1 on a face edge, 2 inside.
-                    let fraction = match (corner, zeros) {
-                        (true, 2) => CORNER,
-                        (true, 1) => 3.0 * CORNER,
-                        (true, _) => 6.0 * CORNER,
-                        (false, 1) => MIDPOINT,
-                        (false, _) => 2.0 * MIDPOINT,
-                    } * sub;
-                    let key = match (i, j, k) {
-                        (_, 0, 0) => Some(Shared::Vertex(t[0])),
-                        (0, _, 0) => Some(Shared::Vertex(t[1])),
-                        (0, 0, _) => Some(Shared::Vertex(t[2])),
-                        (0, _, _) => Some(edge_key(t[1], j, t[2], k, m)),
-                        (_, 0, _) => Some(edge_key(t[0], i, t[2], k, m)),
-                        (_, _, 0) => Some(edge_key(t[0], i, t[1], j, m)),
-                        _ => None,
-                    };
-                    if let Some(list) = key
-                        .as_ref()
-                        .and_then(|k| shared.get(k))
-                        .and_then(|&s| shares.get_mut(s))
-                    {
-                        list.push((face, fraction));
-                        continue;
-                    }
-                    if let Some(key) = key {
-                        shared.insert(key, samples.len());
-                    }
-                    let bary = [i, j, k].map(|x| x as f64 / m as f64);
-                    samples.push(Planned {
-                        face,
-                        bary,
-                        shares: (0, 0),
-                    });
-                    shares.push(vec![(face, fraction)]);
-                }
-            }
-            // Centroids of the upward (corner sum n − 1) and downward (n − 2) sub-triangles.
-            let nf = n as f64;
-            let upward = (n - 1, 1.0 / 3.0);
-            let downward = n.checked_sub(2).map(|sum| (sum, 2.0 / 3.0));
-            for (sum, shift) in std::iter::once(upward).chain(downward) {
-                for i in 0..=sum {
-                    for j in 0..=(sum - i) {
-                        let k = sum - i - j;
-                        samples.push(Planned {
-                            face,
-                            bary: [i, j, k].map(|x| (x as f64 + shift) / nf),
-                            shares: (0, 0),
-                        });
-                        shares.push(vec![(face, CENTROID * sub)]);
-                    }
-                }
-            }
+            planner.add_lattice(face, t, n, sub);
+            planner.add_centroids(face, n, sub);
         }
-        let mut flat = Vec::with_capacity(shares.iter().map(Vec::len).sum());
-        for (s, list) in samples.iter_mut().zip(&shares) {
-            let start = flat.len() as u32;
-            flat.extend_from_slice(list);
-            s.shares = (start, flat.len() as u32);
-        }
-        Self {
-            samples,
-            shares: flat,
-        }
+        planner.finish()
     }
 
     /// Number of samples.
@@ -247,6 +182,114 @@ pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64)
     let mut out = Vec::new();
     SamplingPlan::new(triangles, positions, spacing).apply(triangles, positions, &mut out);
     out
+}
+
+/// [`SamplingPlan::new`] under way: the samples so far, the faces each stands for, and the
+/// sample at each point shared between faces.
+struct Planner {
+    samples: Vec<Planned>,
+    shares: Vec<Vec<(u32, f64)>>,
+    shared: FxHashMap<Shared, usize>,
+}
+
+impl Planner {
+    /// Corners and edge midpoints of the sub-triangles of `face` (`t`) cut `n` times: the lattice
+    /// of step 1/(2n); a point on a mesh vertex or edge joins the sample already there.
+    fn add_lattice(&mut self, face: u32, t: &Triangle, n: usize, sub: f64) {
+        let m = 2 * n;
+        for i in 0..=m {
+            for j in 0..=(m - i) {
+                let k = m - i - j;
+                let fraction = lattice_fraction(i, j, k) * sub;
+                let key = lattice_key(t, i, j, k, m);
+                if let Some(list) = key
+                    .as_ref()
+                    .and_then(|k| self.shared.get(k))
+                    .and_then(|&s| self.shares.get_mut(s))
+                {
+                    list.push((face, fraction));
+                    continue;
+                }
+                if let Some(key) = key {
+                    self.shared.insert(key, self.samples.len());
+                }
+                let bary = [i, j, k].map(|x| x as f64 / m as f64);
+                self.samples.push(Planned {
+                    face,
+                    bary,
+                    shares: (0, 0),
+                });
+                self.shares.push(vec![(face, fraction)]);
+            }
+        }
+    }
+
+    /// Centroids of the upward (corner sum n − 1) and downward (n − 2) sub-triangles.
+    fn add_centroids(&mut self, face: u32, n: usize, sub: f64) {
+        let nf = n as f64;
+        let upward = (n - 1, 1.0 / 3.0);
+        let downward = n.checked_sub(2).map(|sum| (sum, 2.0 / 3.0));
+        for (sum, shift) in std::iter::once(upward).chain(downward) {
+            for i in 0..=sum {
+                for j in 0..=(sum - i) {
+                    let k = sum - i - j;
+                    self.samples.push(Planned {
+                        face,
+                        bary: [i, j, k].map(|x| (x as f64 + shift) / nf),
+                        shares: (0, 0),
+                    });
+                    self.shares.push(vec![(face, CENTROID * sub)]);
+                }
+            }
+        }
+    }
+
+    /// Flattens the shares into one list the samples index.
+    fn finish(self) -> SamplingPlan {
+        let Self {
+            mut samples,
+            shares,
+            ..
+        } = self;
+        let mut flat = Vec::with_capacity(shares.iter().map(Vec::len).sum());
+        for (s, list) in samples.iter_mut().zip(&shares) {
+            let start = flat.len() as u32;
+            flat.extend_from_slice(list);
+            s.shares = (start, flat.len() as u32);
+        }
+        SamplingPlan {
+            samples,
+            shares: flat,
+        }
+    }
+}
+
+/// The fraction of a sub-triangle's area that lattice point (i, j, k) stands for.
+fn lattice_fraction(i: usize, j: usize, k: usize) -> f64 {
+    let zeros = [i, j, k].iter().filter(|&&x| x == 0).count();
+    let corner = i % 2 == 0 && j % 2 == 0 && k % 2 == 0;
+    // Sub-triangles meeting at a corner: 1 at a face corner, 3 on a face edge,
+    // 6 inside; sharing a midpoint: 1 on a face edge, 2 inside.
+    match (corner, zeros) {
+        (true, 2) => CORNER,
+        (true, 1) => 3.0 * CORNER,
+        (true, _) => 6.0 * CORNER,
+        (false, 1) => MIDPOINT,
+        (false, _) => 2.0 * MIDPOINT,
+    }
+}
+
+/// The mesh vertex or edge point that lattice point (i, j, k) of `t` lies on, if any.
+fn lattice_key(t: &Triangle, i: usize, j: usize, k: usize, m: usize) -> Option<Shared> {
+    match (i, j, k) {
+        (_, 0, 0) => Some(Shared::Vertex(t[0])),
+        (0, _, 0) => Some(Shared::Vertex(t[1])),
+        (0, 0, _) => Some(Shared::Vertex(t[2])),
+        (0, _, _) => Some(edge_key(t[1], j, t[2], k, m)),
+        (_, 0, _) => Some(edge_key(t[0], i, t[2], k, m)),
+        (_, _, 0) => Some(edge_key(t[0], i, t[1], j, m)),
+        _ => None,
+    }
 }
 
 /// The key of a lattice point on the edge between vertices `a` (lattice weight `wa`) and `b`.

@@ -151,6 +151,21 @@ impl ContainerWriter {
         self.add(part.tag, part.bytes, part.checksum);
     }
 
+    /// The file's length in bytes, without serialising it.
+    pub fn len(&self) -> u64 {
+        let parts: usize = self
+            .parts
+            .iter()
+            .map(|(_, p, _)| PART_HEADER_LEN + p.len())
+            .sum();
+        (FILE_HEADER_LEN + parts) as u64
+    }
+
+    /// Whether the container holds no part.
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+
     /// Bytes each part takes in the file (payload plus its part header), by part name, in file order.
     pub fn part_sizes(&self) -> Vec<(String, u64)> {
         self.parts
@@ -230,81 +245,20 @@ impl ContainerReader<BufReader<File>> {
 impl<R: Read + Seek> ContainerReader<R> {
     /// Reads the part table of a container from any seekable source.
     pub fn new(mut source: R) -> Result<Self> {
-        let io = |e: std::io::Error| Error::Stream(format!("reading the part table: {e}"));
-        let file_len = source.seek(SeekFrom::End(0)).map_err(io)?;
-        source.seek(SeekFrom::Start(0)).map_err(io)?;
-        let mut head = [0u8; 16];
-        read_exact_or(&mut source, &mut head, "the file header")?;
-        let mut r = ByteReader::new(&head, "file header");
-        if r.take(8)? != MAGIC {
-            return Err(Error::Stream(
-                "not a .mcgv file (wrong magic number)".into(),
-            ));
-        }
-        let version = r.u16()?;
-        if version != VERSION {
-            return Err(Error::Stream(format!(
-                "stream version {version}; this build reads version {VERSION}"
-            )));
-        }
-        let _reserved = r.u16()?;
-        let count = r.u32()?;
-        if count > MAX_PARTS {
-            return Err(Error::Stream(format!(
-                "header claims {count} parts (at most {MAX_PARTS})"
-            )));
-        }
+        let file_len = source.seek(SeekFrom::End(0)).map_err(table_io)?;
+        source.seek(SeekFrom::Start(0)).map_err(table_io)?;
+        let count = read_file_header(&mut source)?;
         let mut parts = Vec::with_capacity(count as usize);
         let mut pos = 16u64;
         let mut truncated = None;
         for i in 0..count {
-            let mut ph = [0u8; 17];
-            read_exact_or(&mut source, &mut ph, "a part header")?;
-            let mut r = ByteReader::new(&ph, "part header");
-            let mut tag = [0u8; 4];
-            tag.copy_from_slice(r.take(4)?);
-            let checksum = match r.u8()? {
-                0 => Checksum::Whole,
-                1 => Checksum::Chunked,
-                2 => Checksum::Progressive,
-                other => {
-                    return Err(Error::Stream(format!(
-                        "part {i}: unknown checksum kind {other}"
-                    )))
-                }
-            };
-            let len = r.u64()?;
-            let crc = r.u32()?;
-            let offset = pos + 17;
-            let declared_end = offset.checked_add(len);
-            // A progressive last part may be cut by the end of the file: its prefix still decodes.
-            let (len, declared_end) = match declared_end {
-                Some(e)
-                    if e > file_len
-                        && checksum == Checksum::Progressive
-                        && i + 1 == count
-                        && offset <= file_len =>
-                {
-                    truncated = Some((Tag(tag), len));
-                    (file_len - offset, Some(file_len))
-                }
-                other => (len, other),
-            };
-            let end = declared_end.filter(|&e| e <= file_len).ok_or_else(|| {
-                Error::Stream(format!(
-                    "part {} claims {len} bytes but the file ends first (truncated file?)",
-                    Tag(tag)
-                ))
-            })?;
-            parts.push(PartEntry {
-                tag: Tag(tag),
-                offset,
-                len,
-                crc,
-                checksum,
-            });
-            pos = end;
-            source.seek(SeekFrom::Start(pos)).map_err(io)?;
+            let part = read_part_entry(&mut source, i, count, pos, file_len)?;
+            if part.truncated.is_some() {
+                truncated = part.truncated;
+            }
+            parts.push(part.entry);
+            pos = part.end;
+            source.seek(SeekFrom::Start(pos)).map_err(table_io)?;
         }
         if pos != file_len {
             return Err(Error::Stream(format!(
@@ -397,6 +351,107 @@ impl<R: Read + Seek> ContainerReader<R> {
     }
 }
 
+/// An I/O failure while reading the part table.
+fn table_io(e: std::io::Error) -> Error {
+    Error::Stream(format!("reading the part table: {e}"))
+}
+
+/// Reads and checks the 16-byte file header (magic, version); returns the part count.
+fn read_file_header<R: Read>(source: &mut R) -> Result<u32> {
+    let mut head = [0u8; 16];
+    read_exact_or(source, &mut head, "the file header")?;
+    let mut r = ByteReader::new(&head, "file header");
+    if r.take(8)? != MAGIC {
+        return Err(Error::Stream(
+            "not a .mcgv file (wrong magic number)".into(),
+        ));
+    }
+    let version = r.u16()?;
+    if version != VERSION {
+        return Err(Error::Stream(format!(
+            "stream version {version}; this build reads version {VERSION}"
+        )));
+    }
+    let _reserved = r.u16()?;
+    let count = r.u32()?;
+    if count > MAX_PARTS {
+        return Err(Error::Stream(format!(
+            "header claims {count} parts (at most {MAX_PARTS})"
+        )));
+    }
+    Ok(count)
+}
+
+/// One part header as read by [`read_part_entry`].
+struct PartRead {
+    entry: PartEntry,
+    /// Where its payload ends in the file.
+    end: u64,
+    /// Its tag and declared length when it is the progressive last part cut by the end of the file.
+    truncated: Option<(Tag, u64)>,
+}
+
+/// Reads part `i` of `count`, whose 17-byte header starts at `pos`.
+fn read_part_entry<R: Read>(
+    source: &mut R,
+    i: u32,
+    count: u32,
+    pos: u64,
+    file_len: u64,
+) -> Result<PartRead> {
+    let mut ph = [0u8; 17];
+    read_exact_or(source, &mut ph, "a part header")?;
+    let mut r = ByteReader::new(&ph, "part header");
+    let mut tag = [0u8; 4];
+    tag.copy_from_slice(r.take(4)?);
+    let checksum = match r.u8()? {
+        0 => Checksum::Whole,
+        1 => Checksum::Chunked,
+        2 => Checksum::Progressive,
+        other => {
+            return Err(Error::Stream(format!(
+                "part {i}: unknown checksum kind {other}"
+            )))
+        }
+    };
+    let len = r.u64()?;
+    let crc = r.u32()?;
+    let offset = pos + 17;
+    let declared_end = offset.checked_add(len);
+    let mut truncated = None;
+    // A progressive last part may be cut by the end of the file: its prefix still decodes.
+    let (len, declared_end) = match declared_end {
+        Some(e)
+            if e > file_len
+                && checksum == Checksum::Progressive
+                && i + 1 == count
+                && offset <= file_len =>
+        {
+            truncated = Some((Tag(tag), len));
+            (file_len - offset, Some(file_len))
+        }
+        other => (len, other),
+    };
+    let end = declared_end.filter(|&e| e <= file_len).ok_or_else(|| {
+        Error::Stream(format!(
+            "part {} claims {len} bytes but the file ends first (truncated file?)",
+            Tag(tag)
+        ))
+    })?;
+    let entry = PartEntry {
+        tag: Tag(tag),
+        offset,
+        len,
+        crc,
+        checksum,
+    };
+    Ok(PartRead {
+        entry,
+        end,
+        truncated,
+    })
+}
+
 fn read_exact_or<R: Read>(source: &mut R, buf: &mut [u8], what: &str) -> Result<()> {
     source.read_exact(buf).map_err(|e| match e.kind() {
         std::io::ErrorKind::UnexpectedEof => {
@@ -416,6 +471,16 @@ mod tests {
         w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
         w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked);
         w.to_bytes()
+    }
+
+    #[test]
+    fn length_without_serialising_is_the_files() {
+        let mut w = ContainerWriter::new();
+        assert!(w.is_empty());
+        assert_eq!(w.len(), w.to_bytes().len() as u64);
+        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
+        w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked);
+        assert_eq!(w.len(), w.to_bytes().len() as u64);
     }
 
     #[test]

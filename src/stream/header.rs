@@ -137,6 +137,15 @@ impl Header {
             },
         };
         r.finish()?;
+        h.check_counts()?;
+        h.check_lattice()?;
+        h.check_quantisation()?;
+        Ok(h)
+    }
+
+    /// Refuses element counts past the limits or inconsistent with one another.
+    fn check_counts(&self) -> Result<()> {
+        let h = self;
         for (what, n) in [
             ("vertices", h.vertices),
             ("frames", h.frames),
@@ -155,6 +164,12 @@ impl Header {
                 h.vertices, h.frames, h.clusters
             )));
         }
+        Ok(())
+    }
+
+    /// Refuses a lattice the codec cannot have, or one too small for the vertices.
+    fn check_lattice(&self) -> Result<()> {
+        let h = self;
         if !h.codec.has_images() {
             // No images, so no lattice: a lattice here means the header is not what it claims.
             if h.lattice_width != 0 || h.lattice_height != 0 || h.charts != 0 {
@@ -187,15 +202,20 @@ impl Header {
                 h.vertices, h.lattice_width, h.lattice_height
             )));
         }
-        if !(1..=32).contains(&h.affine_bits)
-            || !(1..=24).contains(&h.first_frame_bits)
-            || h.gop == 0
+        Ok(())
+    }
+
+    /// Refuses quantisation parameters outside what the coders accept.
+    fn check_quantisation(&self) -> Result<()> {
+        if !(1..=32).contains(&self.affine_bits)
+            || !(1..=24).contains(&self.first_frame_bits)
+            || self.gop == 0
         {
             return Err(Error::Stream(
                 "header has out-of-range quantisation parameters".into(),
             ));
         }
-        Ok(h)
+        Ok(())
     }
 }
 

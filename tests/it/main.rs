@@ -5,6 +5,7 @@
 mod common;
 
 mod attributes;
+mod cloth;
 mod codec;
 mod decimate;
 mod first_frame;
@@ -18,3 +19,4 @@ mod range_floor;
 mod roundtrip;
 mod skinning;
 mod tdct;
+mod tdct_spatial;

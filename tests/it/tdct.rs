@@ -301,33 +301,21 @@ fn step_overrides_quality_and_is_checked() {
 #[test]
 #[ignore = "measurement, not a check"]
 fn measure_dead_zone() {
-    use mcgv_video::codec::tdct::coefficients::{forward, quantise, BandCoder};
-    use mcgv_video::encoder::analysis::{predict, segment};
-    use mcgv_video::first_frame::{self, FirstFrameOptions};
+    use crate::tdct_spatial::coefficients_of;
+    use mcgv_video::codec::tdct::coefficients::{quantise, BandCoder};
+    use mcgv_video::codec::tdct::spatial::Neighbourhood;
+    use std::sync::Arc;
     for name in ["CesiumMan.glb", "Fox.glb", "RiggedFigure.glb"] {
         let mesh = read_media(name);
-        let opts = tdct(50);
-        let ff = first_frame::encode(
-            mesh.frame(0),
-            mesh.triangles(),
-            &FirstFrameOptions {
-                bits: opts.first_frame_bits,
-                reorder: false,
-            },
-        )
-        .unwrap();
-        let (partition, _) = segment(&mesh, &opts).unwrap();
-        let residuals = predict(&mesh, &ff.decoded_positions, &partition, &opts)
-            .unwrap()
-            .residuals;
-        let coefficients = forward(&residuals).unwrap();
+        let coefficients = coefficients_of(&mesh, &tdct(50));
         let d = mesh.bbox_diagonal();
         let n = (coefficients.len() * coefficients[0].len() / 3) as f64;
         for theta in [0.0, 0.05, 0.1, 0.15, 0.2, 0.3] {
             for fraction in [4e-4, 7e-4, 1e-3, 1.6e-3, 2.5e-3, 5e-3] {
                 let step = d * fraction;
                 let levels = quantise(&coefficients, step, theta).unwrap();
-                let mut coder = BandCoder::new(mesh.vertex_count());
+                let neighbourhood = Neighbourhood::new(mesh.vertex_count(), mesh.triangles());
+                let mut coder = BandCoder::new(Arc::new(neighbourhood.unwrap()));
                 let bytes: usize = levels
                     .iter()
                     .enumerate()

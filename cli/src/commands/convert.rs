@@ -7,51 +7,41 @@
 //! Positions are `f32` in both forms, so nothing is lost.
 
 use crate::args::ConvertArgs;
-use mcgv_video::error::{Error, Result};
-use mcgv_video::mesh::gltf_write::is_gltf_path;
-use mcgv_video::mesh::{
-    read_animation, write_gltf, write_obj_frame, write_obj_sequence, write_pc2, GltfOptions,
-    ReadOptions,
+use crate::output::{
+    animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
 };
-use std::path::Path;
-
-/// Whether the output path names a PC2 point cache rather than an OBJ folder.
-fn is_pc2(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("pc2"))
-}
+use mcgv_video::error::Result;
+use mcgv_video::mesh::{write_gltf, write_obj_sequence, GltfOptions, ReadOptions};
 
 /// Runs `convert`.
 pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
-    let mesh = read_animation(&args.input, &ReadOptions::from(&args.input_args))?;
-    if is_gltf_path(&args.output) {
-        super::decode::warn_if_many_targets(mesh.frame_count());
-        let options = GltfOptions {
-            fps: args.input_args.fps.unwrap_or(30.0),
-            ..GltfOptions::default()
-        };
-        write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
-    } else if is_pc2(&args.output) {
-        // A PC2 holds no faces: the base OBJ beside it (same stem) is what `--base` defaults to.
-        let base = args.output.with_extension("obj");
-        if Path::new(&args.input) == base {
-            return Err(Error::Usage(format!(
-                "{}: writing the base OBJ would overwrite the input",
-                base.display()
-            )));
+    let kind = animation_output(&args.output, false)?;
+    let mesh = super::read_input(&args.input, &ReadOptions::from(&args.input_args), quiet)?;
+    match kind {
+        OutputKind::Pc2 => {
+            write_pc2_with_base(&mesh, &args.output, Some(&args.input))?;
         }
-        write_obj_frame(mesh.triangles(), mesh.frame(0), &base)?;
-        write_pc2(&mesh, &args.output)?;
-    } else {
-        write_obj_sequence(&mesh, &args.output)?;
+        OutputKind::Gltf => {
+            create_parent(&args.output)?;
+            super::decode::warn_if_many_targets(mesh.frame_count());
+            let options = GltfOptions {
+                fps: args.input_args.fps.unwrap_or(30.0),
+                ..GltfOptions::default()
+            };
+            write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
+        }
+        OutputKind::ObjFolder | OutputKind::ObjFile => {
+            prepare_frame_folder(&args.output, args.force)?;
+            write_obj_sequence(&mesh, &args.output)?;
+        }
     }
     if !quiet {
-        println!(
+        outln!(
             "{}: {} frame(s) of {} vertices",
             args.output.display(),
             mesh.frame_count(),
             mesh.vertex_count()
-        );
+        )?;
     }
     Ok(())
 }

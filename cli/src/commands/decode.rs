@@ -1,20 +1,18 @@
 //! `mcgv-video decode`.
 
 use crate::args::DecodeArgs;
+use crate::output::{
+    animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
+};
 use crate::progress;
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::error::{Error, Result};
-use mcgv_video::mesh::gltf_write::{is_gltf_path, MANY_MORPH_TARGETS};
+use mcgv_video::mesh::gltf_write::MANY_MORPH_TARGETS;
 use mcgv_video::mesh::io::write_obj_sequence_from;
-use mcgv_video::mesh::{write_gltf, write_pc2, AnimatedMesh, GltfOptions};
-use std::path::Path;
+use mcgv_video::mesh::{write_gltf, write_obj_frame, AnimatedMesh, GltfOptions};
+use std::fs::File;
+use std::io::BufReader;
 use std::time::Instant;
-
-/// Whether the output path names a PC2 point cache rather than an OBJ folder.
-fn is_pc2(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("pc2"))
-}
 
 /// The decoding options of `--bands`.
 pub fn decode_options(bands: Option<u64>) -> DecodeOptions {
@@ -50,51 +48,81 @@ pub fn warn_if_many_targets(frames: usize) {
 /// Runs `decode`.
 pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
     let start = Instant::now();
-    let mut decoder = Decoder::open_with(&args.input, &decode_options(args.bands))?;
+    // The output's kind is checked before any work: a wrong name costs nothing.
+    let kind = animation_output(&args.output, args.frame.is_some())?;
+    let mut decoder = Decoder::open_with(&args.input, &decode_options(args.bands))
+        .map_err(|e| super::in_file(&args.input, e))?;
     warn_if_truncated(&decoder);
-    let frames = decoder.header().frames as usize;
-    let mesh = match args.frame {
-        Some(f) => {
-            if f >= frames {
-                return Err(Error::Usage(format!(
-                    "--frame {f}: the stream has frames 0 to {}",
-                    frames - 1
-                )));
-            }
-            let positions = decoder.decode_frame(f)?;
-            AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
-                .with_attributes(decoder.attributes().clone())?
+    if decoder.header().reorder && !quiet {
+        eprintln!(
+            "mcgv-video: note: {} was encoded with --reorder: the vertices are written in the \
+             stream's order (faces renumbered to match); `eval` against the original restores \
+             the input order itself",
+            args.input.display()
+        );
+    }
+    let mesh =
+        decode_mesh(&mut decoder, args, quiet).map_err(|e| super::in_file(&args.input, e))?;
+    match kind {
+        OutputKind::Pc2 => {
+            write_pc2_with_base(&mesh, &args.output, None)?;
         }
-        None => {
-            let pb = progress::bar(frames as u64, "decode", quiet);
-            let mesh = decoder.decode_all_with_progress(&crate::progress::Reporter(&pb))?;
-            pb.finish_and_clear();
-            mesh
+        OutputKind::ObjFile => {
+            create_parent(&args.output)?;
+            write_obj_frame(mesh.triangles(), mesh.frame(0), &args.output)?;
         }
-    };
-    if is_gltf_path(&args.output) {
-        warn_if_many_targets(mesh.frame_count());
-        let options = GltfOptions {
-            fps: args.fps,
-            ..GltfOptions::default()
-        };
-        write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
-    } else if is_pc2(&args.output) {
-        write_pc2(&mesh, &args.output)?;
-    } else {
-        let first = args.frame.unwrap_or(0);
-        write_obj_sequence_from(&mesh, &args.output, first)?;
+        OutputKind::ObjFolder => {
+            prepare_frame_folder(&args.output, args.force)?;
+            write_obj_sequence_from(&mesh, &args.output, args.frame.unwrap_or(0))?;
+        }
+        OutputKind::Gltf => {
+            create_parent(&args.output)?;
+            warn_if_many_targets(mesh.frame_count());
+            let options = GltfOptions {
+                fps: args.fps,
+                ..GltfOptions::default()
+            };
+            write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
+        }
     }
     if !quiet {
         let seconds = start.elapsed().as_secs_f64();
-        println!(
+        outln!(
             "{}: {} frame(s) of {} vertices written in {:.2} s ({:.1} frames/s)",
             args.output.display(),
             mesh.frame_count(),
             mesh.vertex_count(),
             seconds,
             mesh.frame_count() as f64 / seconds.max(1e-9)
-        );
+        )?;
     }
     Ok(())
+}
+
+/// The frames `--frame` asks for (all by default), decoded.
+fn decode_mesh(
+    decoder: &mut Decoder<BufReader<File>>,
+    args: &DecodeArgs,
+    quiet: bool,
+) -> Result<AnimatedMesh> {
+    let frames = decoder.header().frames as usize;
+    match args.frame {
+        Some(f) => {
+            if f >= frames {
+                return Err(Error::option(
+                    "frame",
+                    format!("{f}: the stream has frames 0 to {}", frames - 1),
+                ));
+            }
+            let positions = decoder.decode_frame(f)?;
+            AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
+                .with_attributes(decoder.attributes().clone())
+        }
+        None => {
+            let pb = progress::bar(frames as u64, "decode", quiet);
+            let mesh = decoder.decode_all_with_progress(&crate::progress::Reporter(&pb))?;
+            pb.finish_and_clear();
+            Ok(mesh)
+        }
+    }
 }

@@ -6,7 +6,7 @@ use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
 use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::io::input_files;
-use mcgv_video::mesh::{read_animation, ReadOptions};
+use mcgv_video::mesh::ReadOptions;
 use mcgv_video::motion::PredictorKind;
 use mcgv_video::Lattice;
 use std::path::{Path, PathBuf};
@@ -15,27 +15,34 @@ use std::time::Instant;
 /// Parses the encode arguments into encoder options, rejecting nonsense with a clear message.
 pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
     let lattice = parse_lattice(&args.lattice)?;
+    let codec = match args.codec {
+        CodecChoice::Jpeg => Codec::Jpeg,
+        CodecChoice::Mpeg4 => Codec::Mpeg4,
+        CodecChoice::Tdct => Codec::Tdct,
+    };
+    check_codec_options(args, codec, lattice)?;
     let padding = match &args.padding {
         Some(name) => Some(
             name.parse::<padding::Method>()
-                .map_err(|e| Error::Usage(format!("--padding {name}: {e}")))?,
+                .map_err(|e| Error::option("padding", format!("{name}: {e}")))?,
         ),
         None => None,
     };
     let segmentation = match args.segmentation {
         SegmentationChoice::Kmeans => {
             if args.e0.is_some() {
-                return Err(Error::Usage(
-                    "--e0 applies to --segmentation decimation only".into(),
+                return Err(Error::option(
+                    "e0",
+                    "applies to --segmentation decimation only",
                 ));
             }
             Segmentation::KMeans
         }
         SegmentationChoice::Decimation => {
             if args.clusters.is_some() {
-                return Err(Error::Usage(
-                    "--clusters applies to --segmentation kmeans only: decimation finds K from --e0"
-                        .into(),
+                return Err(Error::option(
+                    "clusters",
+                    "applies to --segmentation kmeans only: decimation finds K from --e0",
                 ));
             }
             Segmentation::Decimation {
@@ -45,11 +52,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
     };
     let defaults = EncodeOptions::default();
     Ok(EncodeOptions {
-        codec: match args.codec {
-            CodecChoice::Jpeg => Codec::Jpeg,
-            CodecChoice::Mpeg4 => Codec::Mpeg4,
-            CodecChoice::Tdct => Codec::Tdct,
-        },
+        codec,
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
         qscale: args.qscale,
         clusters: args.clusters.unwrap_or(defaults.clusters),
@@ -57,7 +60,9 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         affine_bits: args.affine_bits,
         lattice,
         padding,
-        gop: args.gop,
+        gop: args
+            .gop
+            .map_or(defaults.gop, |g| usize::try_from(g).unwrap_or(usize::MAX)),
         reorder: args.reorder,
         predictor: match args.predictor {
             PredictorChoice::Affine => PredictorKind::Affine,
@@ -71,15 +76,60 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
     })
 }
 
+/// One rule for options of another codec: a usage error naming the codec(s) they belong to.
+fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Result<()> {
+    let given: [(&'static str, bool, &[Codec]); 6] = [
+        ("qscale", args.qscale.is_some(), &[Codec::Mpeg4]),
+        ("gop", args.gop.is_some(), &[Codec::Mpeg4]),
+        ("step", args.step.is_some(), &[Codec::Tdct]),
+        (
+            "padding",
+            args.padding.is_some(),
+            &[Codec::Jpeg, Codec::Mpeg4],
+        ),
+        (
+            "lattice",
+            lattice != Lattice::Auto,
+            &[Codec::Jpeg, Codec::Mpeg4],
+        ),
+        (
+            "range_floor",
+            args.range_floor != 0.0,
+            &[Codec::Jpeg, Codec::Mpeg4],
+        ),
+    ];
+    for (option, set, codecs) in given {
+        if set && !codecs.contains(&codec) {
+            let names: Vec<&str> = codecs.iter().map(|c| c.name()).collect();
+            return Err(Error::option(
+                option,
+                format!(
+                    "applies to the {} codec only, not {}{}; add --codec {} or leave it out",
+                    names.join(" and "),
+                    codec.name(),
+                    if args.codec == CodecChoice::Tdct {
+                        " (the default)"
+                    } else {
+                        ""
+                    },
+                    names[0]
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Parses `auto` or `WIDTHxHEIGHT`.
 pub fn parse_lattice(s: &str) -> Result<Lattice> {
     if s.trim().eq_ignore_ascii_case("auto") {
         return Ok(Lattice::Auto);
     }
     let bad = || {
-        Error::Usage(format!(
-            "--lattice {s}: expected auto or WIDTHxHEIGHT, e.g. 256x256"
-        ))
+        Error::option(
+            "lattice",
+            format!("{s}: expected auto or WIDTHxHEIGHT, e.g. 256x256"),
+        )
     };
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
     Ok(Lattice::Fixed(
@@ -110,19 +160,88 @@ fn check_not_input(input: &str, opts: &ReadOptions, output: &Path) -> Result<()>
     Ok(())
 }
 
-/// Runs `encode`.
+/// Runs `encode`: one stream, or with `--clip all` one stream per glTF clip.
 pub fn run(args: &EncodeArgs, quiet: bool) -> Result<()> {
     let opts = options(args)?;
     let read_options: ReadOptions = (&args.input_args).into();
-    check_not_input(&args.input, &read_options, &args.output)?;
+    let to_stdout = args.output.as_os_str() == "-";
+    if to_stdout && args.json {
+        return Err(Error::option(
+            "json",
+            "cannot share stdout with the stream of -o -; write the stream to a file",
+        ));
+    }
+    if read_options.clip.as_deref() != Some("all") {
+        return encode_one(args, &opts, &read_options, &args.output, quiet);
+    }
+    let clips = mcgv_video::mesh::clips(&args.input, read_options.fps)?;
+    if clips.is_empty() || to_stdout {
+        return Err(Error::option(
+            "clip",
+            "all: needs a glTF input with animations and a file -o (one stream per clip)",
+        ));
+    }
+    for clip in &clips {
+        let name = if clip.name.is_empty() {
+            clip.index.to_string()
+        } else {
+            clip.name.clone()
+        };
+        let output = clip_output(&args.output, &name);
+        let read = ReadOptions {
+            clip: Some(clip.index.to_string()),
+            ..read_options.clone()
+        };
+        encode_one(args, &opts, &read, &output, quiet)?;
+    }
+    Ok(())
+}
+
+/// `fox.mcgv` for clip `Walk` → `fox-Walk.mcgv` (characters a file name cannot hold become `_`).
+fn clip_output(output: &Path, clip: &str) -> PathBuf {
+    let clean: String = clip
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+    let extension = output
+        .extension()
+        .map_or("mcgv".into(), |e| e.to_string_lossy());
+    output.with_file_name(format!("{stem}-{clean}.{extension}"))
+}
+
+/// Encodes one animation to `output` (a file, or stdout for `-`) and reports it.
+fn encode_one(
+    args: &EncodeArgs,
+    opts: &EncodeOptions,
+    read_options: &ReadOptions,
+    output: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let to_stdout = output.as_os_str() == "-";
+    if !to_stdout {
+        check_not_input(&args.input, read_options, output)?;
+    }
     let start = Instant::now();
     let spin = progress::spinner("reading", quiet);
-    let mesh = read_animation(&args.input, &read_options)?;
+    let mesh = super::read_input(&args.input, read_options, quiet);
     spin.finish_and_clear();
+    let mesh = mesh?;
     let pb = progress::bar(mesh.frame_count() as u64, "encode", quiet);
-    let encoded = encoder::encode_with_progress(&mesh, &opts, &progress::Reporter(&pb))?;
+    let encoded = encoder::encode_with_progress(&mesh, opts, &progress::Reporter(&pb))?;
     pb.finish_and_clear();
-    encoded.container.write_atomic(&args.output)?;
+    if to_stdout {
+        write_stdout_bytes(&encoded.to_bytes())?;
+    } else {
+        crate::output::create_parent(output)?;
+        encoded.container.write_atomic(output)?;
+    }
     let seconds = start.elapsed().as_secs_f64();
     let r = &encoded.report;
     if args.json {
@@ -130,25 +249,43 @@ pub fn run(args: &EncodeArgs, quiet: bool) -> Result<()> {
         value["seconds"] = serde_json::json!(seconds);
         value["vertices"] = serde_json::json!(r.header.vertices);
         value["frames"] = serde_json::json!(r.header.frames);
-        println!("{value}");
-    } else if !quiet {
-        println!(
-            "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters by {} in {:.2} s, {} predictor, {} charts), {:.1} s ({:.1} frames/s)",
-            args.output.display(),
-            r.bytes,
-            r.bpvf,
-            r.header.vertices,
-            r.header.frames,
-            r.header.clusters,
-            r.segmentation.method,
-            r.segmentation.seconds,
-            r.header.predictor.name(),
-            r.charts,
-            seconds,
-            r.header.frames as f64 / seconds.max(1e-9)
-        );
+        return outln!("{value}");
     }
-    Ok(())
+    if quiet {
+        return Ok(());
+    }
+    let line = format!(
+        "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters by {} in {:.2} s, {} predictor, {} charts), {:.1} s ({:.1} frames/s)",
+        if to_stdout { "stdout".into() } else { output.display().to_string() },
+        r.bytes,
+        r.bpvf,
+        r.header.vertices,
+        r.header.frames,
+        r.header.clusters,
+        r.segmentation.method,
+        r.segmentation.seconds,
+        r.header.predictor.name(),
+        r.charts,
+        seconds,
+        r.header.frames as f64 / seconds.max(1e-9)
+    );
+    // With `-o -` stdout carries the stream: the report goes to stderr.
+    if to_stdout {
+        eprintln!("{line}");
+        Ok(())
+    } else {
+        outln!("{line}")
+    }
+}
+
+/// The stream's bytes on stdout (a closed pipe is reported like any write to stdout).
+fn write_stdout_bytes(bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(bytes)
+        .and_then(|()| stdout.flush())
+        .map_err(|e| Error::io("stdout", e))
 }
 
 #[cfg(test)]

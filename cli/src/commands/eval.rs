@@ -4,39 +4,72 @@ use crate::args::EvalArgs;
 use crate::progress;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::error::{Error, Result};
-use mcgv_video::mesh::{read_animation, ReadOptions};
+use mcgv_video::first_frame::{self, FirstFrameOptions};
+use mcgv_video::mesh::{AnimatedMesh, ReadOptions};
 use mcgv_video::metrics::{compare, Measures};
 use std::path::Path;
 
 /// Runs `eval`.
 pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     let opts: ReadOptions = (&args.input_args).into();
-    let original = read_animation(&args.original, &opts)?;
+    let original = super::read_input(&args.original, &opts, quiet)?;
     let measures = if is_mcgv(&args.decoded) {
         let options = super::decode::decode_options(args.bands);
-        let mut decoder = Decoder::open_with(Path::new(&args.decoded), &options)?;
+        let path = Path::new(&args.decoded);
+        let mut decoder =
+            Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;
         super::decode::warn_if_truncated(&decoder);
         let bits = decoder.container().file_len() * 8;
         let pb = progress::bar(decoder.header().frames as u64, "decode", quiet);
-        let decoded = decoder.decode_all_with_progress(&crate::progress::Reporter(&pb))?;
+        let decoded = decoder
+            .decode_all_with_progress(&crate::progress::Reporter(&pb))
+            .map_err(|e| super::in_file(path, e))?;
         pb.finish_and_clear();
+        let decoded = match decoder.header().reorder {
+            true => input_order(&original, decoded, decoder.header().first_frame_bits)?,
+            false => decoded,
+        };
         compare(&original, &decoded)?.with_bits(bits)
     } else {
         if args.bands.is_some() {
-            return Err(Error::Usage(
-                "--bands applies to a .mcgv stream of codec tdct".into(),
+            return Err(Error::option(
+                "max_bands",
+                "applies to a .mcgv stream of codec tdct",
             ));
         }
-        compare(&original, &read_animation(&args.decoded, &opts)?)?
+        compare(&original, &super::read_input(&args.decoded, &opts, quiet)?)?
     };
     if args.json {
         let json = serde_json::to_string(&measures)
             .map_err(|e| Error::Usage(format!("cannot write the measures as JSON: {e}")))?;
-        println!("{json}");
+        outln!("{json}")
     } else {
-        print!("{}", report(&measures));
+        out!("{}", report(&measures))
     }
-    Ok(())
+}
+
+/// A stream encoded with `--reorder` holds its vertices in the first-frame coder's traversal
+/// order, and keeps no permutation (that is what saves its bits). The coder is deterministic, so
+/// coding the original's first frame again gives the permutation, and the decoded animation is put
+/// back in the input order: vertex RMSE and KG error then compare each vertex with itself.
+fn input_order(original: &AnimatedMesh, decoded: AnimatedMesh, bits: u8) -> Result<AnimatedMesh> {
+    let options = FirstFrameOptions {
+        bits,
+        reorder: true,
+    };
+    let coded = first_frame::encode(original.frame(0), original.triangles(), &options)?;
+    let Some(permutation) = coded.permutation else {
+        return Ok(decoded);
+    };
+    if permutation.len() != decoded.vertex_count() {
+        return Ok(decoded);
+    }
+    // permutation[new] = old; the decoded mesh is in `new` order, so vertex `old` is at inverse[old].
+    let mut inverse = vec![0u32; permutation.len()];
+    for (new, &old) in permutation.iter().enumerate() {
+        inverse[old as usize] = new as u32;
+    }
+    decoded.permuted(&inverse)
 }
 
 /// Whether a path names a `.mcgv` stream (compared after decoding, with its bpvf).

@@ -2,7 +2,7 @@
 
 use crate::args::InfoArgs;
 use mcgv_video::error::{Error, Result};
-use mcgv_video::mesh::{read_animation, Point, ReadOptions, Summary};
+use mcgv_video::mesh::{clips, Clip, Point, ReadOptions, Summary};
 use std::time::Instant;
 
 /// What `info` reports; the field names are the JSON keys.
@@ -12,32 +12,37 @@ struct Info {
     summary: Summary,
     /// Seconds spent reading the input.
     read_seconds: f64,
+    /// The glTF file's clips (empty for other inputs); the one read is `clip` (default 0).
+    clips: Vec<Clip>,
 }
 
 /// Runs `info`.
 pub fn run(args: &InfoArgs, _quiet: bool) -> Result<()> {
     let start = Instant::now();
-    let mesh = read_animation(&args.input, &ReadOptions::from(&args.input_args))?;
+    let opts = ReadOptions::from(&args.input_args);
+    // `info` lists every clip itself: no note about which one was taken.
+    let mesh = super::read_input(&args.input, &opts, true)?;
     let info = Info {
         summary: Summary::of(&mesh),
         read_seconds: start.elapsed().as_secs_f64(),
+        clips: clips(&args.input, opts.fps)?,
     };
     if args.json {
         let text = serde_json::to_string(&info)
             .map_err(|e| Error::Usage(format!("cannot print JSON: {e}")))?;
-        println!("{text}");
-        return Ok(());
+        return outln!("{text}");
     }
     let read_seconds = info.read_seconds;
+    let clip_lines = clip_lines(&info.clips, opts.clip.as_deref());
     let info = info.summary;
     let r = &info.manifold_report;
     let point = |p: Point| format!("({} {} {})", p[0], p[1], p[2]);
-    println!("{}", args.input);
-    println!("  vertices (V)   {}", info.vertices);
-    println!("  frames (F)     {}", info.frames);
-    println!("  faces          {}", info.faces);
-    println!("  components     {}", info.components);
-    println!(
+    outln!("{}", args.input)?;
+    outln!("  vertices (V)   {}", info.vertices)?;
+    outln!("  frames (F)     {}", info.frames)?;
+    outln!("  faces          {}", info.faces)?;
+    outln!("  components     {}", info.components)?;
+    outln!(
         "  manifold       {} ({} non-manifold edges, {} non-manifold vertices, {} boundary edges, \
          {} degenerate triangles, {} isolated vertices)",
         if info.manifold { "yes" } else { "no" },
@@ -46,18 +51,40 @@ pub fn run(args: &InfoArgs, _quiet: bool) -> Result<()> {
         r.boundary_edges,
         r.degenerate_triangles,
         r.isolated_vertices
-    );
-    println!(
+    )?;
+    outln!(
         "  bounding box   {} – {} (frame 0), diagonal {}",
         point(info.bbox_min),
         point(info.bbox_max),
         info.bbox_diagonal
-    );
-    println!(
+    )?;
+    outln!(
         "  all frames     {} – {}",
         point(info.animation_bbox_min),
         point(info.animation_bbox_max)
-    );
-    println!("  read in        {:.3} s", read_seconds);
-    Ok(())
+    )?;
+    out!("{clip_lines}")?;
+    outln!("  read in        {:.3} s", read_seconds)
+}
+
+/// One line per glTF clip, the one read marked with `*`.
+fn clip_lines(clips: &[Clip], chosen: Option<&str>) -> String {
+    let mut s = String::new();
+    for (i, c) in clips.iter().enumerate() {
+        let read = match chosen {
+            None => i == 0,
+            Some(name) => name == c.name || name == c.index.to_string(),
+        };
+        s.push_str(&format!(
+            "  {:<14} {} `{}`: {} frames at {} fps ({:.2} s){}\n",
+            if i == 0 { "clips" } else { "" },
+            c.index,
+            c.name,
+            c.frames,
+            c.fps,
+            c.seconds,
+            if read { "  * read" } else { "" }
+        ));
+    }
+    s
 }

@@ -1,16 +1,17 @@
 //! `mcgv-video inspect`.
 
+use crate::annotate;
 use crate::args::InspectArgs;
+use mcgv_video::codec::Plane;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::error::{Error, Result};
-use mcgv_video::geometry_image::tile;
-use mcgv_video::mesh::read_animation;
+use mcgv_video::geometry_image::{tile, FrameRanges};
 use mcgv_video::{codec::Codec, stream::header::Header};
 use std::path::Path;
 
 /// Runs `inspect`.
 pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
-    let mut decoder = Decoder::open(&args.input)?;
+    let mut decoder = Decoder::open(&args.input).map_err(|e| super::in_file(&args.input, e))?;
     let header = decoder.header().clone();
     let total = decoder.container().file_len();
     let parts = mcgv_video::inspect::part_bytes(&decoder);
@@ -53,34 +54,37 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "band_bytes": (!bands.is_empty()).then_some(&bands),
             "step": decoder.band_step(),
         });
-        println!("{value}");
-        return Ok(());
+        return outln!("{value}");
     }
-    println!("{}", summary(&header, &args.input));
-    println!(
+    outln!("{}", summary(&header, &args.input))?;
+    outln!(
         "{:<22} {:>12} {:>14} {:>7} {:>8}",
-        "part", "bytes", "bits", "%", "bpvf"
-    );
+        "part",
+        "bytes",
+        "bits",
+        "%",
+        "bpvf"
+    )?;
     for (name, bytes) in &parts {
-        println!(
+        outln!(
             "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
             name,
             bytes,
             bytes * 8,
             100.0 * *bytes as f64 / total as f64,
             *bytes as f64 * 8.0 / vf
-        );
+        )?;
     }
-    println!(
+    outln!(
         "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
         "total",
         total,
         total * 8,
         100.0,
         bpvf
-    );
+    )?;
     if !bands.is_empty() {
-        print!("{}", band_table(&bands, decoder.bands_decoded()));
+        out!("{}", band_table(&bands, decoder.bands_decoded()))?;
     }
     Ok(())
 }
@@ -166,64 +170,29 @@ fn summary(h: &Header, path: &Path) -> String {
     )
 }
 
-/// A distinct, saturated colour per cluster (golden-angle hues).
-pub fn cluster_colour(k: u32) -> [u8; 3] {
-    let h = (k as f32 * 137.507_77) % 360.0;
-    let (s, v) = (0.75f32, 0.95f32);
-    let c = v * s;
-    let x = c * (1.0 - ((h / 60.0) % 2.0 - 1.0).abs());
-    let (r, g, b) = match (h / 60.0) as u32 {
-        0 => (c, x, 0.0),
-        1 => (x, c, 0.0),
-        2 => (0.0, c, x),
-        3 => (0.0, x, c),
-        4 => (x, 0.0, c),
-        _ => (c, 0.0, x),
-    };
-    let m = v - c;
-    [
-        ((r + m) * 255.0) as u8,
-        ((g + m) * 255.0) as u8,
-        ((b + m) * 255.0) as u8,
-    ]
-}
-
-fn save_gray(path: &Path, width: u32, height: u32, data: Vec<u8>) -> Result<()> {
-    let img = image::GrayImage::from_raw(width, height, data)
+/// Writes a residual image (levels, x | y | z side by side) with its panels labelled and a scale
+/// bar in model units from the frame's ranges.
+fn save_residuals(
+    path: &Path,
+    plane: Plane,
+    w: usize,
+    title: &str,
+    ranges: Option<&FrameRanges>,
+) -> Result<()> {
+    let grey = image::GrayImage::from_raw(plane.width, plane.height, plane.data)
         .ok_or_else(|| Error::Usage("image size mismatch".into()))?;
-    img.save(path)
+    annotate::residual_picture(&grey, w as u32, title, ranges)
+        .save(path)
         .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
 }
 
-fn save_levels(path: &Path, images: &[Vec<f32>; 3], w: usize, h: usize) -> Result<()> {
-    let plane = tile::compose([&images[0], &images[1], &images[2]], w, h);
-    save_gray(path, plane.width, plane.height, plane.data)
-}
-
-fn write_pngs<R: std::io::Read + std::io::Seek>(
-    decoder: &mut Decoder<R>,
-    args: &InspectArgs,
-    dir: &Path,
-    quiet: bool,
-) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let header = decoder.header().clone();
+/// The atlas as the decoder sees it, with a legend of the cluster colours.
+fn write_atlas<R: std::io::Read + std::io::Seek>(decoder: &Decoder<R>, path: &Path) -> Result<()> {
+    let header = decoder.header();
     let (w, h) = (
         header.lattice_width as usize,
         header.lattice_height as usize,
     );
-    let frames: Vec<usize> = if args.frames.is_empty() {
-        vec![0]
-    } else {
-        args.frames.clone()
-    };
-    if let Some(&bad) = frames.iter().find(|&&f| f >= header.frames as usize) {
-        return Err(Error::Usage(format!(
-            "--frames {bad}: the stream has frames 0 to {}",
-            header.frames - 1
-        )));
-    }
-
     // The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
     let mut atlas_rgb = vec![0u8; w * h * 3];
     for y in 0..h {
@@ -234,14 +203,28 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
         }
     }
     for (v, &[u, py]) in decoder.vertex_pixels().iter().enumerate() {
-        let c = cluster_colour(decoder.partition().labels()[v]);
+        let c = annotate::cluster_colour(decoder.partition().labels()[v]);
         atlas_rgb[(py as usize * w + u as usize) * 3..][..3].copy_from_slice(&c);
     }
-    let atlas_path = dir.join("atlas.png");
-    image::RgbImage::from_raw(w as u32, h as u32, atlas_rgb)
-        .ok_or_else(|| Error::Usage("atlas image size".into()))?
-        .save(&atlas_path)
-        .map_err(|e| Error::Usage(format!("{}: {e}", atlas_path.display())))?;
+    let atlas = image::RgbImage::from_raw(w as u32, h as u32, atlas_rgb)
+        .ok_or_else(|| Error::Usage("atlas image size".into()))?;
+    let note = "vertex pixels by cluster; grid: 8x8 blocks";
+    annotate::with_legend(&atlas, header.clusters, note)
+        .save(path)
+        .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
+}
+
+fn write_pngs<R: std::io::Read + std::io::Seek>(
+    decoder: &mut Decoder<R>,
+    args: &InspectArgs,
+    dir: &Path,
+    quiet: bool,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let header = decoder.header().clone();
+    let w = header.lattice_width as usize;
+    let frames = selected_frames(args, header.frames)?;
+    write_atlas(decoder, &dir.join("atlas.png"))?;
     crate::render::render_partition_png(
         decoder.reference(),
         decoder.triangles(),
@@ -252,34 +235,66 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
 
     for &f in &frames {
         let plane = decoder.decoded_plane(f)?;
-        save_gray(
+        let ranges = decoder.ranges().get(f).copied();
+        save_residuals(
             &dir.join(format!("frame_{f:04}_decoded.png")),
-            plane.width,
-            plane.height,
-            plane.data,
+            plane,
+            w,
+            &format!("frame {f} decoded residuals"),
+            ranges.as_ref(),
         )?;
     }
 
     if let Some(original) = &args.original {
-        let mesh = read_animation(original, &(&args.input_args).into())?;
-        for images in mcgv_video::inspect::encoder_images(decoder, &mesh, &frames)? {
-            let f = images.frame;
-            save_levels(
-                &dir.join(format!("frame_{f:04}_raw.png")),
-                &images.raw,
-                w,
-                h,
-            )?;
-            save_levels(
-                &dir.join(format!("frame_{f:04}_padded.png")),
-                &images.padded,
-                w,
-                h,
-            )?;
-        }
+        write_encoder_pngs(decoder, args, original, dir, &frames, quiet)?;
     }
     if !quiet {
         eprintln!("images written to {}", dir.display());
+    }
+    Ok(())
+}
+
+/// The frames `--frames` asks for (frame 0 when none), each one the stream has.
+fn selected_frames(args: &InspectArgs, stream_frames: u32) -> Result<Vec<usize>> {
+    let frames: Vec<usize> = if args.frames.is_empty() {
+        vec![0]
+    } else {
+        args.frames.clone()
+    };
+    if let Some(&bad) = frames.iter().find(|&&f| f >= stream_frames as usize) {
+        return Err(Error::Usage(format!(
+            "--frames {bad}: the stream has frames 0 to {}",
+            stream_frames - 1
+        )));
+    }
+    Ok(frames)
+}
+
+/// The residual images the encoder made (raw and padded) for `frames`, redone from `original`.
+fn write_encoder_pngs<R: std::io::Read + std::io::Seek>(
+    decoder: &Decoder<R>,
+    args: &InspectArgs,
+    original: &str,
+    dir: &Path,
+    frames: &[usize],
+    quiet: bool,
+) -> Result<()> {
+    let w = decoder.header().lattice_width as usize;
+    let h = decoder.header().lattice_height as usize;
+    let mesh = super::read_input(original, &(&args.input_args).into(), quiet)?;
+    let ranges = decoder.ranges().to_vec();
+    for images in mcgv_video::inspect::encoder_images(decoder, &mesh, frames)? {
+        let f = images.frame;
+        for (kind, levels) in [("raw", &images.raw), ("padded", &images.padded)] {
+            let plane = tile::compose([&levels[0], &levels[1], &levels[2]], w, h);
+            save_residuals(
+                &dir.join(format!("frame_{f:04}_{kind}.png")),
+                plane,
+                w,
+                &format!("frame {f} {kind} residuals (encoder)"),
+                ranges.get(f),
+            )?;
+        }
     }
     Ok(())
 }

@@ -6,3 +6,54 @@ pub mod encode;
 pub mod eval;
 pub mod info;
 pub mod inspect;
+
+use mcgv_video::error::{Error, Result};
+use mcgv_video::mesh::{clips, read_animation, AnimatedMesh, Clip, ReadOptions};
+use std::path::Path;
+
+/// Reads an animation as every command does; a glTF with several clips read without `--clip` says
+/// on stderr which clip it took and how to pick another (unless `quiet`).
+pub fn read_input(input: &str, opts: &ReadOptions, quiet: bool) -> Result<AnimatedMesh> {
+    if opts.clip.as_deref() == Some("all") {
+        return Err(Error::option(
+            "clip",
+            "all: only `encode` takes every clip (one stream each); name one clip here",
+        ));
+    }
+    let mesh = read_animation(input, opts).map_err(|e| in_file(input, e))?;
+    if opts.clip.is_none() && !quiet {
+        let clips = clips(input, opts.fps).unwrap_or_default();
+        if clips.len() > 1 {
+            eprintln!(
+                "mcgv-video: {input} has {} clips ({}); took clip 0 `{}`. Pick one with --clip \
+                 NAME|INDEX, or encode --clip all for one stream each",
+                clips.len(),
+                clip_list(&clips),
+                clips[0].name,
+            );
+        }
+    }
+    Ok(mesh)
+}
+
+/// `0 Survey (84 frames at 24 fps), 1 Walk (…)`.
+pub fn clip_list(clips: &[Clip]) -> String {
+    clips
+        .iter()
+        .map(|c| {
+            format!(
+                "{} `{}` ({} frames at {} fps)",
+                c.index, c.name, c.frames, c.fps
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A stream error named after its file: `corrupt stream` alone does not say which input it was.
+pub fn in_file(path: impl AsRef<Path>, e: Error) -> Error {
+    match e {
+        Error::Stream(message) => Error::Stream(format!("{}: {message}", path.as_ref().display())),
+        e => e,
+    }
+}

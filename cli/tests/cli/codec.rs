@@ -87,6 +87,8 @@ fn inspect_writes_pngs_a_user_can_open() {
     let sample = media_path("RiggedSimple.glb");
     ok(&run(&[
         "encode",
+        "--codec",
+        "jpeg",
         &sample,
         "-o",
         s,
@@ -147,6 +149,8 @@ fn bad_input_and_outputs_are_clear_errors() {
     let s = stream.to_str().unwrap();
     ok(&run(&[
         "encode",
+        "--codec",
+        "jpeg",
         &media_path("RiggedSimple.glb"),
         "-o",
         s,
@@ -162,7 +166,7 @@ fn bad_input_and_outputs_are_clear_errors() {
         "--frame",
         "9999",
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--frame 9999"));
     // Overwriting the input is refused and the input is untouched.
     let copy = d.join("in.glb");
@@ -170,6 +174,8 @@ fn bad_input_and_outputs_are_clear_errors() {
     let before = std::fs::read(&copy).unwrap();
     let out = run(&[
         "encode",
+        "--codec",
+        "jpeg",
         copy.to_str().unwrap(),
         "-o",
         copy.to_str().unwrap(),
@@ -177,10 +183,13 @@ fn bad_input_and_outputs_are_clear_errors() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("refusing to overwrite"));
     assert_eq!(std::fs::read(&copy).unwrap(), before);
-    // An unwritable output leaves nothing behind.
-    let missing = d.join("no/such/dir/out.mcgv");
+    // An unwritable output (its "folder" is a file) leaves nothing behind.
+    std::fs::write(d.join("afile"), b"x").unwrap();
+    let missing = d.join("afile/out.mcgv");
     let out = run(&[
         "encode",
+        "--codec",
+        "jpeg",
         &media_path("RiggedSimple.glb"),
         "-o",
         missing.to_str().unwrap(),
@@ -191,23 +200,29 @@ fn bad_input_and_outputs_are_clear_errors() {
     // Nonsense options.
     let out = run(&[
         "encode",
+        "--codec",
+        "jpeg",
         &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--lattice",
         "100x100",
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("multiples of 16"));
     let out = run(&[
         "encode",
+        "--codec",
+        "jpeg",
         &media_path("RiggedSimple.glb"),
         "-o",
         s,
         "--padding",
         "magic",
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    // A malformed command line: clap lists the methods.
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("possible values: snap"));
 }
 
 /// `--codec tdct` through the binary: encode, inspect (band table, no PNGs), decode, eval, a
@@ -294,6 +309,8 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
     let jpeg = dir.path().join("fig_jpeg.mcgv");
     let out = run(&[
         "encode",
+        "--codec",
+        "jpeg",
         &sample,
         "-o",
         jpeg.to_str().unwrap(),
@@ -305,6 +322,8 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--step applies to the tdct codec"));
     ok(&run(&[
         "encode",
+        "--codec",
+        "jpeg",
         &sample,
         "-o",
         jpeg.to_str().unwrap(),

@@ -92,6 +92,7 @@ fn a_bad_frame_rate_for_gltf_output_is_named() {
     ]));
     let out_path = dir.path().join("x.glb").display().to_string();
     let out = run(&["decode", &s, "-o", &out_path, "--fps", "0", "--quiet"]);
-    assert_eq!(out.status.code(), Some(1));
+    // A bad value is a usage error.
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("fps"));
 }

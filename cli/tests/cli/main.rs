@@ -6,6 +6,7 @@ mod common;
 mod codec;
 mod convert;
 mod eval;
+mod frictions;
 mod gltf;
 mod info;
 mod outputs;

@@ -25,6 +25,8 @@ fn leftovers(dir: &Path) -> Vec<String> {
 fn encode_frames(frames: &Path, out: &Path) {
     let enc = run(&[
         "encode",
+        "--codec",
+        "jpeg",
         frames.to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
@@ -64,7 +66,9 @@ fn no_input_file_can_be_the_output() {
         (dir, sneaky.to_str().unwrap()),
         (pattern.as_str(), frame1.to_str().unwrap()),
     ] {
-        refused(&run(&["encode", input, "-o", output, "--quiet"]));
+        refused(&run(&[
+            "encode", "--codec", "jpeg", input, "-o", output, "--quiet",
+        ]));
     }
     assert_eq!(std::fs::read(&frame1).unwrap(), before);
     // The base OBJ of a PC2 cache.
@@ -84,6 +88,8 @@ fn no_input_file_can_be_the_output() {
     let base_before = std::fs::read(&base).unwrap();
     refused(&run(&[
         "encode",
+        "--codec",
+        "jpeg",
         pc2.to_str().unwrap(),
         "-o",
         base.to_str().unwrap(),
@@ -105,6 +111,8 @@ fn a_failing_encode_leaves_the_target_as_it_was() {
         }
         let out = run(&[
             "encode",
+            "--codec",
+            "jpeg",
             &media_path("RiggedSimple.glb"),
             "-o",
             target.to_str().unwrap(),

@@ -12,6 +12,8 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
         let s = path.to_str().unwrap();
         ok(&run(&[
             "encode",
+            "--codec",
+            "jpeg",
             &sample,
             "-o",
             s,
@@ -39,6 +41,15 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
         bits[2].is_some_and(|b| bits[1].is_some_and(|full| b < full)),
         "{bits:?}"
     );
-    let bad = run(&["encode", &sample, "-o", "x.mcgv", "--predictor", "bones"]);
+    let bad = run(&[
+        "encode",
+        "--codec",
+        "jpeg",
+        &sample,
+        "-o",
+        "x.mcgv",
+        "--predictor",
+        "bones",
+    ]);
     assert_eq!(bad.status.code(), Some(2));
 }

@@ -7,6 +7,7 @@
 //! every complete band (a coarser animation).
 
 pub mod coefficients;
+pub mod spatial;
 
 use super::StreamLayout;
 use super::{CodecParams, CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
@@ -16,7 +17,9 @@ use crate::mesh::{AnimatedMesh, Point};
 use crate::progress::Progress;
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
 use coefficients::{BandCoder, BandIndex};
+use spatial::Neighbourhood;
 use std::io::{Read, Seek};
+use std::sync::Arc;
 use std::time::Instant;
 
 pub use coefficients::{step_for_quality, DEAD_ZONE};
@@ -50,7 +53,8 @@ impl ResidualEncoder for Encoder {
         let step = step(input.mesh, input.options)?;
         let coefficients = coefficients::forward(input.residuals)?;
         let levels = coefficients::quantise(&coefficients, f64::from(step), DEAD_ZONE)?;
-        let mut coder = BandCoder::new(input.mesh.vertex_count());
+        let neighbourhood = Neighbourhood::new(input.mesh.vertex_count(), input.mesh.triangles())?;
+        let mut coder = BandCoder::new(Arc::new(neighbourhood));
         let chunks = levels
             .iter()
             .enumerate()
@@ -122,7 +126,7 @@ impl Decoder {
         )?;
         let step = index.step;
         let limit = max_bands.unwrap_or(frames).min(frames);
-        let mut coder = BandCoder::new(vertices);
+        let mut coder = BandCoder::new(Arc::new(Neighbourhood::new(vertices, stream.triangles)?));
         let mut decoded = Vec::new();
         for (k, band) in index.bands.iter().enumerate().take(limit) {
             if band.offset + band.len > entry.len {

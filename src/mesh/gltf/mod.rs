@@ -42,6 +42,44 @@ pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Re
     bake(gltf, path.parent(), path, fps, clip)
 }
 
+/// One animation (clip) of a glTF file, as [`read_gltf`] would bake it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Clip {
+    /// Its index in the file (what `ReadOptions::clip` takes besides the name).
+    pub index: usize,
+    /// Its name (empty when it has none).
+    pub name: String,
+    /// Frames baked at `fps`.
+    pub frames: usize,
+    /// The frame rate: the one asked for, else the clip's keyframe rate if plausible, else 30.
+    pub fps: f64,
+    /// Seconds from its first key to its last.
+    pub seconds: f64,
+}
+
+/// The clips of a glTF file with the frames each bakes to at `fps` (default: each clip's own rate).
+pub(crate) fn clips(path: &Path, fps: Option<f64>) -> Result<Vec<Clip>> {
+    let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let gltf::Gltf { document, blob } = validate::from_slice(&bytes, path)?;
+    validate::check_buffer_uris(&document).map_err(fail)?;
+    let buffers = gltf::import_buffers(&document, path.parent(), blob)
+        .map_err(|e| fail(format!("buffer: {e}")))?;
+    let mut clips = Vec::new();
+    for animation in document.animations() {
+        let channels = channels::read_channels(&animation, &buffers).map_err(fail)?;
+        let times = sample::FrameTimes::new(&channels, fps, 1, path)?;
+        clips.push(Clip {
+            index: animation.index(),
+            name: animation.name().unwrap_or("").to_string(),
+            frames: times.frame_count(),
+            fps: times.rate(),
+            seconds: times.seconds(),
+        });
+    }
+    Ok(clips)
+}
+
 /// The glTF file and the buffer files beside it that it refers to (those that can be told without
 /// reading them); an unreadable file is just itself, reading it reports the error.
 pub(crate) fn files(path: &Path) -> Vec<PathBuf> {

@@ -62,6 +62,23 @@ impl FrameTimes {
     }
 }
 
+impl FrameTimes {
+    /// The frame rate the frames are baked at.
+    pub(super) fn rate(&self) -> f64 {
+        self.rate
+    }
+
+    /// Seconds from the first key to the last.
+    pub(super) fn seconds(&self) -> f64 {
+        self.end - self.start
+    }
+
+    /// How many frames the clip bakes to.
+    pub(super) fn frame_count(&self) -> usize {
+        self.count
+    }
+}
+
 impl Iterator for FrameTimes {
     type Item = f64;
 

@@ -23,7 +23,17 @@ pub(super) const NORMALISED: [DataType; 5] = [
 pub(super) fn from_slice(bytes: &[u8], path: &Path) -> Result<gltf::Gltf> {
     let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
     check_glb_header(bytes).map_err(fail)?;
-    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(e.to_string()))?;
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
+        // Neither the GLB magic nor a JSON object: say what the file is not, not where JSON failed.
+        let text = bytes.iter().find(|b| !b.is_ascii_whitespace());
+        if !bytes.starts_with(b"glTF") && text != Some(&b'{') {
+            fail(format!(
+                "not a glTF file (neither a GLB nor glTF JSON: {e})"
+            ))
+        } else {
+            fail(e.to_string())
+        }
+    })?;
     let root = gltf.document.as_json();
     check_attribute_accessors(root).map_err(fail)?;
     check_channel_targets(root).map_err(fail)?;

@@ -1,0 +1,191 @@
+//! Spatial prediction of a band's levels from the neighbours already coded in that band.
+//!
+//! Neighbouring vertices of a soft body move almost alike, so their residual trajectories, and so
+//! their coefficients in one band, are close. The coder visits the vertices in a fixed order both
+//! sides derive from the connectivity (a breadth-first traversal of the first frame's mesh, which the
+//! decoder has before any band) and may predict each level by the rounded mean of the levels of the
+//! vertex's one-ring neighbours visited before it. The prediction is on levels, so it is exact on
+//! both sides (closed loop) and changes bytes only, never the reconstruction.
+
+use crate::error::{Error, Result};
+use crate::mesh::topology::VertexAdjacency;
+use crate::mesh::Triangle;
+use std::collections::VecDeque;
+
+/// How a band's levels are predicted, chosen per band by the encoder (whichever codes smaller) and
+/// written as the first bit of the band's chunk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spatial {
+    /// Every level on its own.
+    None,
+    /// The rounded mean of the vertex's neighbours visited before it (0 without one).
+    Mean,
+}
+
+impl Spatial {
+    /// Both predictors, in the order of their stream bit.
+    pub const ALL: [Spatial; 2] = [Spatial::None, Spatial::Mean];
+
+    /// The stream bit.
+    pub fn bit(self) -> u64 {
+        match self {
+            Spatial::None => 0,
+            Spatial::Mean => 1,
+        }
+    }
+
+    /// The predictor of a stream bit.
+    pub fn from_bit(bit: u64) -> Self {
+        if bit == 0 {
+            Spatial::None
+        } else {
+            Spatial::Mean
+        }
+    }
+}
+
+/// The order in which a band's vertices are coded, and each vertex's neighbours coded before it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Neighbourhood {
+    /// `order[i]`: the vertex coded i-th.
+    order: Vec<u32>,
+    /// `earlier[offsets[i]..offsets[i + 1]]`: the neighbours of `order[i]` coded before it.
+    offsets: Vec<usize>,
+    earlier: Vec<u32>,
+}
+
+impl Neighbourhood {
+    /// `vertices` vertices in index order without neighbours: no spatial prediction possible.
+    pub fn isolated(vertices: usize) -> Self {
+        Self {
+            order: (0..vertices as u32).collect(),
+            offsets: vec![0; vertices + 1],
+            earlier: Vec::new(),
+        }
+    }
+
+    /// The neighbourhood of a connectivity; refuses a triangle that names a vertex out of range.
+    pub fn new(vertices: usize, triangles: &[Triangle]) -> Result<Self> {
+        if let Some(t) = triangles
+            .iter()
+            .find(|t| t.iter().any(|&i| i as usize >= vertices))
+        {
+            return Err(Error::Stream(format!(
+                "triangle {t:?} names a vertex beyond the {vertices} of the mesh"
+            )));
+        }
+        let adjacency = VertexAdjacency::new(vertices, triangles);
+        let order = breadth_first(&adjacency);
+        let mut rank = vec![0u32; vertices];
+        for (i, &v) in order.iter().enumerate() {
+            rank[v as usize] = i as u32;
+        }
+        let mut offsets = Vec::with_capacity(vertices + 1);
+        let mut earlier = Vec::new();
+        offsets.push(0);
+        for (i, &v) in order.iter().enumerate() {
+            let before = adjacency.neighbours(v as usize).iter();
+            earlier.extend(before.filter(|&&w| (rank[w as usize] as usize) < i));
+            offsets.push(earlier.len());
+        }
+        Ok(Self {
+            order,
+            offsets,
+            earlier,
+        })
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.order.len()
+    }
+
+    /// The vertices in coding order, each with its neighbours coded before it.
+    pub fn visit(&self) -> impl Iterator<Item = (usize, &[u32])> {
+        self.order
+            .iter()
+            .zip(self.offsets.windows(2))
+            .map(|(&v, w)| (v as usize, &self.earlier[w[0]..w[1]]))
+    }
+}
+
+/// Vertices in breadth-first order, components in order of their lowest vertex, neighbours in index
+/// order.
+fn breadth_first(adjacency: &VertexAdjacency) -> Vec<u32> {
+    let n = adjacency.vertex_count();
+    let mut seen = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut queue = VecDeque::new();
+    for s in 0..n {
+        if seen[s] {
+            continue;
+        }
+        seen[s] = true;
+        queue.push_back(s as u32);
+        while let Some(v) = queue.pop_front() {
+            order.push(v);
+            for &w in adjacency.neighbours(v as usize) {
+                if !seen[w as usize] {
+                    seen[w as usize] = true;
+                    queue.push_back(w);
+                }
+            }
+        }
+    }
+    order
+}
+
+/// min(|level|, 2) of the largest level of axis `a` among `earlier`: the neighbourhood part of the
+/// coder's context (0 without neighbours).
+pub fn nearby(levels: &[i64], earlier: &[u32], a: usize) -> usize {
+    earlier
+        .iter()
+        .map(|&w| levels[3 * w as usize + a].unsigned_abs().min(2) as usize)
+        .max()
+        .unwrap_or(0)
+}
+
+/// The prediction of axis `a` of a vertex whose earlier neighbours are `earlier`: the mean of their
+/// levels (`levels[3w + a]`) rounded half towards zero, 0 without neighbours.
+pub fn mean(levels: &[i64], earlier: &[u32], a: usize) -> i64 {
+    if earlier.is_empty() {
+        return 0;
+    }
+    // i128: a damaged band's levels are checked only once it is decoded, and may be near ±2^63.
+    let sum: i128 = earlier
+        .iter()
+        .map(|&w| i128::from(levels[3 * w as usize + a]))
+        .sum();
+    let n = earlier.len() as i128;
+    let m = (2 * sum.abs() + n - 1) / (2 * n);
+    (if sum < 0 { -m } else { m }) as i64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn breadth_first_neighbourhood() {
+        // A strip of two triangles: 0-1-2, 1-3-2, plus an isolated vertex 4.
+        let n = Neighbourhood::new(5, &[[0, 1, 2], [1, 3, 2]]).unwrap();
+        let visited: Vec<(usize, Vec<u32>)> = n.visit().map(|(v, e)| (v, e.to_vec())).collect();
+        assert_eq!(
+            visited,
+            vec![
+                (0, vec![]),
+                (1, vec![0]),
+                (2, vec![0, 1]),
+                (3, vec![1, 2]),
+                (4, vec![])
+            ]
+        );
+        assert!(Neighbourhood::new(3, &[[0, 1, 3]]).is_err());
+        let levels = [1, 0, -3, 2, 0, -2, 0, 0, 0];
+        assert_eq!(mean(&levels, &[0, 1], 0), 1);
+        assert_eq!(mean(&levels, &[0, 1], 2), -2);
+        assert_eq!(mean(&levels, &[0, 2], 0), 0);
+        assert_eq!(mean(&levels, &[0, 1, 2], 2), -2);
+        assert_eq!(mean(&levels, &[], 0), 0);
+    }
+}
