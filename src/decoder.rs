@@ -78,7 +78,7 @@ impl<R: Read + Seek> Decoder<R> {
             )));
         }
         let attributes = match reader.has(Tag::ATTRIBUTES) {
-            true => decode_attributes(&reader.part(Tag::ATTRIBUTES)?, &triangles, v)?,
+            true => decode_attributes(&reader.part(Tag::ATTRIBUTES)?, &triangles, &reference)?,
             false => Attributes::default(),
         };
         let labels = side_info::decode_partition(

@@ -17,7 +17,7 @@ fn sorted(t: Triangle) -> Triangle {
 /// The `ATTR` part of `mesh` (already in the decoder's vertex order), whose first frame was coded as
 /// `first_frame` (the `MESH` part's bytes).
 pub(super) fn encode(mesh: &AnimatedMesh, first_frame: &[u8], uv_bits: u8) -> Result<Vec<u8>> {
-    let (decoded, _) = first_frame::decode(first_frame)?;
+    let (decoded, positions) = first_frame::decode(first_frame)?;
     let source = mesh.attributes();
     let mut materials = Vec::new();
     if !source.materials.is_empty() {
@@ -42,5 +42,5 @@ pub(super) fn encode(mesh: &AnimatedMesh, first_frame: &[u8], uv_bits: u8) -> Re
         materials,
         material_names: source.material_names.clone(),
     };
-    encode_attributes(&in_order, &decoded, mesh.vertex_count(), uv_bits)
+    encode_attributes(&in_order, &decoded, &positions, uv_bits)
 }

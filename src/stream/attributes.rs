@@ -1,127 +1,22 @@
 //! The attributes part (`ATTR`): texture coordinates per vertex and the material of each triangle,
 //! coded once for the whole animation, in the decoder's vertex and triangle order.
 //!
-//! Each texture-coordinate set is quantised to `bits` bits over its own bounding box and coded in
-//! the order vertices first appear in the decoded triangles — the first-frame coder's traversal
-//! order — each predicted by a parallelogram across an already-coded edge when there is one, else
-//! the mean of its coded triangle neighbours, else the previous vertex; the residuals go through the
-//! stream's adaptive entropy coder, one context per prediction kind and axis. Materials are one
+//! Each texture-coordinate set is quantised to `bits` bits over its own bounding box and coded by
+//! [`super::texcoords`] (reuse of a welded copy's coordinate, else the 3D triangle projected into
+//! UV) through the stream's adaptive entropy coder. Materials are one
 //! "same as the previous triangle" bit per triangle, and the index when not.
 //! The coding routine is written once for both directions ([`SymbolCoder`]).
 
 use super::bytes::{ByteReader, ByteWriter};
-use super::entropy::{self, BitModel, IntModel, SymbolCoder, UIntModel};
+use super::entropy::{self, BitModel, SymbolCoder, UIntModel};
+use super::texcoords::{code_set, Levels, Schedule};
 use crate::error::{Error, Result};
-use crate::mesh::{Attributes, Triangle};
-use std::collections::HashMap;
+use crate::mesh::{Attributes, Point, Triangle};
 
-const VERSION: u8 = 1;
+const VERSION: u8 = 2;
 /// glTF viewers use a handful of sets; more is a malformed part.
 const MAX_SETS: usize = 8;
 const MAX_NAME: usize = 4096;
-
-/// How one vertex's coordinate is predicted from vertices coded before it.
-#[derive(Clone, Copy)]
-enum Prediction {
-    /// `a + b - c`: the parallelogram across edge `ab` from the triangle with third vertex `c`.
-    Parallelogram(u32, u32, u32),
-    /// The mean of two coded vertices of its triangle.
-    Mean(u32, u32),
-    /// One coded vertex (a neighbour, or the previous vertex coded).
-    One(u32),
-    /// Nothing coded yet: predicted as 0.
-    Zero,
-}
-
-impl Prediction {
-    fn kind(self) -> usize {
-        match self {
-            Prediction::Parallelogram(..) => 0,
-            Prediction::Mean(..) => 1,
-            Prediction::One(_) => 2,
-            Prediction::Zero => 3,
-        }
-    }
-
-    fn value(self, levels: &[[i64; 2]], axis: usize) -> i64 {
-        match self {
-            Prediction::Parallelogram(a, b, c) => {
-                levels[a as usize][axis] + levels[b as usize][axis] - levels[c as usize][axis]
-            }
-            Prediction::Mean(a, b) => (levels[a as usize][axis] + levels[b as usize][axis]) / 2,
-            Prediction::One(a) => levels[a as usize][axis],
-            Prediction::Zero => 0,
-        }
-    }
-}
-
-fn edge_key(a: u32, b: u32) -> u64 {
-    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
-}
-
-/// The coding order of the vertices and each one's prediction: from the triangles alone, so the
-/// encoder and the decoder compute the same.
-fn schedule(triangles: &[Triangle], vertex_count: usize) -> Vec<(u32, Prediction)> {
-    let mut coded = vec![false; vertex_count];
-    let mut third: HashMap<u64, u32> = HashMap::new();
-    let mut order = Vec::with_capacity(vertex_count);
-    let mut previous: Option<u32> = None;
-    for t in triangles {
-        for k in 0..3 {
-            let x = t[k];
-            if coded[x as usize] {
-                continue;
-            }
-            let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
-            let (ca, cb) = (coded[a as usize], coded[b as usize]);
-            let prediction = match third.get(&edge_key(a, b)) {
-                Some(&c) if ca && cb && c != x => Prediction::Parallelogram(a, b, c),
-                _ if ca && cb => Prediction::Mean(a, b),
-                _ if ca => Prediction::One(a),
-                _ if cb => Prediction::One(b),
-                _ => previous.map_or(Prediction::Zero, Prediction::One),
-            };
-            coded[x as usize] = true;
-            order.push((x, prediction));
-            previous = Some(x);
-        }
-        for k in 0..3 {
-            third
-                .entry(edge_key(t[k], t[(k + 1) % 3]))
-                .or_insert(t[(k + 2) % 3]);
-        }
-    }
-    for v in 0..vertex_count as u32 {
-        if !coded[v as usize] {
-            order.push((v, previous.map_or(Prediction::Zero, Prediction::One)));
-            previous = Some(v);
-        }
-    }
-    order
-}
-
-/// Codes (or decodes into) one set of quantised coordinates, `levels` in `0..=max_level`.
-fn code_set<C: SymbolCoder>(
-    coder: &mut C,
-    order: &[(u32, Prediction)],
-    levels: &mut [[i64; 2]],
-    max_level: i64,
-) -> Result<()> {
-    let mut models: [[IntModel; 2]; 4] = Default::default();
-    for &(v, prediction) in order {
-        for axis in 0..2 {
-            let predicted = prediction.value(levels, axis);
-            let residual = levels[v as usize][axis] - predicted;
-            let model = &mut models[prediction.kind()][axis];
-            let value = predicted + coder.signed(residual, model)?;
-            if !(0..=max_level).contains(&value) {
-                return Err(Error::Stream("attributes: coordinate out of range".into()));
-            }
-            levels[v as usize][axis] = value;
-        }
-    }
-    Ok(())
-}
 
 /// Codes (or decodes into) the material of each triangle, indices below `count`.
 fn code_materials<C: SymbolCoder>(coder: &mut C, materials: &mut [u32], count: u32) -> Result<()> {
@@ -141,6 +36,19 @@ fn code_materials<C: SymbolCoder>(coder: &mut C, materials: &mut [u32], count: u
         previous = *m;
     }
     Ok(())
+}
+
+fn check_triangles(triangles: &[Triangle], vertex_count: usize) -> Result<()> {
+    match triangles
+        .iter()
+        .flatten()
+        .any(|&i| i as usize >= vertex_count)
+    {
+        true => Err(Error::Stream(
+            "attributes: a triangle names a missing vertex".into(),
+        )),
+        false => Ok(()),
+    }
 }
 
 /// A coordinate set's quantisation grid: its bounding box on `bits` bits.
@@ -183,6 +91,15 @@ impl Grid {
         })
     }
 
+    fn levels(&self) -> Levels {
+        Levels {
+            step: std::array::from_fn(|a| {
+                (f64::from(self.hi[a]) - f64::from(self.lo[a])) / self.max_level as f64
+            }),
+            max_level: self.max_level,
+        }
+    }
+
     fn dequantise(&self, level: [i64; 2]) -> [f32; 2] {
         std::array::from_fn(|a| {
             let range = f64::from(self.hi[a]) - f64::from(self.lo[a]);
@@ -196,9 +113,10 @@ impl Grid {
 pub fn encode_attributes(
     attributes: &Attributes,
     triangles: &[Triangle],
-    vertex_count: usize,
+    positions: &[Point],
     uv_bits: u8,
 ) -> Result<Vec<u8>> {
+    let vertex_count = positions.len();
     if !(1..=24).contains(&uv_bits) {
         return Err(Error::option(
             "uv_bits",
@@ -206,6 +124,7 @@ pub fn encode_attributes(
         ));
     }
     attributes.check(vertex_count, triangles.len())?;
+    check_triangles(triangles, vertex_count)?;
     if attributes.texcoords.len() > MAX_SETS {
         return Err(Error::Mesh(format!(
             "{} texture coordinate sets; at most {MAX_SETS} are kept",
@@ -214,7 +133,7 @@ pub fn encode_attributes(
     }
     let mut out = ByteWriter::new();
     out.u8(VERSION).u8(attributes.texcoords.len() as u8);
-    let order = schedule(triangles, vertex_count);
+    let schedule = Schedule::new(triangles, positions);
     let mut coder = entropy::Encoder::new();
     for set in &attributes.texcoords {
         let grid = Grid::fit(set, uv_bits);
@@ -224,7 +143,8 @@ pub fn encode_attributes(
             .f32(grid.hi[0])
             .f32(grid.hi[1]);
         let mut levels: Vec<[i64; 2]> = set.iter().map(|&uv| grid.quantise(uv)).collect();
-        code_set(&mut coder, &order, &mut levels, grid.max_level)?;
+        let mesh = (triangles, positions);
+        code_set(&mut coder, &schedule, mesh, &mut levels, &grid.levels())?;
     }
     // Names without per-triangle indices say nothing: they are dropped.
     let names: &[String] = match attributes.materials.is_empty() {
@@ -244,12 +164,14 @@ pub fn encode_attributes(
 }
 
 /// Reads the part written by [`encode_attributes`] for a stream whose decoded first frame has
-/// `triangles` and `vertex_count` vertices.
+/// `triangles` and frame-0 `positions`.
 pub fn decode_attributes(
     bytes: &[u8],
     triangles: &[Triangle],
-    vertex_count: usize,
+    positions: &[Point],
 ) -> Result<Attributes> {
+    let vertex_count = positions.len();
+    check_triangles(triangles, vertex_count)?;
     let mut r = ByteReader::new(bytes, "attributes");
     if r.u8()? != VERSION {
         return Err(Error::Stream("attributes: unknown version".into()));
@@ -286,11 +208,12 @@ pub fn decode_attributes(
     let payload = r.blob()?;
     r.finish()?;
     let mut coder = entropy::Decoder::new(payload)?;
-    let order = schedule(triangles, vertex_count);
+    let schedule = Schedule::new(triangles, positions);
     let mut texcoords = Vec::with_capacity(sets);
     for grid in &grids {
         let mut levels = vec![[0i64; 2]; vertex_count];
-        code_set(&mut coder, &order, &mut levels, grid.max_level)?;
+        let mesh = (triangles, positions);
+        code_set(&mut coder, &schedule, mesh, &mut levels, &grid.levels())?;
         texcoords.push(levels.into_iter().map(|l| grid.dequantise(l)).collect());
     }
     let mut materials = Vec::new();

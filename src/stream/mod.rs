@@ -9,3 +9,4 @@ pub mod entropy;
 pub mod frame_index;
 pub mod header;
 pub mod side_info;
+mod texcoords;
