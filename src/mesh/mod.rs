@@ -17,8 +17,8 @@ pub use attributes::Attributes;
 pub use gltf::Clip;
 pub use gltf_write::{write_gltf, GltfOptions};
 pub use io::{
-    clips, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_sequence,
-    write_pc2, ReadOptions,
+    clips, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_mesh_frame,
+    write_obj_sequence, write_pc2, ReadOptions,
 };
 pub use summary::Summary;
 

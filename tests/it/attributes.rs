@@ -2,8 +2,10 @@
 //! step, material groups exactly, whatever order the first-frame coder puts triangles in.
 
 use crate::common::{decode_all, encode_bytes, read_media};
+use mcgv_video::mesh::{parse_obj, write_obj_sequence};
 use mcgv_video::stream::attributes::{decode_attributes, encode_attributes};
-use mcgv_video::{AnimatedMesh, Attributes, Codec, EncodeOptions};
+use mcgv_video::{read_animation, AnimatedMesh, Attributes, Codec, EncodeOptions, ReadOptions};
+use std::path::Path;
 
 /// Largest UV error over every set, in units of the set's quantisation step at `bits`.
 fn uv_error_in_steps(source: &Attributes, back: &Attributes, order: &[u32], bits: u8) -> f64 {
@@ -128,4 +130,52 @@ fn inputs_without_attributes_get_no_part_and_a_corrupt_part_is_an_error() {
     for cut in [1, part.len() / 2, part.len() - 1] {
         assert!(decode_attributes(&part[..cut], triangles, positions).is_err());
     }
+}
+
+#[test]
+fn obj_frames_carry_vt_and_usemtl_there_and_back() {
+    let mesh = read_media("CesiumMan.glb");
+    let (triangles, frames) = mesh.clone().into_parts();
+    let two = AnimatedMesh::new(triangles, frames[..2].to_vec())
+        .unwrap()
+        .with_attributes(mesh.attributes().clone())
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    write_obj_sequence(&two, dir.path()).unwrap();
+    let back = read_animation(&dir.path().display().to_string(), &ReadOptions::default()).unwrap();
+    let (a, b) = (mesh.attributes(), back.attributes());
+    assert_eq!(b.materials, a.materials);
+    assert_eq!(b.material_names, a.material_names);
+    assert_eq!(b.texcoords.len(), 1);
+    // `vt` stores 1 - v (OBJ's v points up): one f32 rounding each way.
+    for (p, q) in a.texcoords[0].iter().zip(&b.texcoords[0]) {
+        assert!(
+            (p[0] - q[0]).abs() <= 1e-6 && (p[1] - q[1]).abs() <= 1e-6,
+            "{p:?} {q:?}"
+        );
+    }
+}
+
+#[test]
+fn obj_vt_is_kept_only_when_each_vertex_has_one() {
+    let name = Path::new("t.obj");
+    let quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+    let one = parse_obj(
+        &format!("{quad}usemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 3/3 4/4\n"),
+        name,
+    );
+    let one = one.unwrap();
+    let a = one.attributes();
+    assert_eq!(
+        a.texcoords,
+        vec![vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]]
+    );
+    assert_eq!(
+        (a.materials.clone(), a.material_names.clone()),
+        (vec![0, 1], vec!["a".into(), "b".into()])
+    );
+    // Vertex 1 with two coordinates (a seam the file does not split): no UVs rather than wrong ones.
+    let seam = parse_obj(&format!("{quad}f 1/1 2/2 3/3\nf 1/2 3/3 4/4\n"), name).unwrap();
+    assert!(seam.attributes().texcoords.is_empty());
+    assert!(seam.attributes().is_empty());
 }
