@@ -222,6 +222,10 @@ pub struct DecodeArgs {
     /// glTF output: frames per second of the animation (the stream does not record the source's).
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// glTF output: copy the materials, textures and node name of this glTF file (the encoded
+    /// source), so the decoded asset renders as the source did.
+    #[arg(long, value_name = "SOURCE.glb")]
+    pub like: Option<PathBuf>,
     /// Decode only this frame (numbered from 0).
     #[arg(long)]
     pub frame: Option<usize>,

@@ -126,9 +126,7 @@ impl Geometry {
         used.sort();
         used.dedup();
         let name = |m: &Option<usize>| match m.and_then(|i| document.materials().nth(i)) {
-            Some(material) => material
-                .name()
-                .map_or_else(|| format!("material_{}", m.unwrap_or(0)), str::to_string),
+            Some(material) => super::material_name(&material),
             None => "default".to_string(),
         };
         let materials = self
