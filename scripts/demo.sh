@@ -33,8 +33,9 @@ for run in default mpeg4 jpeg; do
 done
 echo "(* the default codec)"
 glb="$out/$(basename "${sample%.*}")-decoded.glb"
-"$bin" decode "$out/sample-tdct.mcgv" -o "$glb" --quiet
+like=(); case $sample in *.glb | *.gltf) like=(--like "$sample") ;; esac
+"$bin" decode "$out/sample-default.mcgv" -o "$glb" "${like[@]}" --quiet
 echo
 echo "streams and decoded OBJ frames are in $out/; look inside with: $bin inspect $out/sample-jpeg.mcgv --png $out/png"
-echo "the tdct stream decoded to glTF (morph targets, UVs): $glb; drop it on https://gltf-viewer.donmccurdy.com/"
+echo "the default stream decoded to glTF (morph targets, UVs, the source's materials): $glb; drop it on https://gltf-viewer.donmccurdy.com/"
 echo "or open it in Blender (File > Import > glTF 2.0) and play the timeline"
