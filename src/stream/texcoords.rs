@@ -55,26 +55,75 @@ fn weld(positions: &[Point]) -> (Vec<u32>, usize) {
     (weld, ids.len())
 }
 
+/// Triangles waiting to be walked into: (triangle, the corner opposite the edge it is entered
+/// through). `sure` ones share the input's vertices on that edge (no seam), `welded` ones only
+/// positions.
+#[derive(Default)]
+struct Gates {
+    sure: Vec<(u32, u8)>,
+    welded: Vec<(u32, u8)>,
+}
+
+/// The walk's view of the mesh: triangles, welded ids and the triangles on each welded edge.
+struct Walk<'a> {
+    triangles: &'a [Triangle],
+    weld: &'a [u32],
+    by_edge: HashMap<u64, Vec<u32>>,
+}
+
+impl Walk<'_> {
+    fn welded_edge(&self, a: u32, b: u32) -> u64 {
+        edge_key(self.weld[a as usize], self.weld[b as usize])
+    }
+
+    /// Queues the not yet visited triangles across each edge of triangle `t`.
+    fn open_gates(&self, t: u32, visited: &[bool], gates: &mut Gates) {
+        let tri = self.triangles[t as usize];
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let key = self.welded_edge(a, b);
+            for &n in self.by_edge.get(&key).map_or(&[][..], Vec::as_slice) {
+                if visited[n as usize] {
+                    continue;
+                }
+                let other = self.triangles[n as usize];
+                let opposite = (0..3)
+                    .find(|&c| self.welded_edge(other[(c + 1) % 3], other[(c + 2) % 3]) == key);
+                let Some(c) = opposite else { continue };
+                let shares = other.contains(&a) && other.contains(&b);
+                let list = if shares {
+                    &mut gates.sure
+                } else {
+                    &mut gates.welded
+                };
+                list.push((n, c as u8));
+            }
+        }
+    }
+}
+
 impl Schedule {
     /// The walk over `triangles` (vertex indices below `positions.len()`, checked by the caller).
     pub(super) fn new(triangles: &[Triangle], positions: &[Point]) -> Self {
         let (weld, welded_count) = weld(positions);
-        let mut by_edge: HashMap<u64, Vec<u32>> = HashMap::new();
+        let mut walk = Walk {
+            triangles,
+            weld: &weld,
+            by_edge: HashMap::new(),
+        };
         for (t, tri) in triangles.iter().enumerate() {
             for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let key = edge_key(weld[a as usize], weld[b as usize]);
-                by_edge.entry(key).or_default().push(t as u32);
+                let key = walk.welded_edge(tri[k], tri[(k + 1) % 3]);
+                walk.by_edge.entry(key).or_default().push(t as u32);
             }
         }
         let mut visited = vec![false; triangles.len()];
         let mut coded = vec![false; positions.len()];
         let mut steps = Vec::with_capacity(positions.len());
-        // Gates: (triangle, the corner opposite the edge it is entered through).
-        let (mut sure, mut welded): (Vec<(u32, u8)>, Vec<(u32, u8)>) = (Vec::new(), Vec::new());
+        let mut gates = Gates::default();
         let mut seed = 0usize;
         loop {
-            let gate = match sure.pop().or_else(|| welded.pop()) {
+            let (t, opposite) = match gates.sure.pop().or_else(|| gates.welded.pop()) {
                 Some(g) => g,
                 None => match (seed..triangles.len()).find(|&t| !visited[t]) {
                     Some(t) => {
@@ -84,49 +133,27 @@ impl Schedule {
                     None => break,
                 },
             };
-            let (t, opposite) = gate;
             if std::mem::replace(&mut visited[t as usize], true) {
                 continue;
             }
             let tri = triangles[t as usize];
             for j in 1..=3 {
                 let k = (opposite as usize + j) % 3;
-                let v = tri[k] as usize;
-                if !std::mem::replace(&mut coded[v], true) {
+                if !std::mem::replace(&mut coded[tri[k] as usize], true) {
                     steps.push(Step {
                         vertex: tri[k],
                         corner: Some((t, k as u8)),
                     });
                 }
             }
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let key = edge_key(weld[a as usize], weld[b as usize]);
-                for &n in by_edge.get(&key).map_or(&[][..], Vec::as_slice) {
-                    if visited[n as usize] {
-                        continue;
-                    }
-                    let other = triangles[n as usize];
-                    let Some(c) = (0..3).find(|&c| {
-                        let (x, y) = (other[(c + 1) % 3], other[(c + 2) % 3]);
-                        edge_key(weld[x as usize], weld[y as usize]) == key
-                    }) else {
-                        continue;
-                    };
-                    let shares = other.contains(&a) && other.contains(&b);
-                    let list = if shares { &mut sure } else { &mut welded };
-                    list.push((n, c as u8));
-                }
-            }
+            walk.open_gates(t, &visited, &mut gates);
         }
-        for v in 0..positions.len() {
-            if !coded[v] {
-                steps.push(Step {
-                    vertex: v as u32,
-                    corner: None,
-                });
-            }
-        }
+        drop(walk);
+        let isolated = coded.iter().enumerate().filter(|(_, &c)| !c);
+        steps.extend(isolated.map(|(v, _)| Step {
+            vertex: v as u32,
+            corner: None,
+        }));
         Self {
             steps,
             weld,
@@ -145,7 +172,8 @@ pub(super) struct Levels {
 /// Adaptive contexts of one coordinate set.
 #[derive(Default)]
 struct Models {
-    reuse: [BitModel; 2],
+    /// "Reuses a coded copy?", by the previous answer and whether there are several copies.
+    reuse: [[BitModel; 2]; 2],
     candidate: UIntModel,
     side: BitModel,
     /// Residuals per prediction kind (projection, one corner, previous vertex) and axis.
@@ -279,7 +307,9 @@ pub(super) fn code_set<C: SymbolCoder>(
             let mut candidates = here.clone();
             candidates.sort_by_key(|&c| distance(c, prediction.value));
             let found = candidates.iter().position(|&c| c == levels[v]);
-            let reuse = coder.bit(found.is_some(), &mut models.reuse[usize::from(last_reuse)])?;
+            let context =
+                &mut models.reuse[usize::from(last_reuse)][usize::from(candidates.len() > 1)];
+            let reuse = coder.bit(found.is_some(), context)?;
             last_reuse = reuse;
             if reuse {
                 let index = coder.unsigned(found.unwrap_or(0) as u64, &mut models.candidate)?;
