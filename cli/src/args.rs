@@ -229,12 +229,33 @@ pub struct DecodeArgs {
     /// Decode only this frame (numbered from 0).
     #[arg(long)]
     pub frame: Option<usize>,
+    /// Decode only frames A to B - 1 (numbered from 0; `10..20` is ten frames): a part of a long
+    /// clip, e.g. as glTF with fewer morph targets. OBJ frames keep their numbers.
+    #[arg(long, value_name = "A..B", conflicts_with = "frame", value_parser = parse_frame_range)]
+    pub frames: Option<std::ops::Range<usize>>,
     /// Decode into a folder that already holds files, removing the frame_*.obj of an earlier decode.
     #[arg(long, short = 'y')]
     pub force: bool,
     /// tdct streams: decode only the first N temporal-DCT bands (a coarser, progressive preview).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub bands: Option<u64>,
+}
+
+/// `A..B` with A < B, for `decode --frames`.
+fn parse_frame_range(text: &str) -> std::result::Result<std::ops::Range<usize>, String> {
+    let (a, b) = text
+        .split_once("..")
+        .ok_or_else(|| format!("{text}: expected A..B, e.g. 0..24"))?;
+    let number = |t: &str| {
+        t.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("{text}: `{t}` is not a frame number"))
+    };
+    let (a, b) = (number(a)?, number(b)?);
+    if a >= b {
+        return Err(format!("{text}: the range is empty (A must be below B)"));
+    }
+    Ok(a..b)
 }
 
 /// `inspect` arguments.

@@ -79,7 +79,8 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
         }
         OutputKind::ObjFolder => {
             prepare_frame_folder(&args.output, args.force)?;
-            write_obj_sequence_from(&mesh, &args.output, args.frame.unwrap_or(0))?;
+            let first = args.frame.or(args.frames.as_ref().map(|r| r.start));
+            write_obj_sequence_from(&mesh, &args.output, first.unwrap_or(0))?;
         }
         OutputKind::Gltf => {
             create_parent(&args.output)?;
@@ -123,6 +124,20 @@ fn decode_mesh(
             }
             let positions = decoder.decode_frame(f)?;
             AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
+                .with_attributes(decoder.attributes().clone())
+        }
+        None if args.frames.is_some() => {
+            let range = args.frames.clone().unwrap_or(0..frames);
+            if range.end > frames {
+                return Err(Error::option(
+                    "frames",
+                    format!("{range:?}: the stream has frames 0 to {}", frames - 1),
+                ));
+            }
+            let positions = range
+                .map(|f| decoder.decode_frame(f))
+                .collect::<Result<Vec<_>>>()?;
+            AnimatedMesh::new(decoder.triangles().to_vec(), positions)?
                 .with_attributes(decoder.attributes().clone())
         }
         None => {

@@ -155,3 +155,45 @@ fn decode_like_the_source_copies_its_materials_textures_and_node_name() {
     let out = run(&[&["decode", &stream, "-o", &obj, "--frame", "0"][..], &like].concat());
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn decode_frames_a_to_b_keeps_their_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = media_path("RiggedSimple.glb");
+    let stream = dir.path().join("s.mcgv").display().to_string();
+    ok(&run(&["encode", &input, "-o", &stream, "--quiet"]));
+    let folder = dir.path().join("frames");
+    let out = folder.display().to_string() + "/";
+    ok(&run(&[
+        "decode", &stream, "-o", &out, "--frames", "2..5", "--quiet",
+    ]));
+    let mut names: Vec<String> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_0002.obj", "frame_0003.obj", "frame_0004.obj"]
+    );
+    let glb = dir.path().join("part.glb");
+    ok(&run(&[
+        "decode",
+        &stream,
+        "-o",
+        &glb.display().to_string(),
+        "--frames",
+        "2..5",
+        "--quiet",
+    ]));
+    // Three frames: the base and two morph targets.
+    let json = glb_json(&glb);
+    assert_eq!(
+        json["meshes"][0]["weights"].as_array().map(Vec::len),
+        Some(2)
+    );
+    for bad in ["5..2", "0..100000", "x..3"] {
+        let out = run(&["decode", &stream, "-o", &out, "--frames", bad, "--force"]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+    }
+}
