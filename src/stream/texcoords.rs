@@ -22,6 +22,9 @@ use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
 use std::collections::HashMap;
 
+/// Distinct coordinates remembered per welded position (real meshes have a handful).
+const MAX_COPIES: usize = 16;
+
 /// One vertex to code: the vertex, and the triangle and corner it is reached through (`None` for
 /// vertices in no triangle).
 #[derive(Clone, Copy)]
@@ -344,7 +347,8 @@ pub(super) fn code_set<C: SymbolCoder>(
             }
         };
         levels[v] = value;
-        if !here.contains(&value) {
+        // A bounded list keeps a hostile stream (every vertex at one position) linear.
+        if here.len() < MAX_COPIES && !here.contains(&value) {
             here.push(value);
         }
         coded[v] = true;
