@@ -114,10 +114,13 @@
 
 mod atlas;
 mod build;
+mod charts;
+mod cut;
 mod error;
 mod input;
 mod lattice;
 mod layout;
+mod open;
 mod options;
 mod ownership;
 mod pack;
@@ -126,7 +129,10 @@ mod raster;
 mod scale;
 mod seed;
 mod stretch;
+mod topology;
 mod unwrap;
+mod weld;
+mod whole;
 
 pub use atlas::{sample, Atlas, AtlasStats, Chart, Occupancy};
 pub use build::build;
