@@ -26,7 +26,11 @@ pub fn build(
 ) -> Result<Atlas, AtlasError> {
     let start = Instant::now();
     check_input(positions, triangles, partition, opts)?;
-    let welded = welded(positions, triangles);
+    let welded = if opts.weld {
+        welded(positions, triangles)
+    } else {
+        triangles.to_vec()
+    };
     let seeds = seeds(triangles, &welded, partition);
     let flat = flatten_seeds(positions, &welded, &seeds, opts)?;
     let (charts, absorbed) =
