@@ -107,16 +107,16 @@
 //! `mcgv-video inspect s.mcgv --json` (`charts`, `packing_efficiency`); snake
 //! and torus are generated OBJ sequences (a closed bending tube of 24 × 180
 //! quads with capped ends, 40 frames; a 96 × 32 torus whose cross-section
-//! breathes), before → after whole-piece charts (glTF rows: → with
-//! [`AtlasOptions::weld`]; without it they stay near the before figures):
+//! breathes), before → after whole-piece charts (glTF rows: after, then with
+//! [`AtlasOptions::weld`]):
 //!
 //! | mesh | V | charts | packing |
 //! |---|---|---|---|
 //! | snake (generated) | 4322 | 41 → 23 | 58.8% → 57.9% |
 //! | torus (generated) | 3072 | 41 → 22 | 49.6% → 45.3% |
-//! | CesiumMan | 3273 | 327 → 44 | 41.6% → 52.7% |
-//! | Fox | 1728 | 576 → 109 | 15.2% → 42.0% |
-//! | RiggedFigure | 370 | 87 → 43 | 31.9% → 46.1% |
+//! | CesiumMan | 3273 | 327 → 341; 44 | 41.6% → 39.3%; 52.7% |
+//! | Fox | 1728 | 576 → 576; 109 | 15.2% → 15.2%; 42.0% |
+//! | RiggedFigure | 370 | 87 → 87; 43 | 31.9% → 32.0%; 46.1% |
 //! | pdance | 7061 | 73 → 69 | 51.3% → 51.1% |
 //! | pcow | 2904 | 61 → 55 | 47.2% → 50.5% |
 //! | chickenCrossing | 3030 | 98 → 116 | 46.8% → 50.9% |
