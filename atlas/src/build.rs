@@ -3,6 +3,7 @@
 //! charts pack, write them into the lattice, sum up the figures. Each stage lives in its own file.
 
 use crate::atlas::{Atlas, AtlasStats};
+use crate::charts::flatten;
 use crate::input::check_input;
 use crate::lattice::Lattice;
 use crate::layout::{layouts, ChartLayout};
@@ -10,7 +11,8 @@ use crate::ownership::{absorb_small_charts, assign_owners};
 use crate::scale::best_scale;
 use crate::seed::{seeds, Seeds};
 use crate::stretch::StretchSum;
-use crate::unwrap::{flatten, Flattening};
+use crate::unwrap::Flattening;
+use crate::weld::welded;
 use crate::{AtlasError, AtlasOptions};
 use std::time::Instant;
 
@@ -24,8 +26,13 @@ pub fn build(
 ) -> Result<Atlas, AtlasError> {
     let start = Instant::now();
     check_input(positions, triangles, partition, opts)?;
-    let seeds = seeds(triangles, partition);
-    let flat = flatten_seeds(positions, triangles, &seeds, opts)?;
+    let welded = if opts.weld {
+        welded(positions, triangles)
+    } else {
+        triangles.to_vec()
+    };
+    let seeds = seeds(triangles, &welded, partition);
+    let flat = flatten_seeds(positions, &welded, &seeds, opts)?;
     let (charts, absorbed) =
         owned_layouts(triangles, partition, &seeds, &flat, positions.len(), opts);
     let (scale, shapes, placements) = best_scale(&charts, opts)?;
@@ -54,7 +61,8 @@ pub fn build(
     })
 }
 
-/// Steps 1–2: the seed pieces flattened into charts (none for a mesh without faces).
+/// Steps 1–2: the seed pieces flattened into charts (none for a mesh without faces), on the
+/// welded triangles.
 fn flatten_seeds(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
@@ -74,6 +82,7 @@ fn flatten_seeds(
         positions,
         triangles,
         &seeds.face_piece,
+        seeds.pieces,
         opts.max_stretch,
         opts.max_split_rounds,
     )

@@ -23,24 +23,36 @@
 //! 1. **Seeds.** Each face takes the majority cluster of its three corners
 //!    (the first corner's when all three differ); the faces of one cluster are
 //!    split into pieces connected through shared edges, so multi-component
-//!    meshes (the 41-part "Chicken") and non-manifold edges are fine.
-//! 2. **Charts.** The pieces are flattened with [`uvunwrap`] 0.3, each piece
-//!    passed as a face material so that no chart crosses it; inside a piece
-//!    uvunwrap may cut further (normal cone, area distortion) and flattens each
-//!    chart by LSCM + ARAP. Then, as iso-charts does, every chart whose
-//!    normalised L2 stretch (Sander et al. 2001; 1 is isometric) exceeds
-//!    [`AtlasOptions::max_stretch`] is cut in two across the principal axis of
-//!    its face centroids and everything is flattened again, for at most
-//!    [`AtlasOptions::max_split_rounds`] rounds. (On the real sequences
-//!    uvunwrap's charts already stay below 1.15, so the default 1.25 rarely cuts.)
+//!    meshes (the 41-part "Chicken") and non-manifold edges are fine. With
+//!    [`AtlasOptions::weld`], charting runs on the triangles with vertices at
+//!    bit-identical positions welded, so that glTF meshes split at UV seams
+//!    (CesiumMan) or not indexed (Fox, 576 loose triangles) do not make every
+//!    seam a chart border and every loose triangle a chart; off by default
+//!    (see the option for why).
+//! 2. **Charts.** A piece that is a disk, or a genus-0 piece with several
+//!    boundary loops once shortest paths join the loops (a band around a tube
+//!    is an annulus: one cut), is flattened whole, as one chart, by [`uvunwrap`]
+//!    0.3 (the piece passed as one polygon, the cut opened by duplicating its
+//!    vertices). Closed pieces and pieces of higher genus are first split
+//!    across their principal axis (twice at most). Pieces whose whole flattening
+//!    fails, and the rest, are flattened as before: each piece a face material,
+//!    so that no chart crosses it, and inside a piece uvunwrap may cut further
+//!    (normal cone, area distortion); it flattens each chart by LSCM + ARAP.
+//!    Then, as iso-charts does, every chart whose normalised L2 stretch
+//!    (Sander et al. 2001; 1 is isometric) exceeds [`AtlasOptions::max_stretch`]
+//!    is cut in two across the principal axis of its face centroids and
+//!    everything is flattened again, for at most
+//!    [`AtlasOptions::max_split_rounds`] rounds.
 //!
 //!    *Why uvunwrap:* pure Rust, builds here, takes per-face chart hints;
 //!    `xatlas-rs` 0.1.3 does not link on Linux (its bindings carry Windows
 //!    symbol names). uvunwrap's own packing is not used: its charts are
-//!    rescaled to surface units and packed below. Passing each seed as one
-//!    uvunwrap "polygon" (one chart per seed) was tried and rejected: seeds
-//!    that cannot be flattened whole are then shredded into hundreds of
-//!    slivers (dance: 247 charts, 11% packing, 5905 moved vertices).
+//!    rescaled to surface units and packed below. Left to its segmentation,
+//!    uvunwrap grows charts within a normal cone, so a tube band came back in
+//!    several charts, and a band passed whole (an annulus cannot be flattened)
+//!    was shredded into slivers: a skinned snake made 414 charts for 20
+//!    clusters. A generated snake (4322 vertices, K = 20) now has 23 charts
+//!    (41 before), a torus 22 (41); see the measured table below.
 //! 3. **Vertex ownership.** A vertex shared by several charts is owned by one:
 //!    among the charts with a face on it, the one with most faces among those
 //!    whose face is in the vertex's own cluster, else the one with most faces
@@ -90,6 +102,33 @@
 //! --jpeg bench-out/media/pdance` (and the other folders; the OBJ sequences
 //! as `make bench` unpacks them from `../shared/media`).
 //!
+//! # Charts and packing in the encoder (motion k-means, K = 20, auto lattice)
+//! `mcgv-video encode IN -o s.mcgv --codec jpeg --quality 50 --quiet` then
+//! `mcgv-video inspect s.mcgv --json` (`charts`, `packing_efficiency`); snake
+//! and torus are generated OBJ sequences (a closed bending tube of 24 × 180
+//! quads with capped ends, 40 frames; a 96 × 32 torus whose cross-section
+//! breathes), before → after whole-piece charts (glTF rows: after, then with
+//! [`AtlasOptions::weld`]):
+//!
+//! | mesh | V | charts | packing |
+//! |---|---|---|---|
+//! | snake (generated) | 4322 | 41 → 23 | 58.8% → 57.9% |
+//! | torus (generated) | 3072 | 41 → 22 | 49.6% → 45.3% |
+//! | CesiumMan | 3273 | 327 → 341; 44 | 41.6% → 39.3%; 52.7% |
+//! | Fox | 1728 | 576 → 576; 109 | 15.2% → 15.2%; 42.0% |
+//! | RiggedFigure | 370 | 87 → 87; 43 | 31.9% → 32.0%; 46.1% |
+//! | pdance | 7061 | 73 → 69 | 51.3% → 51.1% |
+//! | pcow | 2904 | 61 → 55 | 47.2% → 50.5% |
+//! | chickenCrossing | 3030 | 98 → 116 | 46.8% → 50.9% |
+//! | horse-gallop | 8431 | 106 → 93 | 48.5% → 49.8% |
+//!
+//! Long unrolled bands pack no better than the pieces they replace: the
+//! packer places bounding frames on the block grid, and a slanted band
+//! leaves empty blocks in its frame.
+//!
+//! The table below was measured before those changes, with the measuring
+//! example's stand-in partition.
+//!
 //! # Measured (256×256, K = 20 k-means partition, release build)
 //! `cargo run --release -p atlas --example measure -- bench-out/media/pdance ...`
 //!
@@ -114,10 +153,13 @@
 
 mod atlas;
 mod build;
+mod charts;
+mod cut;
 mod error;
 mod input;
 mod lattice;
 mod layout;
+mod open;
 mod options;
 mod ownership;
 mod pack;
@@ -126,7 +168,10 @@ mod raster;
 mod scale;
 mod seed;
 mod stretch;
+mod topology;
 mod unwrap;
+mod weld;
+mod whole;
 
 pub use atlas::{sample, Atlas, AtlasStats, Chart, Occupancy};
 pub use build::build;

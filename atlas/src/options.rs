@@ -30,6 +30,12 @@ pub struct AtlasOptions {
     pub min_chart_vertices: usize,
     /// Rounds of stretch-driven splitting at most.
     pub max_split_rounds: u32,
+    /// Grow and flatten charts on the mesh with vertices at bit-identical positions welded (glTF
+    /// meshes split at UV seams, or not indexed). Off by default: measured at JPEG quality 50,
+    /// CesiumMan went from 327 to 41 charts and 21.1 bpvf / RMSE 2.57e-4 to 21.5 / 1.77e-4, but
+    /// Fox (576 loose triangles) from 27.2 / 2.69e-5 to 23.5 / 3.71e-5, worse at equal rate, and
+    /// RiggedSimple's error rose 2.6×: the copies of a position are coded apart and crack apart.
+    pub weld: bool,
 }
 
 impl Default for AtlasOptions {
@@ -42,6 +48,7 @@ impl Default for AtlasOptions {
             interior: Interior::Rasterised,
             max_split_rounds: 3,
             min_chart_vertices: 8,
+            weld: false,
         }
     }
 }

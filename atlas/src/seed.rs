@@ -46,13 +46,25 @@ impl Dsu {
     }
 }
 
-/// Splits the clusters into pieces connected through edges. Edges shared by
-/// more than two faces (non-manifold) join every face of the same cluster on them.
-pub(crate) fn seeds(triangles: &[[u32; 3]], partition: &[u32]) -> Seeds {
+/// Splits the clusters (faces voting with their corners' clusters in `partition`) into pieces
+/// connected through the edges of `welded`, the same triangles on welded vertex ids.
+pub(crate) fn seeds(triangles: &[[u32; 3]], welded: &[[u32; 3]], partition: &[u32]) -> Seeds {
     let face_cluster: Vec<u32> = triangles
         .iter()
         .map(|t| face_cluster(t, partition))
         .collect();
+    let (face_piece, pieces) = components(welded, &face_cluster);
+    Seeds {
+        face_cluster,
+        face_piece,
+        pieces,
+    }
+}
+
+/// The faces that share a label, split into pieces connected through edges: a dense piece id per
+/// face and the number of pieces. Edges shared by more than two faces (non-manifold) join every
+/// face of the same label on them.
+pub(crate) fn components(triangles: &[[u32; 3]], face_label: &[u32]) -> (Vec<u32>, u32) {
     let mut dsu = Dsu::new(triangles.len());
     let mut first_on_edge: HashMap<(u32, u32, u32), u32> = HashMap::new();
     for (f, tri) in triangles.iter().enumerate() {
@@ -61,7 +73,7 @@ pub(crate) fn seeds(triangles: &[[u32; 3]], partition: &[u32]) -> Seeds {
             if a == b {
                 continue;
             }
-            let key = (a.min(b), a.max(b), face_cluster[f]);
+            let key = (a.min(b), a.max(b), face_label[f]);
             match first_on_edge.get(&key) {
                 Some(&g) => dsu.union(g, f as u32),
                 None => {
@@ -78,11 +90,7 @@ pub(crate) fn seeds(triangles: &[[u32; 3]], partition: &[u32]) -> Seeds {
             *dense.entry(root).or_insert(next)
         })
         .collect();
-    Seeds {
-        face_cluster,
-        face_piece,
-        pieces: dense.len() as u32,
-    }
+    (face_piece, dense.len() as u32)
 }
 
 #[cfg(test)]
@@ -94,7 +102,7 @@ mod tests {
         // Two triangles of cluster 0 touching only at vertex 2, one of cluster 1 sharing an edge.
         let tris = [[0, 1, 2], [2, 3, 4], [1, 5, 2]];
         let part = [0, 0, 0, 0, 0, 1];
-        let s = seeds(&tris, &part);
+        let s = seeds(&tris, &tris, &part);
         assert_eq!(s.pieces, 2);
         assert_ne!(s.face_piece[0], s.face_piece[1]);
         // Face 2 has corners in clusters 0, 1, 0: majority is 0, and it shares edge 1-2 with face 0.

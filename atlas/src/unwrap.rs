@@ -1,6 +1,8 @@
-//! Charts and their flattening: `uvunwrap` inside each seed piece, then
-//! iso-charts-like refinement that splits charts whose L2 stretch is too high.
+//! Flattening with `uvunwrap`: one run over the whole mesh, charts kept within materials and
+//! polygons, read back as per-face charts and 2D corners with their stretch; and the principal-
+//! axis split that [`crate::charts`] uses to cut a chart in two.
 
+use crate::open::OpenMesh;
 use crate::stretch::{dot, StretchSum};
 use crate::AtlasError;
 
@@ -25,13 +27,16 @@ fn position(positions: &[[f32; 3]], v: u32) -> [f64; 3] {
         .map_or([0.0; 3], |p| p.map(f64::from))
 }
 
-/// One `uvunwrap` run where charts never cross a material boundary.
-fn flatten_once(
+/// One `uvunwrap` run on the opened mesh where charts never cross a material boundary and the
+/// faces of one polygon stay in one chart; the stretch is measured on the input mesh.
+pub(crate) fn flatten_once(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
+    open: &OpenMesh,
     materials: &[u32],
+    polygons: &[u32],
 ) -> Result<Flattening, AtlasError> {
-    let out = unwrap(positions, triangles, materials)?;
+    let out = unwrap(&open.positions, &open.triangles, materials, polygons)?;
     let mut flat = read_charts(&out, triangles.len());
     flat.chart_stretch = vec![StretchSum::default(); flat.charts as usize];
     for (f, tri) in triangles.iter().enumerate() {
@@ -48,10 +53,12 @@ fn unwrap(
     positions: &[[f32; 3]],
     triangles: &[[u32; 3]],
     materials: &[u32],
+    polygons: &[u32],
 ) -> Result<uvunwrap::Atlas, AtlasError> {
     let indices: Vec<u32> = triangles.iter().flatten().copied().collect();
     let mesh = uvunwrap::MeshInput {
         face_materials: Some(materials),
+        polygons: Some(polygons),
         ..uvunwrap::MeshInput::new(positions, &indices)
     };
     let options = uvunwrap::Options {
@@ -129,7 +136,11 @@ fn read_charts(out: &uvunwrap::Atlas, faces: usize) -> Flattening {
 /// Splits a chart's faces in two halves across the principal axis of their
 /// centroids; iso-charts uses a spectral embedding, a principal axis is the
 /// cheap version of the same idea (cut across the longest extent).
-fn split_faces(positions: &[[f32; 3]], triangles: &[[u32; 3]], faces: &[usize]) -> Vec<bool> {
+pub(crate) fn split_faces(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    faces: &[usize],
+) -> Vec<bool> {
     let centroids: Vec<[f64; 3]> = faces
         .iter()
         .map(|&f| {
@@ -169,50 +180,4 @@ fn split_faces(positions: &[[f32; 3]], triangles: &[[u32; 3]], faces: &[usize]) 
             .for_each(|(i, s)| *s = i % 2 == 0);
     }
     side
-}
-
-/// Flattens the mesh with charts seeded by `materials` (one id per face),
-/// splitting charts stretched beyond `max_stretch` for up to `rounds` rounds.
-pub(crate) fn flatten(
-    positions: &[[f32; 3]],
-    triangles: &[[u32; 3]],
-    seed_materials: &[u32],
-    max_stretch: f64,
-    rounds: u32,
-) -> Result<Flattening, AtlasError> {
-    let mut materials = seed_materials.to_vec();
-    let mut flat = flatten_once(positions, triangles, &materials)?;
-    for round in 1..=rounds {
-        let mut next_material = materials.iter().copied().max().map_or(0, |m| m + 1);
-        let mut split_any = false;
-        let mut chart_faces = vec![Vec::new(); flat.charts as usize];
-        for (f, c) in flat.face_chart.iter().enumerate() {
-            if let Some(c) = c {
-                chart_faces[*c as usize].push(f);
-            }
-        }
-        for (chart, faces) in chart_faces.iter().enumerate() {
-            let stretched = flat.chart_stretch[chart]
-                .value()
-                .is_some_and(|s| s > max_stretch);
-            if !stretched {
-                continue;
-            }
-            if faces.len() < 2 {
-                continue;
-            }
-            let side = split_faces(positions, triangles, faces);
-            for (&f, &s) in faces.iter().zip(&side) {
-                materials[f] = next_material + u32::from(s);
-            }
-            next_material += 2;
-            split_any = true;
-        }
-        if !split_any {
-            break;
-        }
-        flat = flatten_once(positions, triangles, &materials)?;
-        flat.split_rounds = round;
-    }
-    Ok(flat)
 }
