@@ -165,7 +165,7 @@ fn header(
         quality: opts.quality,
         qscale: params.qscale,
         gop: params.gop,
-        affine_bits: opts.affine_bits,
+        affine_precision: opts.affine_precision_code(),
         first_frame_bits: opts.first_frame_bits,
         padding: params.padding.clone(),
         // Decimation asks for no K: the header then records the K it found.

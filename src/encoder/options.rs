@@ -26,8 +26,10 @@ pub struct EncodeOptions {
     pub clusters: usize,
     /// How the vertices are split into motion clusters.
     pub segmentation: Segmentation,
-    /// Bits per affine coefficient.
-    pub affine_bits: u8,
+    /// The affine coefficients' quantiser step as a multiple `k` of the residual step Δ (the
+    /// translation's step is `k·Δ`, the linear part's `k·Δ / r̄` with `r̄` the cluster's RMS radius);
+    /// stored in sixteenths, 1/16..=255/16.
+    pub affine_precision: f64,
     /// Bits per coordinate of the first frame.
     pub first_frame_bits: u8,
     /// Lattice width and height, or chosen from the mesh.
@@ -58,7 +60,7 @@ impl Default for EncodeOptions {
             qscale: None,
             clusters: 20,
             segmentation: Segmentation::KMeans,
-            affine_bits: 17,
+            affine_precision: motion::DEFAULT_AFFINE_PRECISION,
             first_frame_bits: 12,
             lattice: Lattice::Auto,
             padding: None,
@@ -106,7 +108,7 @@ impl EncodeOptions {
             clusters: header.requested_clusters as usize,
             // The segmentation is not redone: the stream carries its partition.
             segmentation: Segmentation::KMeans,
-            affine_bits: header.affine_bits,
+            affine_precision: f64::from(header.affine_precision) / 16.0,
             first_frame_bits: header.first_frame_bits,
             lattice: Lattice::Fixed(header.lattice_width, header.lattice_height),
             padding: match header.codec.has_images() {
@@ -161,8 +163,14 @@ impl EncodeOptions {
                 ));
             }
         }
-        if !(8..=32).contains(&self.affine_bits) {
-            return Err(Error::option("affine_bits", "must be between 8 and 32"));
+        if !(1.0 / 16.0..=255.0 / 16.0).contains(&self.affine_precision) {
+            return Err(Error::option(
+                "affine_precision",
+                format!(
+                    "must be between 1/16 and 255/16 (a multiple of the residual step), not {}",
+                    self.affine_precision
+                ),
+            ));
         }
         if let Lattice::Fixed(w, h) = self.lattice {
             lattice::check(w, h)?;
@@ -180,6 +188,22 @@ impl EncodeOptions {
             return Err(Error::option("gop", "must be at least 1"));
         }
         Ok(())
+    }
+
+    /// `affine_precision` as the header stores it: in sixteenths, 1..=255.
+    pub fn affine_precision_code(&self) -> u8 {
+        (self.affine_precision * 16.0).round().clamp(1.0, 255.0) as u8
+    }
+
+    /// The affine track's base step in the unit frame (a fraction of the diagonal): the residual
+    /// step's fraction (`step`, or the one `quality` maps to) times the stored precision. Image
+    /// codecs use the same law, which is finer than their residual error at equal quality.
+    pub fn affine_step(&self) -> f64 {
+        let fraction = self
+            .step
+            .unwrap_or_else(|| crate::codec::tdct::step_for_quality(self.quality, 1.0));
+        let k = f64::from(self.affine_precision_code()) / 16.0;
+        (fraction * k).clamp(motion::MIN_AFFINE_STEP, motion::MAX_AFFINE_STEP)
     }
 
     fn check_tdct(&self) -> Result<()> {
