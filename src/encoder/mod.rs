@@ -6,7 +6,7 @@ pub mod analysis;
 mod options;
 
 pub use analysis::{Prediction, SegmentationReport};
-pub use options::{EncodeOptions, Segmentation, DEFAULT_QUALITY};
+pub use options::{default_affine_precision, EncodeOptions, Segmentation, DEFAULT_QUALITY};
 
 use crate::codec::{CodecParams, ResidualInput};
 use crate::error::Result;

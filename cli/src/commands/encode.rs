@@ -25,7 +25,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         return Err(Error::option(
             "affine_bits",
             "was retired: the affine coefficients are now quantised by the residual step that \
-             --quality (or --step) sets; --affine-precision K scales their step (default 0.25)",
+             --quality (or --step) sets; --affine-precision K scales their step (default 0.25; 1/16 for mpeg4)",
         ));
     }
     let padding = match &args.padding {
@@ -64,7 +64,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         qscale: args.qscale,
         clusters: args.clusters.unwrap_or(defaults.clusters),
         segmentation,
-        affine_precision: args.affine_precision.unwrap_or(defaults.affine_precision),
+        affine_precision: args.affine_precision,
         lattice,
         padding,
         gop: args
