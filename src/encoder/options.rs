@@ -51,6 +51,8 @@ pub struct EncodeOptions {
     /// Temporal-DCT quantiser step as a fraction of the first frame's bounding-box diagonal;
     /// `None` derives it from `quality` (tdct only).
     pub step: Option<f64>,
+    /// Bits per texture coordinate over each set's bounding box (1..=24; inputs with UVs only).
+    pub uv_bits: u8,
 }
 
 impl Default for EncodeOptions {
@@ -71,6 +73,7 @@ impl Default for EncodeOptions {
             weight_bits: motion::WEIGHT_BITS,
             range_floor: 0.0,
             step: None,
+            uv_bits: 12,
         }
     }
 }
@@ -140,6 +143,7 @@ impl EncodeOptions {
             weight_bits: weight_bits.unwrap_or(motion::WEIGHT_BITS),
             range_floor: 0.0,
             step: None,
+            uv_bits: 12,
         })
     }
 
@@ -201,6 +205,9 @@ impl EncodeOptions {
         }
         if self.gop == 0 {
             return Err(Error::option("gop", "must be at least 1"));
+        }
+        if !(1..=24).contains(&self.uv_bits) {
+            return Err(Error::option("uv_bits", "must be between 1 and 24"));
         }
         Ok(())
     }

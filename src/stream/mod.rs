@@ -3,9 +3,11 @@
 //! side information (partition, lattice coordinates, predictor).
 
 pub mod affine_coding;
+pub mod attributes;
 pub mod bytes;
 pub mod container;
 pub mod entropy;
 pub mod frame_index;
 pub mod header;
 pub mod side_info;
+mod texcoords;

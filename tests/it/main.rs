@@ -5,6 +5,7 @@
 mod common;
 
 mod affine_coding;
+mod attributes;
 mod cloth;
 mod codec;
 mod decimate;

@@ -78,6 +78,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         weight_bits: args.weight_bits,
         range_floor: args.range_floor,
         step: args.step,
+        uv_bits: args.uv_bits,
         ..defaults
     })
 }
