@@ -19,7 +19,7 @@
 use mcgv_video::mesh::{read_animation, ReadOptions};
 use mcgv_video::motion::{
     decimate, energy, residuals, segment, AffineTrack, DecimateOptions, Partition, SegmentOptions,
-    SkinningWeights, DEFAULT_AFFINE_BITS, DEFAULT_RIDGE, WEIGHT_BITS,
+    SkinningWeights, DEFAULT_AFFINE_PRECISION, DEFAULT_RIDGE, MIN_AFFINE_STEP, WEIGHT_BITS,
 };
 use mcgv_video::stream::side_info::encode_weights;
 use mcgv_video::AnimatedMesh;
@@ -171,7 +171,10 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
     // The reference is the original frame 0: the decoded one is not available to this stage alone.
     let start = Instant::now();
     let reference = mesh.frame(0);
-    let track = match AffineTrack::fit(mesh.frames(), reference, &partition, DEFAULT_AFFINE_BITS) {
+    // The affine step of a default-quality encoding.
+    let step = mcgv_video::codec::tdct::step_for_quality(mcgv_video::encoder::DEFAULT_QUALITY, 1.0)
+        * DEFAULT_AFFINE_PRECISION;
+    let track = match AffineTrack::fit(mesh.frames(), reference, &partition, step) {
         Ok(t) => t,
         Err(e) => return println!("{name:<22} {label:<10} prediction failed: {e}"),
     };
@@ -188,9 +191,9 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
         largest = largest.max(longest(&e));
     }
     let predict_time = start.elapsed().as_secs_f64();
-    // What quantisation alone costs: the 17-bit prediction against a (nearly) unquantised one.
-    let quantisation =
-        AffineTrack::fit(mesh.frames(), reference, &partition, 30).map_or(f64::NAN, |fine| {
+    // What quantisation alone costs: the default-quality prediction against a (nearly) unquantised one.
+    let quantisation = AffineTrack::fit(mesh.frames(), reference, &partition, MIN_AFFINE_STEP)
+        .map_or(f64::NAN, |fine| {
             (0..mesh.frame_count())
                 .map(|f| {
                     longest(&residuals(

@@ -107,12 +107,8 @@ impl<R: Read + Seek> Decoder<R> {
         let residuals = header
             .codec
             .open_decoder(&layout, &mut reader, options.max_bands)?;
-        let track = side_info::decode_affine(
-            &reader.part(Tag::AFFINE)?,
-            f,
-            partition.clusters(),
-            header.affine_bits,
-        )?;
+        let track =
+            side_info::decode_affine(&reader.part(Tag::AFFINE)?, f, &partition, &reference)?;
         let weights = read_weights(&mut reader, &header, &partition, &triangles)?;
         Ok(Self {
             reader,

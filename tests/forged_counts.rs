@@ -216,8 +216,8 @@ fn frames_past_what_the_ranges_hold_are_refused_before_the_affine_track() {
             header.frames = FRAMES;
             *payload = header.to_bytes();
         } else if *tag == Tag::AFFINE {
-            // Bits, then twelve (lo, hi) ranges, then the coded values.
-            payload.truncate(1 + 12 * 8);
+            // The step, then the coded levels.
+            payload.truncate(4);
             payload.extend(vec![0u8; 12_000]);
             assert!(12 * u64::from(FRAMES) <= max_symbols(12_000));
         }

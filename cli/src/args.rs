@@ -121,9 +121,14 @@ pub struct EncodeArgs {
     /// the bounding-box diagonal (default 0.003, the paper's).
     #[arg(long)]
     pub e0: Option<f64>,
-    /// Bits per quantised affine coefficient.
-    #[arg(long, default_value_t = 17)]
-    pub affine_bits: u8,
+    /// The affine coefficients' quantiser step as a multiple of the residual step (whose size
+    /// --quality or --step sets): smaller = finer maps, more side information (1/16..15.9;
+    /// default 0.25; 1/16 for mpeg4, whose P-frames suffer from coarser maps).
+    #[arg(long)]
+    pub affine_precision: Option<f64>,
+    /// Retired: the affine coefficients now follow the quality's step (see --affine-precision).
+    #[arg(long, hide = true)]
+    pub affine_bits: Option<u8>,
     /// Geometry-image lattice: WIDTHxHEIGHT (multiples of 16), or `auto` to size it from the
     /// vertex count (about 28 pixels per vertex; 256x256 for 2341..8738 vertices, more above).
     /// Grown until the charts fit.

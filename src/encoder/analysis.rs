@@ -101,7 +101,7 @@ pub fn predict(
     partition: &Partition,
     opts: &EncodeOptions,
 ) -> Result<Prediction> {
-    let track = AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_bits)?;
+    let track = AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_step())?;
     let weights = match opts.predictor {
         PredictorKind::Affine => None,
         PredictorKind::Skinning => Some(SkinningWeights::fit_with(

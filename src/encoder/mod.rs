@@ -7,7 +7,7 @@ mod attributes;
 mod options;
 
 pub use analysis::{Prediction, SegmentationReport};
-pub use options::{EncodeOptions, Segmentation, DEFAULT_QUALITY};
+pub use options::{default_affine_precision, EncodeOptions, Segmentation, DEFAULT_QUALITY};
 
 use crate::codec::{CodecParams, ResidualInput};
 use crate::error::Result;
@@ -171,7 +171,7 @@ fn header(
         quality: opts.quality,
         qscale: params.qscale,
         gop: params.gop,
-        affine_bits: opts.affine_bits,
+        affine_precision: opts.affine_precision_code(),
         first_frame_bits: opts.first_frame_bits,
         padding: params.padding.clone(),
         // Decimation asks for no K: the header then records the K it found.

@@ -1,5 +1,16 @@
 //! The piecewise affine predictor (MCGV §3.2): one affine map per cluster and frame, fitted from the
 //! decoded frame 0 (eq. 2), quantised for the stream, and applied with the dequantised coefficients.
+//!
+//! Quantisation follows the residuals' quality law instead of a fixed bit count: the encoder
+//! predicts from the *dequantised* maps (closed loop), so a map's error only has to be small
+//! against the residual quantiser step Δ, not against the map itself. Each map `x ↦ A x + b` is
+//! stored as its linear part `A` and the image `t = A c + b` of its cluster's centroid `c`: an
+//! error `e` in an entry of `A` then moves a vertex at distance `r` from the centroid by about
+//! `e·r`, and an error in `t` moves every vertex of the cluster alike, with no share of `A`'s
+//! error. `t` is quantised with the track's step `s` and `A` with `s / r̄`, `r̄` the cluster's
+//! RMS distance from its centroid ([`ClusterGeometry`]), so both move the cluster's vertices by
+//! about `s`. The decoder derives centroids and spreads from the decoded frame 0 and the
+//! partition, which it has before the maps.
 
 use super::fit::{apply, AffineCoefficients, AffineSolver, UnitFrame};
 use super::partition::Partition;
@@ -11,59 +22,137 @@ use rayon::prelude::*;
 /// tiny clusters the identity in their unconstrained directions, far below any effect on residuals.
 const CLUSTER_LAMBDA: f64 = 1e-9;
 
-/// Bits per coefficient the paper uses, and this tool's default.
-pub const DEFAULT_AFFINE_BITS: u8 = 17;
+/// The affine step as a multiple of the residual step Δ (`step_affine = k·Δ` for translations,
+/// `k·Δ / r̄` for the linear part). Measured by total bytes at equal vertex RMSE (issue 18 note).
+pub const DEFAULT_AFFINE_PRECISION: f64 = 0.25;
 
-/// Most bits per coefficient accepted; beyond about 24 the f32 ranges limit precision anyway.
-pub const MAX_AFFINE_BITS: u8 = 31;
+/// Smallest and largest base step accepted (unit coordinates: fractions of the diagonal). Below
+/// 1e-9 the f64 coefficients would need more than 2^40 levels; above 16 nothing is predicted.
+pub const MIN_AFFINE_STEP: f64 = 1e-9;
+/// See [`MIN_AFFINE_STEP`].
+pub const MAX_AFFINE_STEP: f64 = 16.0;
 
-/// The affine maps as they are stored: integers plus the range of each of the 12 coefficient indices.
-///
-/// The maps act in the unit frame of the decoded frame 0 (its bounding-box centre at the origin,
-/// diagonal 1), so coefficients are dimensionless and the decoder rebuilds the frame from what it has.
+/// Spreads below this (unit coordinates) count as this: a cluster of (nearly) one point would
+/// otherwise get an unbounded linear step, and the skinning predictor applies a cluster's map to
+/// vertices of the neighbouring clusters too.
+const MIN_SPREAD: f64 = 1e-3;
+
+/// The coarsest linear-part step: keeps maps of tiny clusters meaningful for those neighbours.
+const MAX_LINEAR_STEP: f64 = 1.0 / 64.0;
+
+/// Largest quantised magnitude: far above any sensible step, far below where i64 arithmetic of
+/// the predictors or f64 dequantisation lose meaning.
+pub const MAX_AFFINE_LEVEL: i64 = 1 << 40;
+
+/// Per cluster, its centroid and RMS distance from it on the decoded frame 0, in the unit frame:
+/// what both sides need to turn the base step into per-coefficient steps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClusterGeometry {
+    /// Centroid of each cluster's vertices.
+    pub centroids: Vec<[f64; 3]>,
+    /// RMS distance of each cluster's vertices from its centroid (0 for an empty cluster).
+    pub spreads: Vec<f64>,
+}
+
+impl ClusterGeometry {
+    /// The geometry of `partition`'s clusters on `reference` (sums in vertex order, so encoder
+    /// and decoder compute the same numbers); labels out of range are skipped.
+    pub fn of(reference: &[Point], partition: &Partition) -> Self {
+        let unit = UnitFrame::of(reference);
+        let k = partition.clusters();
+        let (mut sum, mut count) = (vec![[0.0f64; 3]; k], vec![0usize; k]);
+        for (p, &l) in reference.iter().zip(partition.labels()) {
+            if let (Some(s), Some(n)) = (sum.get_mut(l as usize), count.get_mut(l as usize)) {
+                let u = unit.to_unit(p);
+                (0..3).for_each(|a| s[a] += u[a]);
+                *n += 1;
+            }
+        }
+        let centroids: Vec<[f64; 3]> = sum
+            .iter()
+            .zip(&count)
+            .map(|(s, &n)| s.map(|x| x / n.max(1) as f64))
+            .collect();
+        let mut squares = vec![0.0f64; k];
+        for (p, &l) in reference.iter().zip(partition.labels()) {
+            if let (Some(s), Some(c)) = (squares.get_mut(l as usize), centroids.get(l as usize)) {
+                let u = unit.to_unit(p);
+                *s += (0..3).map(|a| (u[a] - c[a]).powi(2)).sum::<f64>();
+            }
+        }
+        let spreads = squares
+            .iter()
+            .zip(&count)
+            .map(|(s, &n)| (s / n.max(1) as f64).sqrt())
+            .collect();
+        Self { centroids, spreads }
+    }
+
+    /// The 12 quantiser steps of `cluster`'s map for base step `step`, in coefficient order
+    /// (`[a00 a01 a02 t0 a10 …]`): `step` for the translations, `step / r̄` for the linear part.
+    pub fn steps(&self, cluster: usize, step: f64) -> [f64; 12] {
+        let spread = self.spreads.get(cluster).copied().unwrap_or(0.0);
+        let linear = (step / spread.max(MIN_SPREAD)).min(MAX_LINEAR_STEP);
+        std::array::from_fn(|c| if c % 4 == 3 { step } else { linear })
+    }
+
+    /// `cluster`'s centroid (the origin for a cluster out of range).
+    pub fn centroid(&self, cluster: usize) -> [f64; 3] {
+        self.centroids.get(cluster).copied().unwrap_or([0.0; 3])
+    }
+}
+
+/// The identity map in stored form for `cluster`: `A = I`, `t = c`, in levels of `steps`.
+pub fn identity_levels(centroid: [f64; 3], steps: &[f64; 12]) -> [i64; 12] {
+    std::array::from_fn(|c| {
+        let (row, col) = (c / 4, c % 4);
+        let x = match col {
+            3 => centroid[row],
+            _ if col == row => 1.0,
+            _ => 0.0,
+        };
+        level(x / steps[c])
+    })
+}
+
+/// The nearest level, clamped to ±[`MAX_AFFINE_LEVEL`] (NaN gives 0).
+fn level(x: f64) -> i64 {
+    let bound = MAX_AFFINE_LEVEL as f64;
+    if x.is_nan() {
+        0
+    } else {
+        x.round().clamp(-bound, bound) as i64
+    }
+}
+
+/// The affine maps as they are stored: integer levels of `A` and `t` (see the module notes).
 #[derive(Debug, Clone, PartialEq)]
 pub struct QuantisedAffine {
-    /// Bits per coefficient (1..=31).
-    pub bits: u8,
+    /// Base step in the unit frame (a fraction of the decoded frame 0's diagonal): the step of
+    /// the translations, which [`ClusterGeometry::steps`] turns into the linear part's.
+    pub step: f32,
     /// Number of frames.
     pub frames: usize,
     /// Number of clusters.
     pub clusters: usize,
-    /// `(min, max)` of each coefficient index over all clusters and frames.
-    pub ranges: [(f32, f32); 12],
-    /// Quantised coefficients, frame by frame, cluster by cluster, 12 each (row-major `[A | b]`).
-    pub values: Vec<u32>,
+    /// Levels, frame by frame, cluster by cluster, 12 each (row-major `[A | t]`).
+    pub values: Vec<i64>,
 }
 
 impl QuantisedAffine {
-    fn levels(&self) -> f64 {
-        ((1u64 << self.bits) - 1) as f64
-    }
-
-    /// Coefficient `c` of a quantised value.
-    fn dequantise(&self, c: usize, q: u32) -> f64 {
-        let (lo, hi) = self.ranges[c];
-        lo as f64 + q as f64 * (hi as f64 - lo as f64) / self.levels()
-    }
-
-    fn quantise(&self, c: usize, x: f64) -> u32 {
-        let (lo, hi) = self.ranges[c];
-        let width = hi as f64 - lo as f64;
-        if width <= 0.0 {
-            return 0;
+    /// Refuses a stored base step outside [`MIN_AFFINE_STEP`]..=[`MAX_AFFINE_STEP`] (or NaN).
+    pub fn check_step(step: f32) -> Result<()> {
+        // Compared as the f32 the stream stores, which the encoder's f64 bounds round to.
+        if !(MIN_AFFINE_STEP as f32..=MAX_AFFINE_STEP as f32).contains(&step) {
+            return Err(Error::Stream(format!(
+                "affine coefficients: step {step:e} is outside {MIN_AFFINE_STEP:e}..={MAX_AFFINE_STEP}"
+            )));
         }
-        ((x - lo as f64) / width * self.levels())
-            .round()
-            .clamp(0.0, self.levels()) as u32
+        Ok(())
     }
 
     fn check(&self) -> Result<()> {
-        if self.bits == 0 || self.bits > MAX_AFFINE_BITS {
-            return Err(Error::Stream(format!(
-                "affine coefficients: {} bits is outside 1..={MAX_AFFINE_BITS}",
-                self.bits
-            )));
-        }
+        Self::check_step(self.step)?;
         if self.frames == 0 || self.clusters == 0 {
             return Err(Error::Stream(
                 "affine coefficients: no frames or no clusters".into(),
@@ -81,24 +170,38 @@ impl QuantisedAffine {
                 self.clusters
             )));
         }
-        if let Some((c, _)) = self
-            .ranges
+        if let Some(i) = self
+            .values
             .iter()
-            .enumerate()
-            .find(|(_, (lo, hi))| !(lo.is_finite() && hi.is_finite() && lo <= hi))
+            .position(|q| q.unsigned_abs() > MAX_AFFINE_LEVEL as u64)
         {
             return Err(Error::Stream(format!(
-                "affine coefficients: range of coefficient {c} is not a finite interval"
-            )));
-        }
-        let top = (1u64 << self.bits) - 1;
-        if let Some(i) = self.values.iter().position(|&q| q as u64 > top) {
-            return Err(Error::Stream(format!(
-                "affine coefficients: value {i} does not fit in {} bits",
-                self.bits
+                "affine coefficients: level {i} is beyond ±2^40"
             )));
         }
         Ok(())
+    }
+
+    /// The map `[A | b]` of levels `q` of a cluster with `steps` and `centroid`: `b = t − A c`.
+    fn dequantise(q: &[i64], steps: &[f64; 12], centroid: [f64; 3]) -> AffineCoefficients {
+        let mut h: AffineCoefficients = std::array::from_fn(|c| q[c] as f64 * steps[c]);
+        for row in 0..3 {
+            let ac: f64 = (0..3).map(|col| h[4 * row + col] * centroid[col]).sum();
+            h[4 * row + 3] -= ac;
+        }
+        h
+    }
+
+    /// Levels of the exact map `h`: `A` as it is, `t = A c + b`.
+    fn quantise(h: &AffineCoefficients, steps: &[f64; 12], centroid: [f64; 3]) -> [i64; 12] {
+        std::array::from_fn(|c| {
+            let (row, col) = (c / 4, c % 4);
+            let x = match col {
+                3 => h[c] + (0..3).map(|j| h[4 * row + j] * centroid[j]).sum::<f64>(),
+                _ => h[c],
+            };
+            level(x / steps[c])
+        })
     }
 }
 
@@ -106,21 +209,23 @@ impl QuantisedAffine {
 #[derive(Debug, Clone, PartialEq)]
 pub struct AffineTrack {
     quantised: QuantisedAffine,
+    geometry: ClusterGeometry,
     maps: Vec<AffineCoefficients>,
 }
 
 impl AffineTrack {
     /// Fits `H_i^k` (eq. 2) for every frame `i` of `frames` and cluster `k`, from `reference` (the
-    /// frame 0 the decoder will have) to the original frame, then quantises to `bits` per coefficient.
+    /// frame 0 the decoder will have) to the original frame, then quantises with base step `step`
+    /// (unit frame, see [`QuantisedAffine::step`]; rounded to the `f32` the stream stores).
     pub fn fit(
         frames: &[Vec<Point>],
         reference: &[Point],
         partition: &Partition,
-        bits: u8,
+        step: f64,
     ) -> Result<Self> {
-        if bits == 0 || bits > MAX_AFFINE_BITS {
+        if !(step.is_finite() && (MIN_AFFINE_STEP..=MAX_AFFINE_STEP).contains(&step)) {
             return Err(Error::Usage(format!(
-                "affine bits must be in 1..={MAX_AFFINE_BITS}, not {bits}"
+                "the affine step must be in {MIN_AFFINE_STEP:e}..={MAX_AFFINE_STEP}, not {step}"
             )));
         }
         if frames.is_empty() {
@@ -158,42 +263,75 @@ impl AffineTrack {
                 })
             })
             .collect();
-        let mut ranges = [(f32::INFINITY, f32::NEG_INFINITY); 12];
-        for h in &exact {
-            for (r, &x) in ranges.iter_mut().zip(h) {
-                r.0 = r.0.min(x as f32);
-                r.1 = r.1.max(x as f32);
-            }
+        if exact.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(Error::Mesh(
+                "an affine fit is not finite (non-finite vertex coordinates?)".into(),
+            ));
         }
-        let mut quantised = QuantisedAffine {
-            bits,
-            frames: frames.len(),
-            clusters: partition.clusters(),
-            ranges,
-            values: Vec::with_capacity(exact.len() * 12),
-        };
-        let values: Vec<u32> = exact
-            .iter()
-            .flat_map(|h| (0..12).map(|c| quantised.quantise(c, h[c])))
+        let geometry = ClusterGeometry::of(reference, partition);
+        let stored = step as f32;
+        let clusters = partition.clusters();
+        let steps: Vec<[f64; 12]> = (0..clusters)
+            .map(|k| geometry.steps(k, f64::from(stored)))
             .collect();
-        quantised.values = values;
-        Self::from_quantised(quantised)
+        let values = exact
+            .iter()
+            .enumerate()
+            .flat_map(|(i, h)| {
+                let k = i % clusters;
+                QuantisedAffine::quantise(h, &steps[k], geometry.centroid(k))
+            })
+            .collect();
+        let quantised = QuantisedAffine {
+            step: stored,
+            frames: frames.len(),
+            clusters,
+            values,
+        };
+        Self::from_quantised(quantised, geometry)
     }
 
-    /// Rebuilds the predictor from stored integers and ranges; fails on inconsistent input.
-    pub fn from_quantised(quantised: QuantisedAffine) -> Result<Self> {
+    /// Rebuilds the predictor from stored levels and the clusters' geometry on the decoded frame 0
+    /// ([`ClusterGeometry::of`]); fails on inconsistent input.
+    pub fn from_quantised(quantised: QuantisedAffine, geometry: ClusterGeometry) -> Result<Self> {
         quantised.check()?;
+        if geometry.centroids.len() != quantised.clusters
+            || geometry.spreads.len() != quantised.clusters
+        {
+            return Err(Error::Stream(format!(
+                "affine coefficients: {} clusters, the partition has {}",
+                quantised.clusters,
+                geometry.centroids.len()
+            )));
+        }
+        let step = f64::from(quantised.step);
+        let steps: Vec<[f64; 12]> = (0..quantised.clusters)
+            .map(|k| geometry.steps(k, step))
+            .collect();
         let maps = quantised
             .values
             .chunks_exact(12)
-            .map(|q| std::array::from_fn(|c| quantised.dequantise(c, q[c])))
+            .enumerate()
+            .map(|(i, q)| {
+                let k = i % quantised.clusters;
+                QuantisedAffine::dequantise(q, &steps[k], geometry.centroid(k))
+            })
             .collect();
-        Ok(Self { quantised, maps })
+        Ok(Self {
+            quantised,
+            geometry,
+            maps,
+        })
     }
 
-    /// The stored form: integers and ranges.
+    /// The stored form: levels and base step.
     pub fn quantised(&self) -> &QuantisedAffine {
         &self.quantised
+    }
+
+    /// The clusters' centroids and spreads the steps derive from.
+    pub fn geometry(&self) -> &ClusterGeometry {
+        &self.geometry
     }
 
     /// Number of frames.

@@ -29,7 +29,10 @@ mod residual;
 mod sampled_motion;
 mod skinning;
 
-pub use affine::{AffineTrack, QuantisedAffine, DEFAULT_AFFINE_BITS, MAX_AFFINE_BITS};
+pub use affine::{
+    identity_levels, AffineTrack, ClusterGeometry, QuantisedAffine, DEFAULT_AFFINE_PRECISION,
+    MAX_AFFINE_LEVEL, MAX_AFFINE_STEP, MIN_AFFINE_STEP,
+};
 pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
 pub use fit::AffineCoefficients;
 pub use kmeans::{segment, SegmentOptions, MIN_CLUSTER_SIZE};

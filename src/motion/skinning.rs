@@ -412,7 +412,7 @@ mod tests {
             cluster_neighbours(&partition, &tris),
             vec![vec![1], vec![0]]
         );
-        let track = AffineTrack::fit(&frames, &rest, &partition, 17).unwrap();
+        let track = AffineTrack::fit(&frames, &rest, &partition, 1e-6).unwrap();
         let weights = SkinningWeights::fit(&frames, &rest, &partition, &tris, &track).unwrap();
         assert_eq!(weights.values.len(), rest.len());
         let (mut affine_seam, mut skin_seam, mut affine_all, mut skin_all) = (0.0, 0.0, 0.0, 0.0);
@@ -446,7 +446,7 @@ mod tests {
     #[test]
     fn zero_weights_are_the_piecewise_affine_predictor() {
         let (rest, tris, frames, partition) = bend();
-        let track = AffineTrack::fit(&frames, &rest, &partition, 17).unwrap();
+        let track = AffineTrack::fit(&frames, &rest, &partition, 1e-6).unwrap();
         let mut weights = SkinningWeights::fit(&frames, &rest, &partition, &tris, &track).unwrap();
         weights.values.iter_mut().for_each(|w| *w = 0);
         for f in [0, 5, 11] {
@@ -460,7 +460,7 @@ mod tests {
     #[test]
     fn inconsistent_weights_are_refused() {
         let (rest, tris, frames, partition) = bend();
-        let track = AffineTrack::fit(&frames, &rest, &partition, 17).unwrap();
+        let track = AffineTrack::fit(&frames, &rest, &partition, 1e-6).unwrap();
         let good = SkinningWeights::fit(&frames, &rest, &partition, &tris, &track).unwrap();
         let mut short = good.clone();
         short.values.pop();

@@ -28,8 +28,9 @@ pub struct Header {
     pub qscale: u8,
     /// Frames per group of pictures (MPEG-4: an I-frame starts each group; JPEG: 1).
     pub gop: u32,
-    /// Bits per quantised affine coefficient.
-    pub affine_bits: u8,
+    /// The affine coefficients' step as a multiple of the residual step, in sixteenths (16 = 1):
+    /// the encoder's `affine_precision` (the affine part stores the step itself).
+    pub affine_precision: u8,
     /// Bits per coordinate of the first frame's geometry.
     pub first_frame_bits: u8,
     /// Name of the padding method the encoder used (informational: the decoder does not pad).
@@ -93,7 +94,7 @@ impl Header {
             .u8(self.quality)
             .u8(self.qscale)
             .u32(self.gop)
-            .u8(self.affine_bits)
+            .u8(self.affine_precision)
             .u8(self.first_frame_bits)
             .blob(self.padding.as_bytes())
             .u32(self.requested_clusters)
@@ -123,7 +124,7 @@ impl Header {
             quality: r.u8()?,
             qscale: r.u8()?,
             gop: r.u32()?,
-            affine_bits: r.u8()?,
+            affine_precision: r.u8()?,
             first_frame_bits: r.u8()?,
             padding: String::from_utf8_lossy(r.blob()?).into_owned(),
             requested_clusters: r.u32()?,
@@ -207,9 +208,7 @@ impl Header {
 
     /// Refuses quantisation parameters outside what the coders accept.
     fn check_quantisation(&self) -> Result<()> {
-        if !(1..=32).contains(&self.affine_bits)
-            || !(1..=24).contains(&self.first_frame_bits)
-            || self.gop == 0
+        if self.affine_precision == 0 || !(1..=24).contains(&self.first_frame_bits) || self.gop == 0
         {
             return Err(Error::Stream(
                 "header has out-of-range quantisation parameters".into(),
@@ -235,7 +234,7 @@ mod tests {
             quality: 75,
             qscale: 4,
             gop: 50,
-            affine_bits: 17,
+            affine_precision: 16,
             first_frame_bits: 12,
             padding: "cg".into(),
             requested_clusters: 20,

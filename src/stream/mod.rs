@@ -2,6 +2,7 @@
 //! serialisation, the entropy coder, and the parts every codec shares: header, frame index and
 //! side information (partition, lattice coordinates, predictor).
 
+pub mod affine_coding;
 pub mod attributes;
 pub mod bytes;
 pub mod container;

@@ -1,16 +1,18 @@
-//! Entropy coding of the side information: the partition, the lattice coordinates and the affine
-//! coefficients. Each is written once as a traversal generic over [`SymbolCoder`], so the encoder and
-//! the decoder cannot drift apart.
+//! Entropy coding of the side information: the partition, the lattice coordinates, the skinning
+//! weights, and (in [`super::affine_coding`]) the affine coefficients. Each is written once as a
+//! traversal generic over [`SymbolCoder`], so the encoder and the decoder cannot drift apart.
 //!
 //! What is exploited: labels are spatially coherent (a vertex usually shares the label most of its
-//! already-coded neighbours have); lattice coordinates of mesh neighbours are near each other; affine
-//! coefficients change slowly from frame to frame; skinning weights vary smoothly over the surface
-//! and are large only near the cluster they blend toward.
+//! already-coded neighbours have); lattice coordinates of mesh neighbours are near each other;
+//! skinning weights vary smoothly over the surface and are large only near the cluster they blend
+//! toward.
 
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
-use crate::motion::{cluster_neighbours, AffineTrack, Partition, QuantisedAffine, SkinningWeights};
+use crate::motion::{cluster_neighbours, Partition, SkinningWeights};
+
+pub use super::affine_coding::{decode_affine, encode_affine};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::entropy::{
     self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel,
@@ -171,85 +173,6 @@ pub fn decode_lattice(
     let mut pixels = vec![[0u16; 2]; vertices];
     code_lattice(&mut dec, &mut pixels, size, &adj)?;
     Ok(pixels)
-}
-
-/// Frame-to-frame differences of each of the 12 coefficients, one adaptive model per coefficient
-/// index; the first frame's values as differences from mid-range.
-fn code_affine_values<C: SymbolCoder>(c: &mut C, q: &mut QuantisedAffine) -> Result<()> {
-    let mut first: Vec<IntModel> = vec![IntModel::default(); 12];
-    let mut delta: Vec<IntModel> = vec![IntModel::default(); 12];
-    let top = (1i64 << q.bits) - 1;
-    let per_frame = q.clusters * 12;
-    for i in 0..q.values.len() {
-        let (f, coeff) = (i / per_frame, i % 12);
-        let (base, model) = if f == 0 {
-            ((top + 1) / 2, &mut first[coeff])
-        } else {
-            (q.values[i - per_frame] as i64, &mut delta[coeff])
-        };
-        let value = base + c.signed(q.values[i] as i64 - base, model)?;
-        if !(0..=top).contains(&value) {
-            return Err(Error::Stream(
-                "affine coefficient outside its quantisation range".into(),
-            ));
-        }
-        q.values[i] = value as u32;
-    }
-    Ok(())
-}
-
-/// Codes the quantised affine coefficients and their ranges.
-pub fn encode_affine(track: &AffineTrack) -> Result<Vec<u8>> {
-    let mut q = track.quantised().clone();
-    let mut w = ByteWriter::new();
-    w.u8(q.bits);
-    for (lo, hi) in q.ranges {
-        w.f32(lo).f32(hi);
-    }
-    let mut enc = Encoder::new();
-    code_affine_values(&mut enc, &mut q)?;
-    w.raw(&enc.finish()?);
-    Ok(w.into_bytes())
-}
-
-/// Decodes the affine track of `frames` frames and `clusters` clusters at `bits` bits.
-pub fn decode_affine(
-    bytes: &[u8],
-    frames: usize,
-    clusters: usize,
-    bits: u8,
-) -> Result<AffineTrack> {
-    let mut r = ByteReader::new(bytes, "affine coefficients");
-    let stored_bits = r.u8()?;
-    if stored_bits != bits {
-        return Err(Error::Stream(format!(
-            "affine coefficients have {stored_bits} bits, header says {bits}"
-        )));
-    }
-    let mut ranges = [(0f32, 0f32); 12];
-    for range in ranges.iter_mut() {
-        *range = (r.f32()?, r.f32()?);
-    }
-    if !(1..=31).contains(&bits) {
-        return Err(Error::Stream(format!(
-            "affine coefficients: {bits} bits is out of range"
-        )));
-    }
-    let rest = r.take(r.remaining())?;
-    let count = (frames as u64)
-        .saturating_mul(clusters as u64)
-        .saturating_mul(12);
-    check_capacity(count, rest.len(), "affine coefficients")?;
-    let mut q = QuantisedAffine {
-        bits,
-        frames,
-        clusters,
-        ranges,
-        values: vec![0; count as usize],
-    };
-    let mut dec = Decoder::new(rest)?;
-    code_affine_values(&mut dec, &mut q)?;
-    AffineTrack::from_quantised(q)
 }
 
 /// Per vertex, the weight toward each neighbouring cluster as a difference from the rounded mean of

@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod affine_coding;
 mod attributes;
 mod cloth;
 mod codec;

@@ -96,6 +96,9 @@ fn max_residual(mesh: &AnimatedMesh, track: &AffineTrack, partition: &Partition)
         .fold(0.0, f64::max)
 }
 
+/// An affine step (fraction of the diagonal) far below the tests' tolerances.
+const FINE: f64 = 1e-6;
+
 #[test]
 fn separate_parts_are_recovered_and_predicted_to_quantisation_level() {
     let (mesh, truth) = separate_parts();
@@ -104,14 +107,14 @@ fn separate_parts_are_recovered_and_predicted_to_quantisation_level() {
     assert_eq!(rand_index(partition.labels(), &truth), 1.0);
 
     let diag = mesh.bbox_diagonal();
-    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, FINE).unwrap();
     let worst = max_residual(&mesh, &track, &partition);
     assert!(
         worst < 2e-5 * diag,
         "largest residual {worst} vs diagonal {diag}"
     );
-    // Fewer bits: coarser, but still following the motion (the ranges are what make bits count).
-    let coarse = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 8).unwrap();
+    // A coarser step: coarser maps, but still following the motion.
+    let coarse = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 1e-2).unwrap();
     let coarse_worst = max_residual(&mesh, &coarse, &partition);
     assert!(
         coarse_worst > worst && coarse_worst < 1e-2 * diag,
@@ -129,7 +132,7 @@ fn connected_parts_are_recovered_up_to_their_seams() {
     // With the true parts, the predictor leaves only quantisation noise; the motion is far larger.
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
     let exact = Partition::from_labels(labels, 4).unwrap();
-    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, 17).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, FINE).unwrap();
     let diag = mesh.bbox_diagonal();
     assert!(max_residual(&mesh, &track, &exact) < 2e-5 * diag);
     let last = mesh.frame(FRAMES - 1);
@@ -164,7 +167,7 @@ fn twisted_tube() -> AnimatedMesh {
 }
 
 fn residual_energy(mesh: &AnimatedMesh, partition: &Partition) -> f64 {
-    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), partition, 17).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), partition, FINE).unwrap();
     (0..mesh.frame_count())
         .map(|f| {
             energy(&residuals(
@@ -208,23 +211,32 @@ fn quantised_form_round_trips_and_rejects_corruption() {
     let (mesh, truth) = separate_parts();
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
     let partition = Partition::from_labels(labels, 4).unwrap();
-    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
-    let again = AffineTrack::from_quantised(track.quantised().clone()).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, FINE).unwrap();
+    let geometry = track.geometry().clone();
+    let again = AffineTrack::from_quantised(track.quantised().clone(), geometry.clone()).unwrap();
     for f in [0, 5, FRAMES - 1] {
         assert_eq!(
             track.predict(f, mesh.frame(0), &partition),
             again.predict(f, mesh.frame(0), &partition)
         );
     }
+    let refused = |q: mcgv_video::motion::QuantisedAffine| {
+        AffineTrack::from_quantised(q, geometry.clone()).is_err()
+    };
     let mut too_big = track.quantised().clone();
-    too_big.values[3] = 1 << 17;
-    assert!(AffineTrack::from_quantised(too_big).is_err());
+    too_big.values[3] = mcgv_video::motion::MAX_AFFINE_LEVEL + 1;
+    assert!(refused(too_big));
     let mut short = track.quantised().clone();
     short.values.pop();
-    assert!(AffineTrack::from_quantised(short).is_err());
-    let mut nan = track.quantised().clone();
-    nan.ranges[0].1 = f32::NAN;
-    assert!(AffineTrack::from_quantised(nan).is_err());
+    assert!(refused(short));
+    for step in [f32::NAN, 0.0, -1.0, f32::INFINITY] {
+        let mut bad = track.quantised().clone();
+        bad.step = step;
+        assert!(refused(bad), "step {step}");
+    }
+    let mut fewer = geometry.clone();
+    fewer.centroids.pop();
+    assert!(AffineTrack::from_quantised(track.quantised().clone(), fewer).is_err());
     assert!(track
         .try_predict(FRAMES, mesh.frame(0), &partition)
         .is_err());
@@ -239,7 +251,7 @@ fn assert_finite_everywhere(mesh: &AnimatedMesh, clusters: usize) {
     let partition = segment(mesh, &options(clusters)).unwrap();
     assert_eq!(partition.vertex_count(), mesh.vertex_count());
     assert!(partition.clusters() >= 1 && partition.clusters() <= clusters);
-    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 17).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, FINE).unwrap();
     for f in 0..mesh.frame_count() {
         let predicted = track.predict(f, mesh.frame(0), &partition);
         assert!(predicted.iter().flatten().all(|c| c.is_finite()));
@@ -304,8 +316,9 @@ fn bad_requests_are_errors() {
     assert!(segment(&mesh, &options(0)).is_err());
     let labels: Vec<u32> = truth.iter().map(|&k| k as u32).collect();
     let partition = Partition::from_labels(labels, 4).unwrap();
-    assert!(AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 0).is_err());
-    assert!(AffineTrack::fit(mesh.frames(), &mesh.frame(0)[1..], &partition, 17).is_err());
+    assert!(AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, 0.0).is_err());
+    assert!(AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, f64::NAN).is_err());
+    assert!(AffineTrack::fit(mesh.frames(), &mesh.frame(0)[1..], &partition, FINE).is_err());
 }
 
 /// Frame 0 of a real mesh shipped with the project (CesiumMan: 138 pieces, flat patches), cut into
@@ -332,6 +345,6 @@ fn parts_of_a_real_mesh_are_recovered_and_predicted() {
     assert!(score > 0.9, "Rand index {score}");
     let labels: Vec<u32> = part.iter().map(|&k| k as u32).collect();
     let exact = Partition::from_labels(labels, 4).unwrap();
-    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, 17).unwrap();
+    let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &exact, FINE).unwrap();
     assert!(max_residual(&mesh, &track, &exact) < 2e-5 * mesh.bbox_diagonal());
 }

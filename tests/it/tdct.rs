@@ -115,10 +115,11 @@ fn skinning_predictor_and_decimation_round_trip() {
         oriented_set(decoded.triangles()),
         oriented_set(mesh.triangles())
     );
-    // Vertex RMSE measured 3.2e-5 (skinning, quality 75) and 6.7e-5 (decimation on the two-bone
-    // cylinder); the bounds are about twice.
+    // Vertex RMSE measured 8.1e-5 (skinning, quality 75: the affine maps' error at the quality's
+    // step dominates this rigged figure; 3.2e-5 with 17-bit maps) and 6.7e-5 (decimation on the
+    // two-bone cylinder); the bounds are about twice.
     let e = vertex_rmse(&mesh, &decoded);
-    assert!(e < 7e-5, "skinning: vertex RMSE {e}");
+    assert!(e < 1.6e-4, "skinning: vertex RMSE {e}");
 
     let simple = read_media("RiggedSimple.glb");
     let decimation = EncodeOptions {

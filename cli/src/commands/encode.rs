@@ -21,6 +21,13 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         CodecChoice::Tdct => Codec::Tdct,
     };
     check_codec_options(args, codec, lattice)?;
+    if args.affine_bits.is_some() {
+        return Err(Error::option(
+            "affine_bits",
+            "was retired: the affine coefficients are now quantised by the residual step that \
+             --quality (or --step) sets; --affine-precision K scales their step (default 0.25; 1/16 for mpeg4)",
+        ));
+    }
     let padding = match &args.padding {
         Some(name) => Some(
             name.parse::<padding::Method>()
@@ -57,7 +64,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         qscale: args.qscale,
         clusters: args.clusters.unwrap_or(defaults.clusters),
         segmentation,
-        affine_bits: args.affine_bits,
+        affine_precision: args.affine_precision,
         lattice,
         padding,
         gop: args

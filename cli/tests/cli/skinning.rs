@@ -1,6 +1,7 @@
 //! The skinning predictor through the command line.
 
 use crate::common::{json, media_path, ok, run};
+use std::path::Path;
 
 #[test]
 fn cli_records_the_predictor_and_inspect_reports_the_weights() {
@@ -52,4 +53,38 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
         "bones",
     ]);
     assert_eq!(bad.status.code(), Some(2));
+}
+
+/// `--affine-precision` scales the affine step (finer maps, more bytes); the retired
+/// `--affine-bits` is a usage error that says what replaced it.
+#[test]
+fn affine_precision_sets_the_maps_step_and_affine_bits_is_retired() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample = media_path("RiggedSimple.glb");
+    let mut sizes = Vec::new();
+    for precision in ["0.0625", "1"] {
+        let path = dir.path().join(format!("p{precision}.mcgv"));
+        let s = path.to_str().unwrap();
+        ok(&run(&[
+            "encode",
+            &sample,
+            "-o",
+            s,
+            "--affine-precision",
+            precision,
+            "--quiet",
+        ]));
+        let info = json(&run(&["inspect", s, "--json"]));
+        sizes.push(info["parts"]["affine coefficients"].as_u64().unwrap());
+    }
+    assert!(sizes[0] > sizes[1], "{sizes:?}");
+    for (flag, value) in [("--affine-bits", "17"), ("--affine-precision", "100")] {
+        let out = run(&["encode", &sample, "-o", "x.mcgv", flag, value]);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("affine"), "{err}");
+    }
+    let retired = run(&["encode", &sample, "-o", "x.mcgv", "--affine-bits", "17"]);
+    assert!(String::from_utf8_lossy(&retired.stderr).contains("--affine-precision"));
+    assert!(!Path::new("x.mcgv").exists());
 }

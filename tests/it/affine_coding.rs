@@ -1,0 +1,104 @@
+//! The affine track's stream part (issue 18): levels under the residuals' quality law, coded as
+//! trajectories. Round trip within the steps, and damaged parts refused.
+
+use crate::cloth::cloth;
+use mcgv_video::motion::{segment, AffineTrack, Partition, SegmentOptions, MIN_AFFINE_STEP};
+use mcgv_video::stream::side_info::{decode_affine, encode_affine};
+use mcgv_video::AnimatedMesh;
+
+/// A cloth (every cluster's maps change every frame) and its k-means partition.
+fn cloth_and_partition() -> (AnimatedMesh, Partition) {
+    let mesh = cloth(16, 24);
+    let options = SegmentOptions {
+        clusters: 6,
+        ..SegmentOptions::default()
+    };
+    let partition = segment(&mesh, &options).unwrap();
+    (mesh, partition)
+}
+
+/// Coefficient `c` of a map `[A | b]` in stored form: `A` as it is, `t = A·centroid + b`.
+fn stored(h: &[f64; 12], centroid: [f64; 3], c: usize) -> f64 {
+    let row = c / 4;
+    match c % 4 {
+        3 => h[c] + (0..3).map(|j| h[4 * row + j] * centroid[j]).sum::<f64>(),
+        _ => h[c],
+    }
+}
+
+#[test]
+fn decoded_maps_are_the_encoders_and_within_half_a_step_of_the_fit() {
+    let (mesh, partition) = cloth_and_partition();
+    let reference = mesh.frame(0);
+    for step in [1e-2, 1e-3, 2.5e-4] {
+        let track = AffineTrack::fit(mesh.frames(), reference, &partition, step).unwrap();
+        let bytes = encode_affine(&track).unwrap();
+        let decoded = decode_affine(&bytes, mesh.frame_count(), &partition, reference).unwrap();
+        assert_eq!(decoded, track, "step {step}");
+        let exact =
+            AffineTrack::fit(mesh.frames(), reference, &partition, MIN_AFFINE_STEP).unwrap();
+        let geometry = track.geometry();
+        for f in 0..mesh.frame_count() {
+            for k in 0..partition.clusters() {
+                let steps = geometry.steps(k, f64::from(track.quantised().step));
+                let (got, want) = (decoded.map(f, k).unwrap(), exact.map(f, k).unwrap());
+                let centroid = geometry.centroid(k);
+                for (c, quantiser) in steps.iter().enumerate() {
+                    let error = (stored(got, centroid, c) - stored(want, centroid, c)).abs();
+                    assert!(
+                        error <= 0.5 * quantiser * (1.0 + 1e-6) + 1e-9,
+                        "step {step}, frame {f}, cluster {k}, coefficient {c}: error {error:e}, \
+                         quantiser step {quantiser:e}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_coarser_step_codes_fewer_bytes() {
+    let (mesh, partition) = cloth_and_partition();
+    let size = |step| {
+        let track = AffineTrack::fit(mesh.frames(), mesh.frame(0), &partition, step).unwrap();
+        encode_affine(&track).unwrap().len()
+    };
+    let (fine, coarse) = (size(1e-4), size(1e-3));
+    assert!(coarse < fine, "{coarse} bytes at 1e-3, {fine} at 1e-4");
+}
+
+#[test]
+fn truncated_or_damaged_parts_are_errors() {
+    let (mesh, partition) = cloth_and_partition();
+    let reference = mesh.frame(0);
+    let frames = mesh.frame_count();
+    let track = AffineTrack::fit(mesh.frames(), reference, &partition, 1e-3).unwrap();
+    let bytes = encode_affine(&track).unwrap();
+    for cut in 0..bytes.len() {
+        assert!(
+            decode_affine(&bytes[..cut], frames, &partition, reference).is_err(),
+            "cut at {cut} of {}",
+            bytes.len()
+        );
+    }
+    // A forged step: NaN, zero, negative, huge.
+    for step in [f32::NAN, 0.0, -1e-3, 1e9] {
+        let mut forged = bytes.clone();
+        forged[..4].copy_from_slice(&step.to_le_bytes());
+        assert!(decode_affine(&forged, frames, &partition, reference).is_err());
+    }
+    // More frames than the bytes can hold: refused before allocating.
+    assert!(decode_affine(&bytes, 1 << 40, &partition, reference).is_err());
+    // Flipped bits in the coded levels: an error, never a panic; the end marker catches nearly all.
+    let (mut errors, mut trials) = (0, 0);
+    for at in (4..bytes.len()).step_by(7) {
+        let mut damaged = bytes.clone();
+        damaged[at] ^= 0x5A;
+        trials += 1;
+        match decode_affine(&damaged, frames, &partition, reference) {
+            Err(_) => errors += 1,
+            Ok(t) => assert_ne!(t, track, "a flipped byte at {at} changed nothing"),
+        }
+    }
+    assert!(errors * 10 >= trials * 9, "{errors} errors in {trials}");
+}
