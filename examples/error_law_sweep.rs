@@ -21,7 +21,10 @@ fn list<T: std::str::FromStr>(var: &str, default: &str) -> Res<Vec<T>> {
     std::env::var(var)
         .unwrap_or_else(|_| default.to_string())
         .split_whitespace()
-        .map(|s| s.parse::<T>().map_err(|_| format!("{var}: bad value {s}").into()))
+        .map(|s| {
+            s.parse::<T>()
+                .map_err(|_| format!("{var}: bad value {s}").into())
+        })
         .collect()
 }
 
@@ -43,9 +46,15 @@ fn main() -> Res<()> {
     let tdct: Vec<u8> = list("TDCT_QUALITIES", "10 30 50 75 90 97")?;
     let skinning = std::env::var("EXTRA_PREDICTOR").is_ok_and(|p| p == "skinning");
     let fresh = !std::path::Path::new(out).exists();
-    let mut file = std::fs::OpenOptions::new().create(true).append(true).open(out)?;
+    let mut file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(out)?;
     if fresh {
-        writeln!(file, "sequence,codec,step,quantiser,quality,bpvf,vertex_rmse")?;
+        writeln!(
+            file,
+            "sequence,codec,step,quantiser,quality,bpvf,vertex_rmse"
+        )?;
     }
     for input in inputs {
         let mesh = read_animation(input, &ReadOptions::default())?;
@@ -62,7 +71,11 @@ fn main() -> Res<()> {
         };
         let mut runs: Vec<(EncodeOptions, String)> = Vec::new();
         for &q in &tdct {
-            let o = EncodeOptions { codec: Codec::Tdct, quality: q, ..base.clone() };
+            let o = EncodeOptions {
+                codec: Codec::Tdct,
+                quality: q,
+                ..base.clone()
+            };
             runs.push((o, format!("tdct,,,{q}")));
         }
         for &s in &steps {

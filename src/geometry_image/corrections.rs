@@ -154,7 +154,9 @@ fn read_varint(r: &mut ByteReader) -> Result<u64> {
             return Ok(v);
         }
     }
-    Err(Error::Stream("a correction number runs past 64 bits".into()))
+    Err(Error::Stream(
+        "a correction number runs past 64 bits".into(),
+    ))
 }
 
 #[cfg(test)]

@@ -127,9 +127,9 @@ pub fn choose(
     (ranges, corrections)
 }
 
-/// The step and offset of axis `a` over a group: the narrowest window that leaves out at most
-/// [`CORRECTION_SHARE`] of the group's values, at the pixel step if it spans at most [`SPAN`] of
-/// them, else at the step that makes it span [`SPAN`] levels.
+/// The step and offset of axis `a` over a group: at the pixel step, centred on the [`SPAN`]-level
+/// window that holds most of the group's values, if it leaves out at most [`CORRECTION_SHARE`] of
+/// them; else centred on the narrowest window that does, at the step that makes it [`SPAN`] levels.
 fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange {
     let mut values: Vec<f64> = group
         .iter()
@@ -143,10 +143,15 @@ fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange 
     values.sort_by(f64::total_cmp);
     let n = values.len();
     let keep = n - (n as f64 * CORRECTION_SHARE).floor() as usize;
-    let (lo, hi) = (0..=n - keep)
-        .map(|i| (values[i], values[i + keep - 1]))
-        .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
-        .unwrap_or((values[0], values[n - 1]));
+    let (held, lo, hi) = fullest_window(&values);
+    let (lo, hi) = if held >= keep {
+        (lo, hi)
+    } else {
+        (0..=n - keep)
+            .map(|i| (values[i], values[i + keep - 1]))
+            .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+            .unwrap_or((values[0], values[n - 1]))
+    };
     let scale = ((hi - lo) / SPAN).max(1.0);
     // f32 rounding must not narrow the step below what the window needs.
     let mut step = (f64::from(pixel_step) * scale) as f32;
@@ -156,6 +161,25 @@ fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange 
     let mid = 0.5 * (lo + hi) * f64::from(pixel_step) / f64::from(step);
     let offset = mid.round().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
     AxisRange::new(step, offset)
+}
+
+/// The window of at most [`SPAN`] pixel steps that holds most of the sorted `values` (in pixel
+/// steps): how many it holds, its lowest and its highest value.
+fn fullest_window(sorted: &[f64]) -> (usize, f64, f64) {
+    let (mut best, mut best_at, mut j) = (0usize, 0usize, 0usize);
+    for i in 0..sorted.len() {
+        j = j.max(i);
+        while j + 1 < sorted.len() && sorted[j + 1] - sorted[i] <= SPAN {
+            j += 1;
+        }
+        if j + 1 - i > best {
+            (best, best_at) = (j + 1 - i, i);
+        }
+    }
+    match best {
+        0 => (0, 0.0, 0.0),
+        _ => (best, sorted[best_at], sorted[best_at + best - 1]),
+    }
 }
 
 /// Serialises the pixel step and every frame's steps and offsets.
@@ -211,7 +235,7 @@ mod tests {
         let r = AxisRange::new(0.01, 7);
         assert_eq!(r.quantise(0.07), MID);
         for i in -127..=127 {
-            let v = 0.07 + i as f32 * 0.0101;
+            let v = 0.07 + i as f32 * 0.0099;
             assert!(r.fits(v), "{v}");
             let back = r.dequantise(r.quantise(v).round());
             assert!((back - v).abs() <= 0.005 + 1e-6, "{v} -> {back}");

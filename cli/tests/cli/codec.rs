@@ -320,7 +320,10 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
     ]);
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("range") && stderr.contains("retired"), "{stderr}");
+    assert!(
+        stderr.contains("range") && stderr.contains("retired"),
+        "{stderr}"
+    );
     ok(&run(&[
         "encode",
         "--codec",
