@@ -258,7 +258,7 @@ mod tests {
         assert_eq!(corrections.frame(0)[0].vertex, 3);
         // Values over ±300 steps: the step widens to fit them in 254 levels, one outlier aside.
         let wide: Vec<[f32; 3]> = frame.iter().map(|r| [3.0 * r[0], 0.0, 0.0]).collect();
-        let (ranges, corrections) = choose(&[wide.clone()], RangeMode::PerFrame, step);
+        let (ranges, corrections) = choose(std::slice::from_ref(&wide), RangeMode::PerFrame, step);
         let r = ranges[0][0];
         assert!(r.step > 2.3 * step && r.step < 2.4 * step, "{r:?}");
         let corrected = corrections.frame(0);
