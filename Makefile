@@ -5,11 +5,13 @@ VENV := .venv
 PY := $(VENV)/bin/python
 CARGO ?= cargo
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+# chromium: the browser test (cli/tests/cli/browser.rs) draws glTF files in it, headless.
 APT_PACKAGES := pkg-config clang libclang-dev libavcodec-dev libavformat-dev libavutil-dev \
 	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools time \
-	fonts-dejavu-core
+	fonts-dejavu-core chromium
 PY_PACKAGES := pymeshlab DracoPy numpy zstandard constriction brotli
-# Node tools of the bench's glTF peers (gltfpack, @gltf-transform, meshoptimizer), pinned by its lockfile.
+# Node tools of the bench's glTF peers (gltfpack, @gltf-transform, meshoptimizer) and of the tests
+# (gltf-validator, three), pinned by its lockfile.
 NODE_DIR := scripts/node
 
 .PHONY: help deps apt-deps venv node-deps demo test bench fuzz install clean

@@ -3,7 +3,7 @@
 # sweep of mcgv-video (JPEG and MPEG-4) and of the peer codecs (Draco, zstd, PCA, Dynapack-style with
 # zstd and with an arithmetic coder, gltfpack raw and Brotli'd, meshoptimizer's vertex codec) over
 # media/ and, when present, ../shared/media, then a shorter sweep of the encoder variants (skinning
-# predictor, decimation segmentation, both; JPEG q 10 and 50, MPEG-4 qscale 4 and 16, TDCT q 10 and 50
+# predictor, decimation segmentation, both; every codec at quality 10 and 50
 # when the binary has it), then one RD plot per sequence, the README tables and the peers' page:
 #   bench-out/motion.txt, sweep.csv, sweep-variants.csv, peers.csv, peers.skipped.csv (what a peer
 #   could not take, and why), plots/SEQUENCE.png, table.md, peers.md
@@ -34,7 +34,7 @@ VARIANTS=default bash scripts/sweep.sh bench-out/sweep.csv "${inputs[@]}"
 csvs=(bench-out/sweep.csv)
 variants=${BENCH_VARIANTS-"skinning decimation skinning+decimation"}
 if [ -n "$variants" ]; then
-    VARIANTS=$variants JPEG_QUALITIES="10 50" QSCALES="4 16" TDCT_QUALITIES="10 50" \
+    VARIANTS=$variants JPEG_QUALITIES="10 50" MPEG4_QUALITIES="10 50" TDCT_QUALITIES="10 50" \
         bash scripts/sweep.sh bench-out/sweep-variants.csv "${inputs[@]}"
     csvs+=(bench-out/sweep-variants.csv)
 fi

@@ -32,5 +32,10 @@ for run in default mpeg4 jpeg; do
         'BEGIN { printf "%-7s %-14s %10d %8.3f %12.3f %12.5f %8.2f %8.2f\n", c, s, b, bpvf, r * 1e4, h, t1 - t0, t2 - t1 }'
 done
 echo "(* the default codec)"
+glb="$out/$(basename "${sample%.*}")-decoded.glb"
+like=(); case $sample in *.glb | *.gltf) like=(--like "$sample") ;; esac
+"$bin" decode "$out/sample-default.mcgv" -o "$glb" "${like[@]}" --quiet
 echo
 echo "streams and decoded OBJ frames are in $out/; look inside with: $bin inspect $out/sample-jpeg.mcgv --png $out/png"
+echo "the default stream decoded to glTF (morph targets, UVs, the source's materials): $glb; drop it on https://gltf-viewer.donmccurdy.com/"
+echo "or open it in Blender (File > Import > glTF 2.0) and play the timeline"

@@ -14,6 +14,7 @@ mpeg4+skinning) are series of their own, all counted as mcgv-video. When a seque
 things follow: which mcgv-video series has the lowest RMSE at equal rate, over which rates (on the
 same log grid), and a table of bpvf / RMSE per image-codec setting with one column per variant
 (default = affine predictor, k-means segmentation), so that variants are compared at the same settings.
+Also per sequence, the default encoder's bpvf / RMSE at each `--quality`, one column per codec.
 Last, speed and peak memory for the largest sequence (V x F),
 or for --speed SEQUENCE: whole-process figures as the CSV records them.
 Only standard-library Python, so it also runs outside the virtualenv.
@@ -159,7 +160,7 @@ def sequence_section(name, rows):
         out.append(f"| {label(codec)} | {len(pts)} | {lo:.3g}–{hi:.3g} | {cells} | "
                    f"{e4(best_e)}{kg} at {best_b:.3g} |")
     lossless = min((b for c, pts in by_codec.items() for b, e, _k in pts if e == 0), default=None)
-    out += ["", closing_line(fronts, lossless), ""]
+    out += ["", closing_line(fronts, lossless), ""] + quality_table(rows)
     if any(ours(c) and split(c)[1] for c in by_codec):
         out += [best_series_line(fronts), ""] + variant_table(rows) + [""]
     return out
@@ -202,6 +203,26 @@ def best_series_line(fronts):
         parts.append(f"{codec} at " + ", ".join(f"{a:.3g}–{b:.3g}" for a, b in spans))
     return ("Best mcgv-video series (lowest RMSE at equal rate, where two or more are measured): "
             + "; ".join(parts) + " bpvf.")
+
+
+def quality_table(rows):
+    """bpvf / RMSE x 1e-4 of the default encoder per `--quality`, one column per codec: one quality
+    should mean about the same error whichever codec (the one error law)."""
+    cells = defaultdict(dict)
+    for r in rows:
+        words = r["setting"].split()
+        if r["codec"] in OURS and len(words) == 2 and words[0] == "quality":
+            cells[int(float(words[1]))][r["codec"]] = r
+    if not cells:
+        return []
+    cols = [c for c in OURS if any(c in v for v in cells.values())]
+    out = ["bpvf / RMSE ×1e-4 per `--quality` (default encoder):", "",
+           "| quality | " + " | ".join(cols) + " |", "|---|" + "---|" * len(cols)]
+    for q in sorted(cells):
+        row = cells[q]
+        out.append(f"| {q} | " + " | ".join(
+            "—" if c not in row else f"{row[c]['bpvf']:.3g} / {row[c]['rmse'] * 1e4:.3g}" for c in cols) + " |")
+    return out + [""]
 
 
 def variant_table(rows):

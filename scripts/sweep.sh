@@ -1,24 +1,28 @@
 #!/usr/bin/env bash
-# Rate sweep: encode each given animation with JPEG at several qualities and MPEG-4 at several
-# quantisers, and append one CSV row per encoding (bpvf counts every byte of the file; RMSE is the
+# Rate sweep: encode each given animation with JPEG, MPEG-4 and the temporal DCT at several
+# qualities (and MPEG-4 at fixed quantisers, when asked), and append one CSV row per encoding (bpvf counts every byte of the file; RMSE is the
 # papers' surface measure, as a fraction of the bbox diagonal). Times are whole-process figures from
 # GNU time: wall seconds, CPU seconds (user + system, steadier than wall on a shared machine) and
 # peak resident memory.
 #   scripts/sweep.sh OUT.csv INPUT...
-# env: JPEG_QUALITIES, QSCALES, TDCT_QUALITIES, VARIANTS, MCGV_BIN
+# env: JPEG_QUALITIES, MPEG4_QUALITIES, QSCALES, TDCT_QUALITIES, VARIANTS, MCGV_BIN
 #   VARIANTS   space-separated encoder variants, each a '+'-joined list of
 #              skinning (--predictor skinning) and decimation (--segmentation decimation), or
 #              `default` (no extra flag). Unset: the default encoder only. A variant's rows are
 #              labelled in the codec column as CODEC+VARIANT (mpeg4+skinning, jpeg+skinning+decimation),
 #              so plots and tables treat each as its own series; the CSV columns stay the same.
-#   JPEG_QUALITIES, QSCALES  unset: the defaults below; set but empty: no run of that codec.
+#   JPEG_QUALITIES, MPEG4_QUALITIES  --quality values; unset: the defaults below (the five
+#              qualities of the rate-control issue, and 97 for MPEG-4's top end); set but empty: none.
+#   QSCALES    `--codec mpeg4 --qscale N` runs (the codec's own quantiser, overriding the one
+#              --quality picks); unset or empty: none.
 #   TDCT_QUALITIES  --quality values of `--codec tdct` runs, made only when the binary's
 #              `encode --help` mentions tdct (default: the JPEG qualities); empty: none.
 set -euo pipefail
 bin=${MCGV_BIN:-target/release/mcgv-video}
 out=$1; shift
-qualities=${JPEG_QUALITIES-"5 10 20 35 50 75"}
-qscales=${QSCALES-"2 3 4 8 16 31"}
+qualities=${JPEG_QUALITIES-"10 30 50 75 90"}
+mpeg4_qualities=${MPEG4_QUALITIES-"10 30 50 75 90 97"}
+qscales=${QSCALES-}
 tdct_qualities=${TDCT_QUALITIES-$qualities}
 variants=${VARIANTS:-default}
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -55,6 +59,7 @@ for input in "$@"; do
     name=$(basename "${input%/}"); name=${name%.*}
     runs=()
     for q in $qualities; do runs+=("jpeg --quality $q"); done
+    for q in $mpeg4_qualities; do runs+=("mpeg4 --quality $q"); done
     for q in $qscales; do runs+=("mpeg4 --qscale $q"); done
     if [ "$tdct" = yes ]; then
         for q in $tdct_qualities; do runs+=("tdct --quality $q"); done

@@ -9,9 +9,10 @@ use crate::codec::{Codec, Plane, ResidualDecoder, StreamLayout};
 use crate::error::{Error, Result};
 use crate::first_frame;
 use crate::geometry_image::FrameRanges;
-use crate::mesh::{AnimatedMesh, Point, Triangle};
+use crate::mesh::{AnimatedMesh, Attributes, Point, Triangle};
 use crate::motion::{predict_frame, AffineTrack, Partition, PredictorKind, SkinningWeights};
 use crate::progress::{Progress, Silent};
+use crate::stream::attributes::decode_attributes;
 use crate::stream::container::{ContainerReader, Tag};
 use crate::stream::frame_index::ChunkEntry;
 use crate::stream::header::Header;
@@ -37,6 +38,7 @@ pub struct Decoder<R> {
     track: AffineTrack,
     weights: Option<SkinningWeights>,
     residuals: Box<dyn ResidualDecoder<R>>,
+    attributes: Attributes,
 }
 
 impl Decoder<BufReader<File>> {
@@ -75,6 +77,10 @@ impl<R: Read + Seek> Decoder<R> {
                 header.triangles
             )));
         }
+        let attributes = match reader.has(Tag::ATTRIBUTES) {
+            true => decode_attributes(&reader.part(Tag::ATTRIBUTES)?, &triangles, &reference)?,
+            false => Attributes::default(),
+        };
         let labels = side_info::decode_partition(
             &reader.part(Tag::PARTITION)?,
             v,
@@ -117,6 +123,7 @@ impl<R: Read + Seek> Decoder<R> {
             track,
             weights,
             residuals,
+            attributes,
         })
     }
 
@@ -125,7 +132,12 @@ impl<R: Read + Seek> Decoder<R> {
         &self.header
     }
 
-    /// The shared connectivity.
+    /// Texture coordinates and materials, in the decoder's order (empty when the stream has none).
+    pub fn attributes(&self) -> &Attributes {
+        &self.attributes
+    }
+
+    /// The triangles of every frame, in the decoder's order.
     pub fn triangles(&self) -> &[Triangle] {
         &self.triangles
     }
@@ -249,7 +261,7 @@ impl<R: Read + Seek> Decoder<R> {
             .collect::<Result<Vec<_>>>()?;
         self.residuals
             .add_all(&mut self.reader, &mut out, progress)?;
-        AnimatedMesh::new(self.triangles.clone(), out)
+        AnimatedMesh::new(self.triangles.clone(), out)?.with_attributes(self.attributes.clone())
     }
 
     fn predict(&self, f: usize) -> Result<Vec<Point>> {

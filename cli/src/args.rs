@@ -151,6 +151,9 @@ pub struct EncodeArgs {
     /// the same residual energy at 12 for about 60 % of the weights' bits).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u8).range(2..=31))]
     pub weight_bits: u8,
+    /// Bits per texture coordinate over each UV set's bounding box (inputs with UVs only).
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u8).range(1..=24))]
+    pub uv_bits: u8,
     /// Retired with stream version 2 (the step now follows --quality, not each frame's range);
     /// kept hidden so that old scripts get a clear error rather than "unexpected argument".
     #[arg(long, hide = true)]
@@ -221,15 +224,40 @@ pub struct DecodeArgs {
     /// glTF output: frames per second of the animation (the stream does not record the source's).
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// glTF output: copy the materials, textures and node name of this glTF file (the encoded
+    /// source), so the decoded asset renders as the source did.
+    #[arg(long, value_name = "SOURCE.glb")]
+    pub like: Option<PathBuf>,
     /// Decode only this frame (numbered from 0).
     #[arg(long)]
     pub frame: Option<usize>,
+    /// Decode only frames A to B - 1 (numbered from 0; `10..20` is ten frames): a part of a long
+    /// clip, e.g. as glTF with fewer morph targets. OBJ frames keep their numbers.
+    #[arg(long, value_name = "A..B", conflicts_with = "frame", value_parser = parse_frame_range)]
+    pub frames: Option<std::ops::Range<usize>>,
     /// Decode into a folder that already holds files, removing the frame_*.obj of an earlier decode.
     #[arg(long, short = 'y')]
     pub force: bool,
     /// tdct streams: decode only the first N temporal-DCT bands (a coarser, progressive preview).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub bands: Option<u64>,
+}
+
+/// `A..B` with A < B, for `decode --frames`.
+fn parse_frame_range(text: &str) -> std::result::Result<std::ops::Range<usize>, String> {
+    let (a, b) = text
+        .split_once("..")
+        .ok_or_else(|| format!("{text}: expected A..B, e.g. 0..24"))?;
+    let number = |t: &str| {
+        t.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("{text}: `{t}` is not a frame number"))
+    };
+    let (a, b) = (number(a)?, number(b)?);
+    if a >= b {
+        return Err(format!("{text}: the range is empty (A must be below B)"));
+    }
+    Ok(a..b)
 }
 
 /// `inspect` arguments.

@@ -126,7 +126,7 @@ pub fn write_pc2_with_base(
         )));
     }
     create_parent(path)?;
-    mcgv_video::mesh::write_obj_frame(mesh.triangles(), mesh.frame(0), &base)?;
+    mcgv_video::mesh::io::write_obj_mesh_frame(mesh, 0, &base)?;
     mcgv_video::mesh::write_pc2(mesh, path)?;
     Ok(base)
 }

@@ -20,11 +20,13 @@ use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
 use crate::stream::frame_index::{FrameChunk, FrameIndex};
 use crate::stream::side_info;
+use rayon::prelude::*;
 use std::io::{Read, Seek};
 use std::time::Instant;
 
-/// What a picture codec (one file per codec) tells the geometry-video coder.
-pub trait PictureCodec {
+/// What a picture codec (one file per codec) tells the geometry-video coder. `Sync`: groups of
+/// pictures are coded on several threads at once.
+pub trait PictureCodec: Sync {
     /// The codec's stream id.
     fn codec(&self) -> Codec;
     /// How residual ranges are shared between frames.
@@ -37,11 +39,13 @@ pub trait PictureCodec {
     fn quantiser(&self, opts: &EncodeOptions) -> u8;
     /// Frames per group of pictures (1 for intra codecs).
     fn gop(&self, opts: &EncodeOptions) -> u32;
-    /// An encoder for `width`×`height` pictures.
+    /// An encoder for `width`×`height` pictures whose first picture is frame `first_frame` of the
+    /// sequence (a key frame: every group of pictures gets its own encoder).
     fn encoder(
         &self,
         width: u32,
         height: u32,
+        first_frame: usize,
         opts: &EncodeOptions,
     ) -> Result<Box<dyn PictureEncoder>>;
     /// A decoder for `width`×`height` pictures; `setup` is the stream's codec set-up part.
@@ -184,33 +188,70 @@ impl<P: PictureCodec> ResidualEncoder for Encoder<P> {
     }
 }
 
-/// Pads, tiles and codes every frame's images in order.
+/// Pads, tiles and codes every frame's images, one group of pictures per task.
+///
+/// Groups are independent by construction (a group starts at a key frame and its padding starts
+/// afresh), so they run on rayon's threads; each gets its own picture encoder and the chunks are
+/// joined in frame order. The encoders' set-up parts must agree, as one encoder's frames do.
 fn code_pictures(
     codec: &dyn PictureCodec,
     images: &GeometryImages,
     input: &ResidualInput,
 ) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
-    let (w, h) = (images.lattice.0 as usize, images.lattice.1 as usize);
-    let mut encoder = codec.encoder((3 * w) as u32, h as u32, input.options)?;
-    let mut previous: Option<[Vec<f32>; 3]> = None;
-    for (f, frame) in input.residuals.iter().enumerate() {
-        // A new group starts from a key frame: its free pixels need no temporal continuity.
-        let prev = previous.as_ref().filter(|_| images.continues(f));
-        let padded = images.padded(frame, f, prev)?;
-        encoder.push(&tile::compose([&padded[0], &padded[1], &padded[2]], w, h))?;
-        previous = Some(padded);
-        input.progress.frames(1);
+    let frames = input.residuals.len();
+    let groups: Vec<std::ops::Range<usize>> = (0..frames)
+        .step_by(images.gop.max(1))
+        .map(|start| start..(start + images.gop.max(1)).min(frames))
+        .collect();
+    let coded: Vec<Result<(Vec<u8>, Vec<FrameChunk>)>> = groups
+        .into_par_iter()
+        .map(|group| code_group(codec, images, input, group))
+        .collect();
+    let mut setup: Option<Vec<u8>> = None;
+    let mut chunks = Vec::with_capacity(frames);
+    for group in coded {
+        let (group_setup, group_chunks) = group?;
+        match &setup {
+            None => setup = Some(group_setup),
+            Some(s) if *s != group_setup => {
+                return Err(Error::Codec(format!(
+                    "the {} encoders of two groups of pictures gave different set-ups",
+                    codec.codec().name()
+                )))
+            }
+            Some(_) => {}
+        }
+        chunks.extend(group_chunks);
     }
-    let (setup, chunks) = encoder.finish()?;
-    if chunks.len() != input.residuals.len() {
+    if chunks.len() != frames {
         return Err(Error::Codec(format!(
             "the {} encoder gave {} pictures for {} frames",
             codec.codec().name(),
             chunks.len(),
-            input.residuals.len()
+            frames
         )));
     }
-    Ok((setup, chunks))
+    Ok((setup.unwrap_or_default(), chunks))
+}
+
+/// Pads, tiles and codes the frames of one group of pictures in order, from its key frame.
+fn code_group(
+    codec: &dyn PictureCodec,
+    images: &GeometryImages,
+    input: &ResidualInput,
+    group: std::ops::Range<usize>,
+) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
+    let (w, h) = (images.lattice.0 as usize, images.lattice.1 as usize);
+    let mut encoder = codec.encoder((3 * w) as u32, h as u32, group.start, input.options)?;
+    let mut previous: Option<[Vec<f32>; 3]> = None;
+    for f in group {
+        let prev = previous.as_ref().filter(|_| images.continues(f));
+        let padded = images.padded(&input.residuals[f], f, prev)?;
+        encoder.push(&tile::compose([&padded[0], &padded[1], &padded[2]], w, h))?;
+        previous = Some(padded);
+        input.progress.frames(1);
+    }
+    encoder.finish()
 }
 
 /// The geometry-image side of a stream: what the decoder reads before any picture.

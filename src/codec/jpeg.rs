@@ -131,6 +131,7 @@ impl PictureCodec for Pictures {
         &self,
         _width: u32,
         _height: u32,
+        _first_frame: usize,
         opts: &EncodeOptions,
     ) -> Result<Box<dyn PictureEncoder>> {
         Ok(Box::new(FrameEncoder {

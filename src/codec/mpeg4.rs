@@ -95,6 +95,18 @@ pub struct Encoder {
 impl Encoder {
     /// Opens an encoder for `width × height` planes (sides even, at most 8191).
     pub fn new(width: u32, height: u32, options: &Mpeg4Options) -> Result<Self> {
+        Self::starting_at(width, height, options, 0)
+    }
+
+    /// [`Encoder::new`] for a sequence whose first plane is frame `first_frame` of a longer one:
+    /// its time stamps continue there, so a group of pictures coded alone carries the same time
+    /// code (and so the same bytes) as when one encoder codes the whole sequence.
+    pub fn starting_at(
+        width: u32,
+        height: u32,
+        options: &Mpeg4Options,
+        first_frame: usize,
+    ) -> Result<Self> {
         init()?;
         check_size(width, height)?;
         if !(1..=31).contains(&options.qscale) {
@@ -143,7 +155,8 @@ impl Encoder {
             width,
             height,
             lambda,
-            next_pts: 0,
+            next_pts: i64::try_from(first_frame)
+                .map_err(|_| Error::Codec(format!("mpeg4 first frame {first_frame} too large")))?,
         })
     }
 
@@ -367,6 +380,7 @@ impl PictureCodec for Pictures {
         &self,
         width: u32,
         height: u32,
+        first_frame: usize,
         opts: &EncodeOptions,
     ) -> Result<Box<dyn PictureEncoder>> {
         let options = Mpeg4Options {
@@ -374,7 +388,7 @@ impl PictureCodec for Pictures {
             gop: opts.gop,
         };
         Ok(Box::new(PacketEncoder {
-            encoder: Encoder::new(width, height, &options)?,
+            encoder: Encoder::starting_at(width, height, &options, first_frame)?,
             packets: Vec::new(),
         }))
     }

@@ -3,6 +3,7 @@
 //! behind [`ResidualEncoder`](crate::codec::ResidualEncoder), and the container only sees parts.
 
 pub mod analysis;
+mod attributes;
 mod options;
 
 pub use analysis::{Prediction, SegmentationReport};
@@ -103,7 +104,12 @@ pub fn encode_with_progress(
     let atlas = coded.atlas;
     let header = header(mesh, opts, &partition, &coded.params, atlas.as_ref());
     let parts = (coded.before_predictor, coded.after_predictor);
-    let container = assemble(&header, ff.bytes, mesh, &partition, &prediction, parts)?;
+    let mut leading = vec![Part::whole(Tag::FIRST_FRAME, ff.bytes)];
+    if !mesh.attributes().is_empty() {
+        let bytes = attributes::encode(mesh, &leading[0].bytes, opts.uv_bits)?;
+        leading.push(Part::whole(Tag::ATTRIBUTES, bytes));
+    }
+    let container = assemble(&header, leading, mesh, &partition, &prediction, parts)?;
     clock.lap("side information");
     let report = EncodeReport {
         parts: container.part_sizes(),
@@ -180,25 +186,23 @@ fn header(
     }
 }
 
-/// The container in file order: header, first frame, partition, the codec's leading parts, the
+/// The container in file order: header, first frame (and attributes), partition, the codec's leading parts, the
 /// predictor (affine track, skinning weights), the codec's other parts.
 fn assemble(
     header: &Header,
-    first_frame: Vec<u8>,
+    leading: Vec<Part>,
     mesh: &AnimatedMesh,
     partition: &Partition,
     prediction: &Prediction,
     (before, after): (Vec<Part>, Vec<Part>),
 ) -> Result<ContainerWriter> {
     let triangles = mesh.triangles();
-    let mut parts = vec![
-        Part::whole(Tag::HEADER, header.to_bytes()),
-        Part::whole(Tag::FIRST_FRAME, first_frame),
-        Part::whole(
-            Tag::PARTITION,
-            side_info::encode_partition(partition.labels(), partition.clusters(), triangles)?,
-        ),
-    ];
+    let mut parts = vec![Part::whole(Tag::HEADER, header.to_bytes())];
+    parts.extend(leading);
+    parts.push(Part::whole(
+        Tag::PARTITION,
+        side_info::encode_partition(partition.labels(), partition.clusters(), triangles)?,
+    ));
     parts.extend(before);
     parts.push(Part::whole(
         Tag::AFFINE,

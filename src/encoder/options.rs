@@ -46,6 +46,8 @@ pub struct EncodeOptions {
     /// Quantiser step (tdct) or pixel step (one grey level, image codecs) as a fraction of the
     /// first frame's bounding-box diagonal; `None` derives it from `quality`.
     pub step: Option<f64>,
+    /// Bits per texture coordinate over each set's bounding box (1..=24; inputs with UVs only).
+    pub uv_bits: u8,
 }
 
 impl Default for EncodeOptions {
@@ -66,6 +68,7 @@ impl Default for EncodeOptions {
             predictor: PredictorKind::Affine,
             weight_bits: motion::WEIGHT_BITS,
             step: None,
+            uv_bits: 12,
         }
     }
 }
@@ -122,6 +125,7 @@ impl EncodeOptions {
             predictor: header.predictor,
             weight_bits: weight_bits.unwrap_or(motion::WEIGHT_BITS),
             step: None,
+            uv_bits: 12,
         })
     }
 
@@ -174,6 +178,9 @@ impl EncodeOptions {
         }
         if self.gop == 0 {
             return Err(Error::option("gop", "must be at least 1"));
+        }
+        if !(1..=24).contains(&self.uv_bits) {
+            return Err(Error::option("uv_bits", "must be between 1 and 24"));
         }
         Ok(())
     }

@@ -82,7 +82,7 @@ pub fn clips(input: &str, fps: Option<f64>) -> Result<Vec<gltf::Clip>> {
 /// Parses one OBJ held in memory as a one-frame animation; `name` only labels errors.
 pub fn parse_obj(text: &str, name: &Path) -> Result<AnimatedMesh> {
     let frame = obj::parse_obj(text, name)?;
-    AnimatedMesh::new(frame.triangles, vec![frame.positions])
+    AnimatedMesh::new(frame.triangles, vec![frame.positions])?.with_attributes(frame.attributes)
 }
 
 /// Parses a PC2 point cache held in memory, with the triangles of `base_obj` (an OBJ's text);
@@ -120,7 +120,8 @@ pub fn write_obj_sequence_from(mesh: &AnimatedMesh, dir: &Path, first: usize) ->
         .max(4);
     for (f, frame) in mesh.frames().iter().enumerate() {
         let path = dir.join(format!("frame_{:0digits$}.obj", first + f));
-        write_atomic(&path, obj::obj_text(mesh.triangles(), frame).as_bytes())?;
+        let text = obj::obj_text(mesh.triangles(), frame, mesh.attributes());
+        write_atomic(&path, text.as_bytes())?;
     }
     Ok(())
 }
@@ -132,7 +133,19 @@ pub fn write_obj_frame(
     positions: &[super::Point],
     path: &Path,
 ) -> Result<()> {
-    write_atomic(path, obj::obj_text(triangles, positions).as_bytes())
+    let text = obj::obj_text(triangles, positions, &super::Attributes::default());
+    write_atomic(path, text.as_bytes())
+}
+
+/// Writes frame `frame` of `mesh` as an OBJ file with its texture coordinates (`vt`) and materials
+/// (`usemtl`), like the files of [`write_obj_sequence`].
+pub fn write_obj_mesh_frame(mesh: &AnimatedMesh, frame: usize, path: &Path) -> Result<()> {
+    let positions = mesh
+        .frames()
+        .get(frame)
+        .ok_or_else(|| Error::Usage(format!("frame {frame} of {}", mesh.frame_count())))?;
+    let text = obj::obj_text(mesh.triangles(), positions, mesh.attributes());
+    write_atomic(path, text.as_bytes())
 }
 
 /// Writes the animation's positions as a PC2 point cache (start frame 0, one sample per frame).

@@ -17,8 +17,8 @@ pub use attributes::Attributes;
 pub use gltf::Clip;
 pub use gltf_write::{write_gltf, GltfOptions};
 pub use io::{
-    clips, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_sequence,
-    write_pc2, ReadOptions,
+    clips, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_mesh_frame,
+    write_obj_sequence, write_pc2, ReadOptions,
 };
 pub use summary::Summary;
 
@@ -38,6 +38,7 @@ pub type Triangle = [u32; 3];
 pub struct AnimatedMesh {
     triangles: Vec<Triangle>,
     frames: Vec<Vec<Point>>,
+    attributes: Attributes,
 }
 
 impl AnimatedMesh {
@@ -75,7 +76,24 @@ impl AnimatedMesh {
                 )));
             }
         }
-        Ok(Self { triangles, frames })
+        Ok(Self {
+            triangles,
+            frames,
+            attributes: Attributes::default(),
+        })
+    }
+
+    /// The same mesh with texture coordinates and materials (checked against its vertices and
+    /// triangles).
+    pub fn with_attributes(mut self, attributes: Attributes) -> Result<Self> {
+        attributes.check(self.vertex_count(), self.triangles.len())?;
+        self.attributes = attributes;
+        Ok(self)
+    }
+
+    /// Texture coordinates and materials (empty for inputs that have none).
+    pub fn attributes(&self) -> &Attributes {
+        &self.attributes
     }
 
     /// The triangles, shared by every frame.
@@ -160,6 +178,14 @@ impl AnimatedMesh {
             .iter()
             .map(|f| order.iter().map(|&old| f[old as usize]).collect())
             .collect();
-        Ok(Self { triangles, frames })
+        let mut attributes = self.attributes.clone();
+        for set in &mut attributes.texcoords {
+            *set = order.iter().map(|&old| set[old as usize]).collect();
+        }
+        Ok(Self {
+            triangles,
+            frames,
+            attributes,
+        })
     }
 }

@@ -5,11 +5,18 @@
 //! error measures all rely on vertex `i` of one frame being vertex `i` of the next). `tobj` splits the
 //! file into models at every `o`/`g`/`usemtl`, renumbers each model's vertices in order of first use
 //! and drops unused ones, and does not expose the original indices, so that order cannot be recovered
-//! from its output. Only `v` and `f` lines matter here; everything else (normals, texture
-//! coordinates, groups, materials, lines, points) is skipped. Polygons become triangle fans around
-//! their first corner, as `tobj` triangulates them; `tests/mesh_io.rs` checks the two agree.
+//! from its output. `v`, `f`, `vt` and `usemtl` lines matter here; everything else (normals, groups,
+//! lines, points) is skipped. Polygons become triangle fans around their first corner, as `tobj`
+//! triangulates them; `tests/mesh_io.rs` checks the two agree.
+//!
+//! Texture coordinates are per vertex in [`Attributes`] (as in glTF, `v` pointing down: OBJ's `vt`
+//! is flipped on the way in and out). They are kept when every face names a `vt` and each vertex
+//! gets one coordinate from all its corners (files whose seams split vertices, as game exporters
+//! write them); a file whose corners give a vertex several is read without them, since splitting
+//! vertices would break the vertex-for-vertex match of the frames. `usemtl` names each triangle's
+//! material (`default` before the first).
 
-use super::{AnimatedMesh, Point, Triangle};
+use super::{AnimatedMesh, Attributes, Point, Triangle};
 use crate::error::{Error, Result};
 use std::borrow::Cow;
 use std::cmp::Ordering;
@@ -22,6 +29,96 @@ pub(crate) struct ObjFrame {
     pub positions: Vec<Point>,
     /// Faces triangulated as fans, indices into `positions`.
     pub triangles: Vec<Triangle>,
+    /// Per-vertex `vt` coordinates and `usemtl` materials, when the file has them.
+    pub attributes: Attributes,
+}
+
+/// The `vt` and `usemtl` lines of a file and what each triangle corner takes from them.
+#[derive(Default)]
+struct Looks {
+    texcoords: Vec<[f32; 2]>,
+    /// Per triangle, each corner's 1-based `vt` reference (None: the corner has none).
+    corners: Vec<[Option<i64>; 3]>,
+    names: Vec<String>,
+    current: Option<u32>,
+    materials: Vec<Option<u32>>,
+}
+
+impl Looks {
+    fn texcoord<'a>(
+        &mut self,
+        mut words: impl Iterator<Item = &'a str>,
+    ) -> std::result::Result<(), String> {
+        let mut uv = [0f32; 2];
+        for c in &mut uv {
+            let word = words.next().unwrap_or("0");
+            *c = word
+                .parse()
+                .map_err(|_| format!("`{word}` is not a number"))?;
+        }
+        if uv.iter().any(|c| !c.is_finite()) {
+            return Err("a texture coordinate is not a finite number".into());
+        }
+        self.texcoords.push([uv[0], 1.0 - uv[1]]);
+        Ok(())
+    }
+
+    fn use_material(&mut self, name: &str) {
+        let index = match self.names.iter().position(|n| n == name) {
+            Some(i) => i,
+            None => {
+                self.names.push(name.to_string());
+                self.names.len() - 1
+            }
+        };
+        self.current = Some(index as u32);
+    }
+
+    /// The attributes of `triangles` (0-based), or none of a kind the file does not give fully.
+    fn attributes(mut self, triangles: &[Triangle], vertices: usize) -> Attributes {
+        let count = self.texcoords.len() as i64;
+        let mut per_vertex: Vec<Option<[f32; 2]>> = vec![None; vertices];
+        let mut consistent = !self.texcoords.is_empty();
+        'faces: for (t, corners) in triangles.iter().zip(&self.corners) {
+            for (&v, vt) in t.iter().zip(corners) {
+                let uv = vt
+                    .map(|i| if i < 0 { count + i } else { i - 1 })
+                    .filter(|i| (0..count).contains(i))
+                    .map(|i| self.texcoords[i as usize]);
+                let slot = &mut per_vertex[v as usize];
+                match (uv, *slot) {
+                    (None, _) => consistent = false,
+                    (Some(uv), None) => *slot = Some(uv),
+                    (Some(uv), Some(had)) => consistent &= uv == had,
+                }
+                if !consistent {
+                    break 'faces;
+                }
+            }
+        }
+        let mut attributes = Attributes::default();
+        if consistent {
+            let set = per_vertex
+                .into_iter()
+                .map(Option::unwrap_or_default)
+                .collect();
+            attributes.texcoords.push(set);
+        }
+        if !self.names.is_empty() {
+            let default = self.materials.iter().any(Option::is_none);
+            if default {
+                self.names.push("default".into());
+            }
+            let fallback = self.names.len() as u32 - 1;
+            attributes.materials = self
+                .materials
+                .iter()
+                .map(|m| m.unwrap_or(fallback))
+                .collect();
+            attributes.material_names = self.names;
+        }
+        attributes
+    }
 }
 
 /// Reads and parses one OBJ file.
@@ -36,20 +133,22 @@ pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
     // Corners keep the 1-based or negative OBJ index until all positions are known, because a face
     // may name a vertex defined further down.
     let mut triangles: Vec<[(i64, usize); 3]> = Vec::new();
-    let mut corners: Vec<i64> = Vec::new();
+    let mut corners: Vec<(i64, Option<i64>)> = Vec::new();
+    let mut looks = Looks::default();
     for (line_no, line) in logical_lines(text) {
         let at = |what: String| line_error(path, line_no, what);
         let mut words = line.split_whitespace();
         match words.next() {
             Some("v") => positions.push(parse_vertex(words, positions.len()).map_err(at)?),
+            Some("vt") => looks.texcoord(words).map_err(at)?,
+            Some("usemtl") => looks.use_material(words.next().unwrap_or("")),
             Some("f") => {
                 parse_face(words, positions.len(), &mut corners).map_err(at)?;
                 for k in 1..corners.len() - 1 {
-                    triangles.push([
-                        (corners[0], line_no),
-                        (corners[k], line_no),
-                        (corners[k + 1], line_no),
-                    ]);
+                    let fan = [corners[0], corners[k], corners[k + 1]];
+                    triangles.push(fan.map(|(v, _)| (v, line_no)));
+                    looks.corners.push(fan.map(|(_, vt)| vt));
+                    looks.materials.push(looks.current);
                 }
             }
             _ => {}
@@ -66,9 +165,11 @@ pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
         )));
     }
     let triangles = resolve_corners(triangles, positions.len(), path)?;
+    let attributes = looks.attributes(&triangles, positions.len());
     Ok(ObjFrame {
         positions,
         triangles,
+        attributes,
     })
 }
 
@@ -116,15 +217,18 @@ fn parse_vertex<'a>(
 }
 
 /// The corners of an `f` line (the words after `f`) into `corners` as 1-based indices, negative
-/// ones resolved against the `read` vertices so far; a face needs at least three.
+/// ones resolved against the `read` vertices so far, each with its `vt` reference if any; a face
+/// needs at least three.
 fn parse_face<'a>(
     words: impl Iterator<Item = &'a str>,
     read: usize,
-    corners: &mut Vec<i64>,
+    corners: &mut Vec<(i64, Option<i64>)>,
 ) -> std::result::Result<(), String> {
     corners.clear();
     for word in words {
-        let index = word.split('/').next().unwrap_or("");
+        let mut parts = word.split('/');
+        let index = parts.next().unwrap_or("");
+        let texcoord = parts.next().and_then(|t| t.parse::<i64>().ok());
         let index: i64 = index
             .parse()
             .map_err(|_| format!("`{word}` is not a vertex reference"))?;
@@ -132,11 +236,12 @@ fn parse_face<'a>(
             return Err("vertex index 0 (OBJ counts from 1)".into());
         }
         // A negative index counts back from the last vertex read so far.
-        corners.push(if index < 0 {
+        let index = if index < 0 {
             read as i64 + index + 1
         } else {
             index
-        });
+        };
+        corners.push((index, texcoord));
     }
     if corners.len() < 3 {
         return Err(format!(
@@ -209,7 +314,7 @@ pub(crate) fn read_sequence(files: &[PathBuf]) -> Result<AnimatedMesh> {
         check_same_mesh(&first.triangles, frames[0].len(), first_path, &frame, path)?;
         frames.push(frame.positions);
     }
-    AnimatedMesh::new(first.triangles, frames)
+    AnimatedMesh::new(first.triangles, frames)?.with_attributes(first.attributes)
 }
 
 /// The error naming `path` and the first way its mesh differs from the first frame's.
@@ -349,16 +454,41 @@ fn compare_numbers(a: &str, b: &str) -> Ordering {
 }
 
 /// One frame as OBJ text: `v` lines in vertex order (shortest text that reads back to the same
-/// `f32`), then `f` lines.
-pub(crate) fn obj_text(triangles: &[Triangle], positions: &[Point]) -> String {
+/// `f32`), the first texture-coordinate set as `vt` lines (one per vertex, `v` flipped back to
+/// OBJ's upward axis), then `f` lines, `usemtl` before each run of one material.
+pub(crate) fn obj_text(
+    triangles: &[Triangle],
+    positions: &[Point],
+    attributes: &Attributes,
+) -> String {
     use std::fmt::Write;
     let mut out = String::with_capacity(positions.len() * 40 + triangles.len() * 24);
+    // Writing to a String cannot fail.
     for p in positions {
-        // Writing to a String cannot fail.
         let _ = writeln!(out, "v {} {} {}", p[0], p[1], p[2]);
     }
-    for t in triangles {
-        let _ = writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    let texcoords = attributes
+        .texcoords
+        .first()
+        .filter(|s| s.len() == positions.len());
+    for uv in texcoords.into_iter().flatten() {
+        let _ = writeln!(out, "vt {} {}", uv[0], 1.0 - uv[1]);
+    }
+    let mut material = None;
+    for (i, t) in triangles.iter().enumerate() {
+        let m = attributes.materials.get(i).copied();
+        if m != material {
+            if let Some(name) = m.and_then(|m| attributes.material_names.get(m as usize)) {
+                let _ = writeln!(out, "usemtl {name}");
+            }
+            material = m;
+        }
+        let [a, b, c] = t.map(|v| v + 1);
+        match texcoords {
+            Some(_) => writeln!(out, "f {a}/{a} {b}/{b} {c}/{c}"),
+            None => writeln!(out, "f {a} {b} {c}"),
+        }
+        .unwrap_or_default();
     }
     out
 }

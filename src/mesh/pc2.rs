@@ -68,10 +68,12 @@ fn with_base(cache: PointCache, mesh: ObjFrame, path: &Path, base: &Path) -> Res
             mesh.positions.len()
         )));
     }
-    AnimatedMesh::new(mesh.triangles, cache.frames).map_err(|e| match e {
-        Error::Mesh(m) => Error::Mesh(format!("{}: {m}", path.display())),
-        other => other,
-    })
+    AnimatedMesh::new(mesh.triangles, cache.frames)
+        .and_then(|m| m.with_attributes(mesh.attributes))
+        .map_err(|e| match e {
+            Error::Mesh(m) => Error::Mesh(format!("{}: {m}", path.display())),
+            other => other,
+        })
 }
 
 /// Reads and checks a PC2 file: magic, version, counts and exact length.

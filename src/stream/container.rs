@@ -37,6 +37,8 @@ impl Tag {
     pub const FIRST_FRAME: Tag = Tag(*b"MESH");
     /// Cluster label per vertex.
     pub const PARTITION: Tag = Tag(*b"PART");
+    /// Texture coordinates and triangle materials (only for inputs that have them).
+    pub const ATTRIBUTES: Tag = Tag(*b"ATTR");
     /// Lattice coordinate per vertex.
     pub const LATTICE: Tag = Tag(*b"LATC");
     /// Quantised affine coefficients per cluster and frame.
@@ -62,6 +64,7 @@ impl Tag {
             b"HEAD" => "header",
             b"MESH" => "first frame",
             b"PART" => "partition",
+            b"ATTR" => "attributes",
             b"LATC" => "lattice coordinates",
             b"AFFN" => "affine coefficients",
             b"SKIN" => "skinning weights",

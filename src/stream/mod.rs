@@ -2,9 +2,11 @@
 //! serialisation, the entropy coder, and the parts every codec shares: header, frame index and
 //! side information (partition, lattice coordinates, predictor).
 
+pub mod attributes;
 pub mod bytes;
 pub mod container;
 pub mod entropy;
 pub mod frame_index;
 pub mod header;
 pub mod side_info;
+mod texcoords;

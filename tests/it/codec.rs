@@ -253,6 +253,29 @@ fn mpeg4_decodes_from_any_i_frame() -> Result<()> {
     Ok(())
 }
 
+/// The encoder codes groups of pictures on separate threads, each with its own FFmpeg encoder that
+/// starts at the group's first frame: its packets must be the bytes one encoder makes of the whole
+/// sequence (time codes included), so threading changes no stream.
+#[test]
+fn mpeg4_groups_coded_alone_match_one_encoder() -> Result<()> {
+    let planes = sequence(64, 48, 60);
+    let options = Mpeg4Options { qscale: 3, gop: 7 };
+    let whole = encode_all(&planes, &options)?;
+    let mut alone = Vec::new();
+    for (g, group) in planes.chunks(options.gop).enumerate() {
+        let mut encoder = mpeg4::Encoder::starting_at(64, 48, &options, g * options.gop)?;
+        for plane in group {
+            alone.extend(encoder.encode(plane)?);
+        }
+        alone.extend(encoder.finish()?);
+    }
+    assert_eq!(alone.len(), whole.len());
+    for (f, (a, w)) in alone.iter().zip(&whole).enumerate() {
+        assert_eq!((a.key, &a.data), (w.key, &w.data), "frame {f}");
+    }
+    Ok(())
+}
+
 #[test]
 fn mpeg4_sizes_not_multiple_of_16() -> Result<()> {
     // Macroblocks are 16×16, but FFmpeg pads internally: any even size works.

@@ -77,6 +77,7 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
         [
             Tag::HEADER,
             Tag::FIRST_FRAME,
+            Tag::ATTRIBUTES,
             Tag::PARTITION,
             Tag::AFFINE,
             Tag::TDCT_INDEX,

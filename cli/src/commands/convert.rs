@@ -11,6 +11,7 @@ use crate::output::{
     animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
 };
 use mcgv_video::error::Result;
+use mcgv_video::mesh::gltf_write::is_gltf_path;
 use mcgv_video::mesh::{write_gltf, write_obj_sequence, GltfOptions, ReadOptions};
 
 /// Runs `convert`.
@@ -24,11 +25,14 @@ pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
         OutputKind::Gltf => {
             create_parent(&args.output)?;
             super::decode::warn_if_many_targets(mesh.frame_count());
+            // A glTF source lends its materials and textures to the rewritten asset.
+            let source = std::path::Path::new(&args.input);
             let options = GltfOptions {
                 fps: args.input_args.fps.unwrap_or(30.0),
+                like: (is_gltf_path(source) && source.is_file()).then(|| source.to_path_buf()),
                 ..GltfOptions::default()
             };
-            write_gltf(&mesh, None, &args.output, &options)?;
+            write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
         }
         OutputKind::ObjFolder | OutputKind::ObjFile => {
             prepare_frame_folder(&args.output, args.force)?;

@@ -8,8 +8,8 @@ use crate::progress;
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::gltf_write::MANY_MORPH_TARGETS;
-use mcgv_video::mesh::io::write_obj_sequence_from;
-use mcgv_video::mesh::{write_gltf, write_obj_frame, AnimatedMesh, GltfOptions};
+use mcgv_video::mesh::io::{write_obj_mesh_frame, write_obj_sequence_from};
+use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions};
 use std::fs::File;
 use std::io::BufReader;
 use std::time::Instant;
@@ -50,6 +50,12 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
     let start = Instant::now();
     // The output's kind is checked before any work: a wrong name costs nothing.
     let kind = animation_output(&args.output, args.frame.is_some())?;
+    if args.like.is_some() && kind != OutputKind::Gltf {
+        return Err(Error::option(
+            "like",
+            "applies to a glTF output (.glb, .gltf)",
+        ));
+    }
     let mut decoder = Decoder::open_with(&args.input, &decode_options(args.bands))
         .map_err(|e| super::in_file(&args.input, e))?;
     warn_if_truncated(&decoder);
@@ -69,20 +75,22 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
         }
         OutputKind::ObjFile => {
             create_parent(&args.output)?;
-            write_obj_frame(mesh.triangles(), mesh.frame(0), &args.output)?;
+            write_obj_mesh_frame(&mesh, 0, &args.output)?;
         }
         OutputKind::ObjFolder => {
             prepare_frame_folder(&args.output, args.force)?;
-            write_obj_sequence_from(&mesh, &args.output, args.frame.unwrap_or(0))?;
+            let first = args.frame.or(args.frames.as_ref().map(|r| r.start));
+            write_obj_sequence_from(&mesh, &args.output, first.unwrap_or(0))?;
         }
         OutputKind::Gltf => {
             create_parent(&args.output)?;
             warn_if_many_targets(mesh.frame_count());
             let options = GltfOptions {
                 fps: args.fps,
+                like: args.like.clone(),
                 ..GltfOptions::default()
             };
-            write_gltf(&mesh, None, &args.output, &options)?;
+            write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
         }
     }
     if !quiet {
@@ -115,7 +123,22 @@ fn decode_mesh(
                 ));
             }
             let positions = decoder.decode_frame(f)?;
-            AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])
+            AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
+                .with_attributes(decoder.attributes().clone())
+        }
+        None if args.frames.is_some() => {
+            let range = args.frames.clone().unwrap_or(0..frames);
+            if range.end > frames {
+                return Err(Error::option(
+                    "frames",
+                    format!("{range:?}: the stream has frames 0 to {}", frames - 1),
+                ));
+            }
+            let positions = range
+                .map(|f| decoder.decode_frame(f))
+                .collect::<Result<Vec<_>>>()?;
+            AnimatedMesh::new(decoder.triangles().to_vec(), positions)?
+                .with_attributes(decoder.attributes().clone())
         }
         None => {
             let pb = progress::bar(frames as u64, "decode", quiet);

@@ -1,5 +1,5 @@
 //! glTF output checked by the Khronos glTF-Validator: every sample in `media/`, encoded and decoded
-//! to `.glb`, and converted to `.gltf`, must validate with no errors.
+//! to `.glb` (`--like` the sample), and converted to `.gltf`, must validate with no errors.
 //!
 //! The validator is npm's `gltf-validator`, installed by `make node-tools` (a step of `make test`)
 //! into `scripts/node/`. A missing validator fails the test: a check that silently skips checks nothing.
@@ -59,7 +59,11 @@ fn decoded_and_converted_gltf_of_every_sample_validates() {
             "tdct",
             "--quiet",
         ]));
-        ok(&run(&["decode", &s(&stream), "-o", &s(&glb), "--quiet"]));
+        // With the source's materials and textures: the copied JSON and images validate too.
+        let like = ["--like", &input, "--quiet"];
+        ok(&run(
+            &[&["decode", &s(&stream), "-o", &s(&glb)][..], &like].concat()
+        ));
         ok(&run(&["convert", &input, "-o", &s(&gltf), "--quiet"]));
         files.extend([glb, gltf]);
     }
@@ -95,4 +99,101 @@ fn a_bad_frame_rate_for_gltf_output_is_named() {
     // A bad value is a usage error.
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("fps"));
+}
+
+/// The JSON chunk of a GLB file.
+fn glb_json(path: &Path) -> serde_json::Value {
+    let bytes = std::fs::read(path).unwrap();
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    serde_json::from_slice(&bytes[20..20 + length]).unwrap()
+}
+
+#[test]
+fn decode_like_the_source_copies_its_materials_textures_and_node_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = media_path("CesiumMan.glb");
+    let stream = dir.path().join("s.mcgv").display().to_string();
+    ok(&run(&["encode", &input, "-o", &stream, "--quiet"]));
+    let glb = dir.path().join("like.glb");
+    let like = ["--like", &input, "--quiet"];
+    ok(&run(&[
+        &["decode", &stream, "-o", &glb.display().to_string()][..],
+        &like,
+    ]
+    .concat()));
+    let (source, decoded) = (glb_json(Path::new(&input)), glb_json(&glb));
+    // Copied through gltf-json, which may spell defaults out: compared by what renders.
+    let count = |doc: &serde_json::Value, key: &str| doc[key].as_array().map_or(0, Vec::len);
+    for key in ["materials", "textures", "samplers"] {
+        assert_eq!(count(&decoded, key), count(&source, key), "{key}");
+    }
+    let texture = |doc: &serde_json::Value| {
+        let m = &doc["materials"][0];
+        (
+            m["name"].clone(),
+            m["pbrMetallicRoughness"]["baseColorTexture"]["index"].clone(),
+        )
+    };
+    assert_eq!(texture(&decoded), texture(&source));
+    assert_eq!(
+        decoded["textures"][0]["source"],
+        source["textures"][0]["source"]
+    );
+    let images = decoded["images"].as_array().expect("images");
+    assert_eq!(images.len(), source["images"].as_array().unwrap().len());
+    assert!(images.iter().all(|i| i["bufferView"].is_u64()));
+    let mesh_node = |doc: &serde_json::Value| {
+        let nodes = doc["nodes"].as_array().unwrap().clone();
+        nodes.into_iter().find(|n| n.get("mesh").is_some()).unwrap()["name"].clone()
+    };
+    assert_eq!(mesh_node(&decoded), mesh_node(&source));
+    let primitive = &decoded["meshes"][0]["primitives"][0];
+    assert_eq!(primitive["material"], 0);
+    assert!(primitive["attributes"]["TEXCOORD_0"].is_u64());
+    // --like is for glTF outputs only.
+    let obj = dir.path().join("f.obj").display().to_string();
+    let out = run(&[&["decode", &stream, "-o", &obj, "--frame", "0"][..], &like].concat());
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn decode_frames_a_to_b_keeps_their_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = media_path("RiggedSimple.glb");
+    let stream = dir.path().join("s.mcgv").display().to_string();
+    ok(&run(&["encode", &input, "-o", &stream, "--quiet"]));
+    let folder = dir.path().join("frames");
+    let out = folder.display().to_string() + "/";
+    ok(&run(&[
+        "decode", &stream, "-o", &out, "--frames", "2..5", "--quiet",
+    ]));
+    let mut names: Vec<String> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_0002.obj", "frame_0003.obj", "frame_0004.obj"]
+    );
+    let glb = dir.path().join("part.glb");
+    ok(&run(&[
+        "decode",
+        &stream,
+        "-o",
+        &glb.display().to_string(),
+        "--frames",
+        "2..5",
+        "--quiet",
+    ]));
+    // Three frames: the base and two morph targets.
+    let json = glb_json(&glb);
+    assert_eq!(
+        json["meshes"][0]["weights"].as_array().map(Vec::len),
+        Some(2)
+    );
+    for bad in ["5..2", "0..100000", "x..3"] {
+        let out = run(&["decode", &stream, "-o", &out, "--frames", bad, "--force"]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+    }
 }

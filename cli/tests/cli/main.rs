@@ -1,6 +1,7 @@
 //! The command line's integration tests, one module per subject, in one test binary: each runs
 //! the `mcgv-video` binary built for the tests and checks its output, files and exit codes.
 
+mod browser;
 mod common;
 
 mod codec;

@@ -7,7 +7,7 @@ use super::primitive::{Part, MAX_INFLUENCE_SETS};
 use super::skin::{blend, Skin};
 use super::validate::check_accessor;
 use super::{buffer_data, Buffers};
-use crate::mesh::{Point, Triangle};
+use crate::mesh::{Attributes, Point, Triangle};
 use gltf::accessor::{DataType, Dimensions};
 use std::collections::HashMap;
 
@@ -16,6 +16,10 @@ pub(super) struct Geometry {
     pub(super) triangles: Vec<Triangle>,
     pub(super) parts: Vec<Part>,
     pub(super) vertex_count: usize,
+    /// Per part, its texture-coordinate sets (TEXCOORD_0, TEXCOORD_1, …).
+    texcoords: Vec<Vec<Vec<[f32; 2]>>>,
+    /// The glTF material of each triangle (`None`: the primitive has none).
+    materials: Vec<Option<usize>>,
 }
 
 /// A node and the accessors that feed a primitive's vertices (see [`vertex_accessors`]).
@@ -35,6 +39,8 @@ impl Geometry {
             triangles: Vec::new(),
             parts: Vec::new(),
             vertex_count: 0,
+            texcoords: Vec::new(),
+            materials: Vec::new(),
         };
         let mut first_vertex = SharedVertices::new();
         let mut stack: Vec<gltf::Node> = scene.nodes().collect();
@@ -75,6 +81,8 @@ impl Geometry {
                     return Ok(());
                 };
                 let range = (self.vertex_count, part.positions.len());
+                self.texcoords
+                    .push(read_texcoords(primitive, data, range.1, &name)?);
                 self.vertex_count += part.positions.len();
                 self.parts.push(part);
                 first_vertex.insert(key, range);
@@ -85,8 +93,52 @@ impl Geometry {
         let offset = first as u32;
         let shifted = triangles_of(primitive.mode(), &indices)
             .map(|t| [t[0] + offset, t[1] + offset, t[2] + offset]);
+        let before = self.triangles.len();
         self.triangles.extend(shifted);
+        let material = primitive.material().index();
+        self.materials
+            .resize(self.triangles.len().max(before), material);
         Ok(())
+    }
+
+    /// The texture coordinates of every vertex (a part without set `s` gets (0, 0) there) and the
+    /// material of every triangle, named after the document's materials (`default` for none).
+    pub(super) fn attributes(&self, document: &gltf::Document) -> Attributes {
+        let sets = self.texcoords.iter().map(Vec::len).max().unwrap_or(0);
+        let texcoords = (0..sets)
+            .map(|s| {
+                let parts = self.texcoords.iter().zip(&self.parts);
+                parts
+                    .flat_map(|(part_sets, part)| match part_sets.get(s) {
+                        Some(set) => set.clone(),
+                        None => vec![[0.0; 2]; part.positions.len()],
+                    })
+                    .collect()
+            })
+            .collect();
+        if self.materials.iter().all(Option::is_none) {
+            return Attributes {
+                texcoords,
+                ..Attributes::default()
+            };
+        }
+        let mut used: Vec<Option<usize>> = self.materials.clone();
+        used.sort();
+        used.dedup();
+        let name = |m: &Option<usize>| match m.and_then(|i| document.materials().nth(i)) {
+            Some(material) => super::material_name(&material),
+            None => "default".to_string(),
+        };
+        let materials = self
+            .materials
+            .iter()
+            .map(|m| used.binary_search(m).unwrap_or(0) as u32)
+            .collect();
+        Attributes {
+            texcoords,
+            materials,
+            material_names: used.iter().map(name).collect(),
+        }
     }
 
     /// World-space positions of every vertex in one pose.
@@ -110,6 +162,29 @@ impl Geometry {
         }
         out
     }
+}
+
+/// Every TEXCOORD_n set of a primitive, as floats (normalised integers are converted).
+fn read_texcoords(
+    primitive: &gltf::Primitive,
+    data: Buffers,
+    count: usize,
+    name: &str,
+) -> Result<Vec<Vec<[f32; 2]>>, String> {
+    let reader = primitive.reader(|b| buffer_data(data, b));
+    let mut sets = Vec::new();
+    while let Some(coords) = reader.read_tex_coords(sets.len() as u32) {
+        let set: Vec<[f32; 2]> = coords.into_f32().collect();
+        if set.len() != count || set.iter().flatten().any(|c| !c.is_finite()) {
+            return Err(format!(
+                "{name}: TEXCOORD_{} has {} finite entries for {count} vertices",
+                sets.len(),
+                set.len()
+            ));
+        }
+        sets.push(set);
+    }
+    Ok(sets)
 }
 
 /// A primitive's vertex indices (`0..count` when it has none), each checked against `count`.

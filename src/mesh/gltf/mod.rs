@@ -42,6 +42,27 @@ pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Re
     bake(gltf, path.parent(), path, fps, clip)
 }
 
+/// The parsed document of a glTF file and its loaded buffers (for the writer's `like` option).
+pub(crate) fn load_document(path: &Path) -> Result<(gltf::Document, Vec<gltf::buffer::Data>)> {
+    let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let gltf::Gltf { document, blob } = validate::from_slice(&bytes, path)?;
+    validate::check_buffer_uris(&document).map_err(fail)?;
+    let buffers = gltf::import_buffers(&document, path.parent(), blob)
+        .map_err(|e| fail(format!("buffer: {e}")))?;
+    Ok((document, buffers))
+}
+
+/// The name [`read_gltf`] gives a triangle's material in the attributes: the material's name, else
+/// `material_N`, or `default` for a primitive without one.
+pub(crate) fn material_name(material: &gltf::Material) -> String {
+    match (material.index(), material.name()) {
+        (None, _) => "default".to_string(),
+        (Some(_), Some(name)) => name.to_string(),
+        (Some(i), None) => format!("material_{i}"),
+    }
+}
+
 /// One animation (clip) of a glTF file, as [`read_gltf`] would bake it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Clip {
@@ -140,5 +161,8 @@ fn bake(
     let frames = times
         .map(|time| geometry.bake(&pose.at(time, &channels), &skins))
         .collect();
-    AnimatedMesh::new(geometry.triangles, frames).map_err(|e| fail(e.to_string()))
+    let attributes = geometry.attributes(&document);
+    AnimatedMesh::new(geometry.triangles, frames)
+        .and_then(|mesh| mesh.with_attributes(attributes))
+        .map_err(|e| fail(e.to_string()))
 }

@@ -42,6 +42,11 @@ impl BufferBuilder {
         self.views.len() - 1
     }
 
+    /// Appends opaque bytes (an image) as a buffer view with no target; returns its index.
+    pub(super) fn raw(&mut self, bytes: &[u8]) -> usize {
+        self.view(bytes, None)
+    }
+
     /// Adds float vectors of `N` components as an accessor (`with_bounds`: with min and max);
     /// returns the accessor's index.
     pub(super) fn floats<const N: usize>(

@@ -9,6 +9,7 @@
 //! `gltf-json` (the `gltf` crate's own JSON layer), so the library needs no JSON crate of its own.
 
 mod buffer;
+mod like;
 mod normals;
 
 use super::{AnimatedMesh, Attributes, Point};
@@ -16,8 +17,9 @@ use crate::error::{Error, Result};
 use crate::output::write_atomic;
 use buffer::{object, BufferBuilder, ARRAY_BUFFER};
 use gltf::json::Value;
+use like::Look;
 use normals::{vertex_normals, Welding};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Morph targets beyond which a writer should warn: each target stores `V` positions and normals,
 /// and the weights animation grows as frames × targets. three.js and Blender import more, slowly;
@@ -29,8 +31,11 @@ pub const MANY_MORPH_TARGETS: usize = 256;
 pub struct GltfOptions {
     /// Frames per second of the weights animation (the stream does not record the source's rate).
     pub fps: f64,
-    /// Name of the node holding the mesh (default "mcgv-video").
+    /// Name of the node holding the mesh (default: the `like` source's, else "mcgv-video").
     pub node_name: Option<String>,
+    /// A glTF file (the encoded source) whose materials, textures, samplers, images and node name
+    /// the output copies; triangles take the source material of the same name.
+    pub like: Option<PathBuf>,
 }
 
 impl Default for GltfOptions {
@@ -38,6 +43,7 @@ impl Default for GltfOptions {
         Self {
             fps: 30.0,
             node_name: None,
+            like: None,
         }
     }
 }
@@ -85,8 +91,9 @@ pub fn gltf_bytes(
     let empty = Attributes::default();
     let attributes = attributes.unwrap_or(&empty);
     attributes.check(mesh.vertex_count(), mesh.triangles().len())?;
+    let look = options.like.as_deref().map(Look::read).transpose()?;
     let mut buf = BufferBuilder::default();
-    let mut root = document(mesh, attributes, options, &mut buf);
+    let mut root = document(mesh, attributes, options, look.as_ref(), &mut buf);
     let json = if binary {
         set(
             &mut root,
@@ -123,6 +130,7 @@ fn document(
     mesh: &AnimatedMesh,
     attributes: &Attributes,
     options: &GltfOptions,
+    look: Option<&Look>,
     buf: &mut BufferBuilder,
 ) -> Value {
     let welding = Welding::new(mesh.frame(0));
@@ -143,6 +151,14 @@ fn document(
     }
     let targets = morph_targets(mesh, &welding, &base_normals, buf);
     let groups = material_groups(mesh, attributes);
+    // With a source to look like, a group's material is the source's of the same name.
+    let material_of = |m: u32| match look {
+        Some(look) => attributes
+            .material_names
+            .get(m as usize)
+            .and_then(|name| look.material_index(name)),
+        None => Some(m as usize),
+    };
     let primitives: Vec<Value> = groups
         .iter()
         .map(|(material, indices)| {
@@ -151,8 +167,8 @@ fn document(
                 ("indices", buf.indices(indices).into()),
                 ("mode", 4.into()),
             ]);
-            if let Some(m) = material {
-                set(&mut p, "material", *m);
+            if let Some(m) = material.and_then(material_of) {
+                set(&mut p, "material", m);
             }
             if !targets.is_empty() {
                 set(&mut p, "targets", targets.clone());
@@ -172,7 +188,9 @@ fn document(
             object([("targetNames", names.into())]),
         );
     }
-    let node_name = options.node_name.as_deref().unwrap_or("mcgv-video");
+    let node_name = (options.node_name.as_deref())
+        .or(look.and_then(Look::node_name))
+        .unwrap_or("mcgv-video");
     let mut root = object([
         (
             "asset",
@@ -189,7 +207,9 @@ fn document(
         ),
         ("meshes", vec![gltf_mesh].into()),
     ]);
-    if !attributes.material_names.is_empty() {
+    if let Some(look) = look {
+        look.apply(&mut root, buf);
+    } else if !attributes.material_names.is_empty() {
         let materials: Vec<Value> = attributes
             .material_names
             .iter()
