@@ -411,6 +411,14 @@ fn read_part_entry<R: Read>(
     let mut r = ByteReader::new(&ph, "part header");
     let mut tag = [0u8; 4];
     tag.copy_from_slice(r.take(4)?);
+    // Part tags are outside every CRC: a damaged tag would otherwise drop an optional part
+    // (the attributes) silently. Every part of this version is known, so any other is refused.
+    if Tag(tag).name() == "unknown part" {
+        return Err(Error::Stream(format!(
+            "part {i}: unknown tag {} (damaged file?)",
+            Tag(tag)
+        )));
+    }
     let checksum = match r.u8()? {
         0 => Checksum::Whole,
         1 => Checksum::Chunked,
