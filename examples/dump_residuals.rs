@@ -31,6 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (partition, _) = analysis::segment(&mesh, &opts)?;
     let prediction = analysis::predict(&mesh, &ff.decoded_positions, &partition, &opts)?;
     let pictures = opts.codec.pictures()?.ok_or("the codec makes no images")?;
+    let step = geometry_video::pixel_step(pictures.as_ref(), mesh.bbox_diagonal(), &opts)?;
     let images = geometry_video::images_of(
         pictures.as_ref(),
         &ff.decoded_positions,
@@ -38,6 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &partition,
         &prediction.residuals,
         &opts,
+        step,
     )?;
     let (w, h) = (images.lattice.0 as u32, images.lattice.1 as u32);
     let mask: Vec<u8> = images

@@ -67,6 +67,10 @@ pub fn encoder_images<R: Read + Seek>(
     let opts = EncodeOptions::from_header(header, decoder.weights().map(|w| w.bits))?;
     let redone = analysis::redo(original, &opts, decoder.partition())?;
     let residuals = &redone.prediction.residuals;
+    let layout = decoder
+        .images()
+        .ok_or_else(|| Error::Usage("the stream has no geometry images".into()))?;
+    // The stream's own step, ranges and corrections: the encoder's option (`step`) is not recorded.
     let mut images = crate::codec::geometry_video::images_of(
         pictures.as_ref(),
         &redone.reference,
@@ -74,9 +78,10 @@ pub fn encoder_images<R: Read + Seek>(
         decoder.partition(),
         residuals,
         &opts,
+        layout.pixel_step,
     )?;
-    // The stream's own ranges: the encoder may have widened them (range_floor).
-    images.ranges = decoder.ranges().to_vec();
+    images.ranges = layout.ranges.clone();
+    images.corrections = layout.corrections.clone();
     frames
         .iter()
         .map(|&f| {

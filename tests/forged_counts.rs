@@ -207,7 +207,7 @@ fn triangles_past_what_the_connectivity_stream_holds_are_refused() {
 fn frames_past_what_the_ranges_hold_are_refused_before_the_affine_track() {
     // 4M frames of one cluster are 48M affine coefficients: 12 KB of zero bytes decode as that
     // many (each at the coder's floor), so the affine part alone cannot refuse the claim. The
-    // residual ranges take 24 bytes a frame and are read first.
+    // residual ranges take 24 bytes a frame (a step and an offset per axis) and are read first.
     const FRAMES: u32 = 1 << 22;
     let mut forged = parts(&tiny_stream(Codec::Jpeg));
     for (tag, payload, _) in forged.iter_mut() {

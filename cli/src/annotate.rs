@@ -105,19 +105,20 @@ pub fn residual_picture(
                 image.put_pixel(x0 + x, y, Rgb([level, level, level]));
             }
         }
-        if range.min < 0.0 && range.max > 0.0 {
-            let zero = (-range.min / (range.max - range.min) * (w - 1) as f32).round() as u32;
+        let (min, max) = (range.min(), range.max());
+        if min < 0.0 && max > 0.0 {
+            let zero = (-min / (max - min) * (w - 1) as f32).round() as u32;
             for y in y0 - 2..y0 + bar + 2 {
                 image.put_pixel(x0 + zero, y, ZERO_MARK);
             }
         }
-        let lo = units(range.min);
-        let hi = units(range.max);
+        let lo = units(min);
+        let hi = units(max);
         let text_y = (y0 + bar + 1) as i64;
         draw_text(&mut image, x0 as i64, text_y, &lo, INK);
         let right = (x0 + w) as i64 - 8 * hi.len() as i64;
         draw_text(&mut image, right, text_y + LINE as i64, &hi, INK);
-        let step = format!("1 level {:.1e}", (range.max - range.min) / 255.0);
+        let step = format!("1 level {:.1e}", range.step);
         draw_text(&mut image, x0 as i64, text_y + 2 * LINE as i64, &step, INK);
     }
     image
@@ -175,10 +176,7 @@ mod tests {
     #[test]
     fn residual_picture_has_three_labelled_panels_and_a_scale() {
         let plane = GrayImage::from_fn(3 * 64, 16, |x, _| image::Luma([(x % 256) as u8]));
-        let range = mcgv_video::geometry_image::quantise::AxisRange {
-            min: -0.5,
-            max: 1.0,
-        };
+        let range = mcgv_video::geometry_image::quantise::AxisRange::new(0.01, 20);
         let picture = residual_picture(&plane, 64, "frame 0", Some(&[range; 3]));
         assert_eq!(picture.width(), 3 * 64 + 2 * GAP);
         assert!(picture.pixels().any(|p| *p == ZERO_MARK));

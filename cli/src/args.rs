@@ -104,11 +104,15 @@ pub struct EncodeArgs {
     /// Rate knob for every codec, 1..100 (higher = better quality, more bits; default 50).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
     pub quality: Option<u8>,
-    /// MPEG-4 quantiser 1..31 (lower = better); overrides --quality for mpeg4.
+    /// MPEG-4 quantiser 1..31 (lower = better); overrides the one --quality sets for mpeg4.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=31))]
     pub qscale: Option<u8>,
-    /// Temporal-DCT quantiser step as a fraction of the first frame's bounding-box diagonal
-    /// (e.g. 0.001); overrides --quality for tdct.
+    /// JPEG's own quality 1..100 for the residual pictures; overrides the one --quality sets.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub jpeg_quality: Option<u8>,
+    /// Quantiser step (tdct) or pixel step (one grey level of the residual images, jpeg and mpeg4)
+    /// as a fraction of the first frame's bounding-box diagonal (e.g. 0.001); overrides the one
+    /// --quality sets.
     #[arg(long)]
     pub step: Option<f64>,
     /// Number of motion clusters K for k-means (default 20).
@@ -155,12 +159,10 @@ pub struct EncodeArgs {
     /// Bits per texture coordinate over each UV set's bounding box (inputs with UVs only).
     #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u8).range(1..=24))]
     pub uv_bits: u8,
-    /// Widen each frame's residual range to at least this fraction (0..1) of the sequence's widest,
-    /// so frames with small residuals take coarser levels: fewer bits for a more even error
-    /// (0 = every frame's tightest range). Measured at equal rate: 8-14 % lower RMSE on Chicken
-    /// (JPEG and MPEG-4), 0-4 % on Cow with JPEG, 0-8 % higher on Cow with MPEG-4 (README).
-    #[arg(long, default_value_t = 0.0)]
-    pub range_floor: f32,
+    /// Retired with stream version 2 (the step now follows --quality, not each frame's range);
+    /// kept hidden so that old scripts get a clear error rather than "unexpected argument".
+    #[arg(long, hide = true)]
+    pub range_floor: Option<String>,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,

@@ -3,14 +3,17 @@
 //! Encoding builds the atlas on the decoded first frame, splats each frame's quantised residuals
 //! onto it, pads the free pixels, tiles x | y | z into one picture and hands the pictures to a
 //! [`PictureCodec`] (JPEG, MPEG-4). Its parts, in file order: the lattice coordinates (before the
-//! predictor's), then the residual ranges, the codec set-up, the frame index and the coded frames.
+//! predictor's), then the residual ranges (pixel step, per-frame shifts and offsets, the
+//! correction list), the codec set-up, the frame index and the coded frames.
 //! Decoding reads the frames from the last key frame before the one asked for.
 
 use super::{Codec, StreamLayout};
 use super::{CodecParams, CodedResiduals, Plane, ResidualDecoder, ResidualEncoder, ResidualInput};
 use crate::encoder::EncodeOptions;
 use crate::error::{Error, Result};
-use crate::geometry_image::{lattice, quantise, tile, FrameRanges, GeometryImages, RangeMode};
+use crate::geometry_image::{
+    lattice, quantise, tile, Corrections, FrameRanges, GeometryImages, RangeMode,
+};
 use crate::mesh::Point;
 use crate::progress::Progress;
 use crate::stream::bytes::{ByteReader, ByteWriter};
@@ -30,8 +33,10 @@ pub trait PictureCodec: Sync {
     fn range_mode(&self, opts: &EncodeOptions) -> RangeMode;
     /// The padding this codec measured best with.
     fn default_padding(&self) -> padding::Method;
-    /// The MPEG-4 quantiser of the header (0 when the codec has none).
-    fn qscale(&self, opts: &EncodeOptions) -> u8;
+    /// The pixel step as a multiple of the target step of `opts.quality`.
+    fn step_factor(&self, opts: &EncodeOptions) -> f64;
+    /// The picture codec's own quantiser (MPEG-4 qscale, JPEG quality), recorded in the header.
+    fn quantiser(&self, opts: &EncodeOptions) -> u8;
     /// Frames per group of pictures (1 for intra codecs).
     fn gop(&self, opts: &EncodeOptions) -> u32;
     /// An encoder for `width`×`height` pictures whose first picture is frame `first_frame` of the
@@ -68,6 +73,7 @@ pub fn padding_method(codec: &dyn PictureCodec, opts: &EncodeOptions) -> padding
 
 /// The residual images an encoding with `codec` makes of `input`'s residuals.
 pub fn images(codec: &dyn PictureCodec, input: &ResidualInput) -> Result<GeometryImages> {
+    let step = pixel_step(codec, input.mesh.bbox_diagonal(), input.options)?;
     images_of(
         codec,
         input.reference,
@@ -75,11 +81,30 @@ pub fn images(codec: &dyn PictureCodec, input: &ResidualInput) -> Result<Geometr
         input.partition,
         input.residuals,
         input.options,
+        step,
     )
 }
 
+/// One grey level of an encoding in model units: `opts.step` (a fraction of the first frame's
+/// bounding-box diagonal `diagonal`) or the law's for `opts.quality`, rounded to the `f32` the
+/// stream stores.
+pub fn pixel_step(codec: &dyn PictureCodec, diagonal: f64, opts: &EncodeOptions) -> Result<f32> {
+    let step = match opts.step {
+        Some(fraction) => diagonal * fraction,
+        None => codec.step_factor(opts) * super::target_step(opts.quality, diagonal),
+    };
+    let stored = step as f32;
+    if !(stored.is_normal() && stored > 0.0) {
+        return Err(Error::Mesh(format!(
+            "the pixel step is {step} (first frame's bounding-box diagonal {diagonal}): \
+             a degenerate first frame gives no scale to quantise against"
+        )));
+    }
+    Ok(stored)
+}
+
 /// The residual images an encoding with `codec` and `opts` makes of `residuals` on the atlas of
-/// `reference`, `triangles` and `partition`.
+/// `reference`, `triangles` and `partition`, at `pixel_step`.
 pub fn images_of(
     codec: &dyn PictureCodec,
     reference: &[Point],
@@ -87,6 +112,7 @@ pub fn images_of(
     partition: &crate::motion::Partition,
     residuals: &[Vec<[f32; 3]>],
     opts: &EncodeOptions,
+    pixel_step: f32,
 ) -> Result<GeometryImages> {
     let (size, atlas) = lattice::build_atlas(reference, triangles, partition, opts.lattice)?;
     Ok(GeometryImages::new(
@@ -94,10 +120,13 @@ pub fn images_of(
         atlas,
         residuals,
         codec.range_mode(opts),
-        opts.range_floor,
+        pixel_step,
         padding::PaddingOptions {
             method: padding_method(codec, opts),
-            jpeg_quality: opts.quality,
+            jpeg_quality: match codec.codec() {
+                Codec::Jpeg => codec.quantiser(opts),
+                _ => opts.quality,
+            },
             ..padding::PaddingOptions::default()
         },
     ))
@@ -123,7 +152,8 @@ impl<P: PictureCodec> ResidualEncoder for Encoder<P> {
         let (setup, chunks) = code_pictures(&self.0, &images, input)?;
         let images_seconds = clock.elapsed().as_secs_f64();
         let mut ranges = ByteWriter::new();
-        quantise::write_ranges(&images.ranges, &mut ranges);
+        quantise::write_ranges(images.pixel_step, &images.ranges, &mut ranges);
+        images.corrections.write(&mut ranges);
         let (index, payload) = FrameIndex::build(chunks);
         let lattice_part = side_info::encode_lattice(
             images.atlas.vertex_pixels(),
@@ -134,7 +164,7 @@ impl<P: PictureCodec> ResidualEncoder for Encoder<P> {
         Ok(CodedResiduals {
             params: CodecParams {
                 lattice: images.lattice,
-                qscale: self.0.qscale(opts),
+                qscale: self.0.quantiser(opts),
                 gop: self.0.gop(opts),
                 padding: images.padding.method.to_string(),
             },
@@ -228,8 +258,12 @@ fn code_group(
 pub struct ImageLayout {
     /// Lattice pixel of every vertex.
     pub pixels: Vec<[u16; 2]>,
-    /// Residual range per frame and coordinate.
+    /// One grey level in model units, before any frame's shift.
+    pub pixel_step: f32,
+    /// Residual range (shift, offset) per frame and coordinate.
     pub ranges: Vec<FrameRanges>,
+    /// The residuals the ranges clip.
+    pub corrections: Corrections,
     /// Where each frame's picture lies.
     pub index: FrameIndex,
     /// The codec set-up part.
@@ -258,7 +292,8 @@ impl<P: PictureCodec> Decoder<P> {
             side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, stream.triangles)?;
         let ranges_bytes = reader.part(Tag::RANGES)?;
         let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
-        let ranges = quantise::read_ranges(&mut r, frames)?;
+        let (pixel_step, ranges) = quantise::read_ranges(&mut r, frames)?;
+        let corrections = Corrections::read(&mut r, frames, v)?;
         r.finish()?;
         let setup = reader.part(Tag::CODEC_SETUP)?;
         let images_len = reader.entry(Tag::FRAMES)?.len;
@@ -267,7 +302,9 @@ impl<P: PictureCodec> Decoder<P> {
             codec,
             layout: ImageLayout {
                 pixels,
+                pixel_step,
                 ranges,
+                corrections,
                 index,
                 setup,
                 lattice,
@@ -308,11 +345,22 @@ impl<P: PictureCodec> Decoder<P> {
             )));
         }
         let lw = self.layout.lattice.0 as usize;
+        let mut residuals = vec![[0.0f32; 3]; frame.len()];
         for a in 0..3 {
             let levels = tile::sample(plane, a, lw, &self.layout.pixels);
             let range = self.layout.ranges[f][a];
-            for (p, l) in frame.iter_mut().zip(levels) {
-                p[a] += range.dequantise(l);
+            for (r, l) in residuals.iter_mut().zip(levels) {
+                r[a] = range.dequantise(l);
+            }
+        }
+        for c in self.layout.corrections.frame(f) {
+            if let Some(r) = residuals.get_mut(c.vertex as usize) {
+                r[usize::from(c.axis)] = c.residual(self.layout.pixel_step);
+            }
+        }
+        for (p, r) in frame.iter_mut().zip(&residuals) {
+            for a in 0..3 {
+                p[a] += r[a];
             }
         }
         Ok(())

@@ -113,8 +113,14 @@ impl PictureCodec for Pictures {
         padding::Method::Snap
     }
 
-    fn qscale(&self, _opts: &EncodeOptions) -> u8 {
-        0
+    fn step_factor(&self, opts: &EncodeOptions) -> f64 {
+        super::jpeg_law(opts.quality).step_factor
+    }
+
+    /// The JPEG quality: the option's, else the law's for `quality`.
+    fn quantiser(&self, opts: &EncodeOptions) -> u8 {
+        opts.jpeg_quality
+            .unwrap_or_else(|| super::jpeg_law(opts.quality).quantiser)
     }
 
     fn gop(&self, _opts: &EncodeOptions) -> u32 {
@@ -129,7 +135,7 @@ impl PictureCodec for Pictures {
         opts: &EncodeOptions,
     ) -> Result<Box<dyn PictureEncoder>> {
         Ok(Box::new(FrameEncoder {
-            quality: opts.quality,
+            quality: self.quantiser(opts),
             shared: None,
             chunks: Vec::new(),
         }))

@@ -23,7 +23,7 @@ pub mod quality;
 pub mod tdct;
 
 pub use plane::Plane;
-pub use quality::{ijg_scale_percent, quality_to_qscale};
+pub use quality::{ijg_scale_percent, jpeg_law, mpeg4_law, target_step, PictureLaw};
 
 use crate::encoder::EncodeOptions;
 use crate::error::{Error, Result};
@@ -176,7 +176,7 @@ pub struct ResidualInput<'a> {
 pub struct CodecParams {
     /// Geometry-image lattice, (0, 0) without images.
     pub lattice: (u16, u16),
-    /// The MPEG-4 quantiser (0 for other codecs).
+    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality (0 without pictures).
     pub qscale: u8,
     /// Frames per group of pictures (1 for intra codecs).
     pub gop: u32,

@@ -31,7 +31,7 @@ const NO_SCENE_CUT: &str = "1000000000";
 /// Encoder settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Mpeg4Options {
-    /// Fixed quantiser, 1 (best) ..= 31 (coarsest); see [`super::quality_to_qscale`].
+    /// Fixed quantiser, 1 (best) ..= 31 (coarsest); see [`super::mpeg4_law`].
     pub qscale: u8,
     /// Frames per group of pictures: an I-frame, then `gop − 1` P-frames.
     pub gop: usize,
@@ -363,9 +363,13 @@ impl PictureCodec for Pictures {
         padding::Method::Biharmonic
     }
 
-    fn qscale(&self, opts: &EncodeOptions) -> u8 {
+    fn step_factor(&self, opts: &EncodeOptions) -> f64 {
+        super::mpeg4_law(opts.quality).step_factor
+    }
+
+    fn quantiser(&self, opts: &EncodeOptions) -> u8 {
         opts.qscale
-            .unwrap_or_else(|| super::quality_to_qscale(opts.quality))
+            .unwrap_or_else(|| super::mpeg4_law(opts.quality).quantiser)
     }
 
     fn gop(&self, opts: &EncodeOptions) -> u32 {
@@ -380,7 +384,7 @@ impl PictureCodec for Pictures {
         opts: &EncodeOptions,
     ) -> Result<Box<dyn PictureEncoder>> {
         let options = Mpeg4Options {
-            qscale: self.qscale(opts),
+            qscale: self.quantiser(opts),
             gop: opts.gop,
         };
         Ok(Box::new(PacketEncoder {

@@ -8,9 +8,8 @@ use crate::mesh::AnimatedMesh;
 use crate::motion::{self, PredictorKind};
 use crate::stream::header::Header;
 
-/// Default `quality`: the middle of the useful range. On CesiumMan it gives RMSE 2.6e-4 of the
-/// diagonal (under half a millimetre on a 1.8 m figure) at 6.5 bpvf with MPEG-4 (qscale 4); 75
-/// (qscale 2) costs 1.6× the bits for 0.6× the error (scripts/sweep.sh on media/CesiumMan.glb).
+/// Default `quality`: the middle of the useful range, a target step of 1/1000 of the first frame's
+/// bounding-box diagonal (see [`crate::codec::quality`]).
 pub const DEFAULT_QUALITY: u8 = 50;
 
 /// Everything the caller can choose about an encoding.
@@ -22,6 +21,8 @@ pub struct EncodeOptions {
     pub quality: u8,
     /// MPEG-4 quantiser; `None` derives it from `quality`.
     pub qscale: Option<u8>,
+    /// JPEG's own quality 1..100 for the residual pictures; `None` derives it from `quality`.
+    pub jpeg_quality: Option<u8>,
     /// Motion clusters K (k-means only; decimation finds its own).
     pub clusters: usize,
     /// How the vertices are split into motion clusters.
@@ -45,11 +46,8 @@ pub struct EncodeOptions {
     pub predictor: PredictorKind,
     /// Bits per skinning weight, sign included (the paper's 16 by default).
     pub weight_bits: u8,
-    /// Residual ranges narrower than this fraction of the sequence's widest are widened to it, so
-    /// frames with small residuals get coarser levels instead of the full 0..255 (0 = off).
-    pub range_floor: f32,
-    /// Temporal-DCT quantiser step as a fraction of the first frame's bounding-box diagonal;
-    /// `None` derives it from `quality` (tdct only).
+    /// Quantiser step (tdct) or pixel step (one grey level, image codecs) as a fraction of the
+    /// first frame's bounding-box diagonal; `None` derives it from `quality`.
     pub step: Option<f64>,
     /// Bits per texture coordinate over each set's bounding box (1..=24; inputs with UVs only).
     pub uv_bits: u8,
@@ -61,6 +59,7 @@ impl Default for EncodeOptions {
             codec: Codec::Jpeg,
             quality: DEFAULT_QUALITY,
             qscale: None,
+            jpeg_quality: None,
             clusters: 20,
             segmentation: Segmentation::KMeans,
             affine_precision: None,
@@ -71,7 +70,6 @@ impl Default for EncodeOptions {
             reorder: false,
             predictor: PredictorKind::Affine,
             weight_bits: motion::WEIGHT_BITS,
-            range_floor: 0.0,
             step: None,
             uv_bits: 12,
         }
@@ -121,7 +119,8 @@ impl EncodeOptions {
         Ok(Self {
             codec: header.codec,
             quality: header.quality,
-            qscale: Some(header.qscale).filter(|&q| q > 0),
+            qscale: Some(header.qscale).filter(|&q| q > 0 && header.codec == Codec::Mpeg4),
+            jpeg_quality: Some(header.qscale).filter(|&q| q > 0 && header.codec == Codec::Jpeg),
             clusters: header.requested_clusters as usize,
             // The segmentation is not redone: the stream carries its partition.
             segmentation: Segmentation::KMeans,
@@ -141,7 +140,6 @@ impl EncodeOptions {
             reorder: header.reorder,
             predictor: header.predictor,
             weight_bits: weight_bits.unwrap_or(motion::WEIGHT_BITS),
-            range_floor: 0.0,
             step: None,
             uv_bits: 12,
         })
@@ -150,10 +148,9 @@ impl EncodeOptions {
     /// Fails, naming the field, when an option is out of range or does not apply to the codec.
     pub fn check(&self, mesh: &AnimatedMesh) -> Result<()> {
         self.check_ranges()?;
+        self.check_step()?;
         if self.codec == Codec::Tdct {
             self.check_tdct()?;
-        } else if self.step.is_some() {
-            return Err(Error::option("step", "applies to the tdct codec only"));
         }
         if !self.codec.available() {
             return Err(Error::option(
@@ -197,11 +194,10 @@ impl EncodeOptions {
         if !(2..=31).contains(&self.weight_bits) {
             return Err(Error::option("weight_bits", "must be between 2 and 31"));
         }
-        if !(0.0..=1.0).contains(&self.range_floor) {
-            return Err(Error::option(
-                "range_floor",
-                format!("must be between 0 and 1, not {}", self.range_floor),
-            ));
+        if let Some(q) = self.jpeg_quality {
+            if !(1..=100).contains(&q) {
+                return Err(Error::option("jpeg_quality", "must be between 1 and 100"));
+            }
         }
         if self.gop == 0 {
             return Err(Error::option("gop", "must be at least 1"));
@@ -226,12 +222,12 @@ impl EncodeOptions {
     pub fn affine_step(&self) -> f64 {
         let fraction = self
             .step
-            .unwrap_or_else(|| crate::codec::tdct::step_for_quality(self.quality, 1.0));
+            .unwrap_or_else(|| crate::codec::quality::target_step(self.quality, 1.0));
         let k = f64::from(self.affine_precision_code()) / 16.0;
         (fraction * k).clamp(motion::MIN_AFFINE_STEP, motion::MAX_AFFINE_STEP)
     }
 
-    fn check_tdct(&self) -> Result<()> {
+    fn check_step(&self) -> Result<()> {
         if let Some(step) = self.step {
             if !(step.is_finite() && step > 0.0 && step <= 1.0) {
                 return Err(Error::option(
@@ -240,6 +236,10 @@ impl EncodeOptions {
                 ));
             }
         }
+        Ok(())
+    }
+
+    fn check_tdct(&self) -> Result<()> {
         let no_images = |option| {
             Err(Error::option(
                 option,
@@ -249,8 +249,8 @@ impl EncodeOptions {
         if let Lattice::Fixed(..) = self.lattice {
             return no_images("lattice");
         }
-        if self.range_floor > 0.0 {
-            return no_images("range_floor");
+        if self.jpeg_quality.is_some() {
+            return no_images("jpeg_quality");
         }
         if self.padding.is_some() {
             return no_images("padding");

@@ -2,6 +2,7 @@
 //! vertex's pixel, then padded. The encoder and `inspect` both make them here, so the pictures
 //! `inspect` shows are the ones the encoder coded.
 
+use super::corrections::Corrections;
 use super::quantise::{self, FrameRanges, RangeMode};
 use crate::error::Result;
 
@@ -11,8 +12,12 @@ pub struct GeometryImages {
     pub lattice: (u16, u16),
     /// The atlas: each vertex's pixel, the chart pixels.
     pub atlas: atlas::Atlas,
-    /// Residual range per frame and coordinate.
+    /// One grey level in model units, before any frame's shift.
+    pub pixel_step: f32,
+    /// Residual range (shift and offset) per frame and coordinate.
     pub ranges: Vec<FrameRanges>,
+    /// The residuals the ranges clip, sent apart.
+    pub corrections: Corrections,
     /// How free pixels are filled.
     pub padding: padding::PaddingOptions,
     /// Frames per group: the first frame of a group is padded on its own, the others continue the
@@ -21,28 +26,25 @@ pub struct GeometryImages {
 }
 
 impl GeometryImages {
-    /// The images of an encoding on `atlas`, with the ranges `residuals` span as `mode` groups
-    /// them, widened to `range_floor` of the widest.
+    /// The images of an encoding on `atlas` at `pixel_step`, with offsets centred on the
+    /// `residuals` of each frame or group as `mode` groups them.
     pub fn new(
         lattice: (u16, u16),
         atlas: atlas::Atlas,
         residuals: &[Vec<[f32; 3]>],
         mode: RangeMode,
-        range_floor: f32,
+        pixel_step: f32,
         padding: padding::PaddingOptions,
     ) -> Self {
-        let mut ranges = quantise::frame_ranges(residuals, mode);
-        quantise::widen(&mut ranges, range_floor);
-        let gop = match mode {
-            RangeMode::PerFrame => 1,
-            RangeMode::PerGroup(n) => n.max(1),
-        };
+        let (ranges, corrections) = quantise::choose(residuals, mode, pixel_step);
         Self {
             lattice,
             atlas,
+            pixel_step,
             ranges,
+            corrections,
             padding,
-            gop,
+            gop: mode.group(),
         }
     }
 

@@ -1,159 +1,229 @@
-//! Residual quantisation: each coordinate's residuals map linearly onto `0..=255` over a stored range.
+//! Residual quantisation: one step for the whole sequence, set by the target error, not by each
+//! frame's range (issue 15).
 //!
-//! Intra (JPEG) frames use a range per frame and coordinate, the tightest possible. MPEG-4 P-frames
-//! predict a frame's pixels from the previous frame's, which only works if a pixel value means the same
-//! residual in both: there the range is shared by a whole group of pictures.
+//! A residual `r` of one coordinate becomes the level `r / step − offset + 128`: mid-grey is the
+//! offset, one grey level one step. The step is the encoding's pixel step (a fraction of the first
+//! frame's bounding-box diagonal that `quality` sets, [`crate::codec::quality`]), so a frame whose
+//! residuals are small makes a near-flat picture that costs almost nothing, and a better predictor
+//! buys fewer bits rather than finer levels. The offset (an integer number of steps) centres the
+//! 256 levels on the frame's residuals.
+//!
+//! Intra (JPEG) frames take an offset per frame and coordinate. MPEG-4 P-frames predict a frame's
+//! pixels from the previous frame's, which only works if a pixel value means the same residual in
+//! both: there step and offset are shared by a whole group of pictures.
+//!
+//! Residuals that do not fit the 256 levels around the offset: if only a few do (at most
+//! [`CORRECTION_SHARE`] of the group's values), they are clipped in the picture and sent exactly
+//! (at the pixel step) in a sparse correction list ([`super::corrections`]); if more, the group's
+//! step is widened just enough that that holds (stored per frame and coordinate), so such a group
+//! costs precision, never a wrong frame. The widened step is the smallest that works rather than a
+//! power of two, so that a finer pixel step never ends in a coarser frame step: a higher quality
+//! never gives a higher error.
 
+use super::corrections::Corrections;
 use crate::error::{Error, Result};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 
 /// Largest quantised value (8-bit images).
 pub const LEVELS: f32 = 255.0;
+/// The level of the offset: mid-grey.
+pub const MID: f32 = 128.0;
+/// The share of a group's values that may be clipped and corrected before its step is widened.
+pub const CORRECTION_SHARE: f64 = 1.0 / 256.0;
+/// Levels a group's kept values may span: 254 rather than 255 leaves room for rounding at both ends.
+const SPAN: f64 = LEVELS as f64 - 1.0;
+/// Bytes per frame and coordinate in the ranges part: step (f32) and offset (i32).
+const AXIS_BYTES: usize = 8;
 
-/// The interval one coordinate's residuals are quantised over.
+/// How one coordinate's residuals of one frame map to levels: residual = (level − 128 + offset) × step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisRange {
-    /// Residual that maps to 0.
-    pub min: f32,
-    /// Residual that maps to 255.
-    pub max: f32,
+    /// One grey level, in model units: the pixel step, or more for a group whose residuals span
+    /// more than 256 of them.
+    pub step: f32,
+    /// The residual at mid-grey, in steps.
+    pub offset: i32,
 }
 
 impl AxisRange {
-    /// The range spanning `values` (a zero-width range at 0 for no values).
-    pub fn spanning(values: impl Iterator<Item = f32>) -> Self {
-        let (mut min, mut max) = (f32::INFINITY, f32::NEG_INFINITY);
-        for v in values {
-            min = min.min(v);
-            max = max.max(v);
-        }
-        if min > max {
-            Self { min: 0.0, max: 0.0 }
-        } else {
-            Self { min, max }
-        }
+    /// The range of one grey level `step`, centred on `offset` steps.
+    pub fn new(step: f32, offset: i32) -> Self {
+        Self { step, offset }
     }
 
-    /// The smallest range covering both.
-    pub fn union(self, other: Self) -> Self {
-        Self {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-        }
+    /// `value` as a real level, not clamped (rounding is left to the caller, after padding).
+    fn level(self, value: f32) -> f32 {
+        value / self.step - self.offset as f32 + MID
     }
 
-    /// `value` as a real number in `0..=255` (rounding is left to the caller, after padding).
+    /// `value` as a real number in `0..=255`: values beyond the range are clipped.
     pub fn quantise(self, value: f32) -> f32 {
-        let width = self.max - self.min;
-        if width <= 0.0 {
-            0.0
+        let level = self.level(value);
+        if level.is_nan() {
+            MID
         } else {
-            ((value - self.min) / width * LEVELS).clamp(0.0, LEVELS)
+            level.clamp(0.0, LEVELS)
         }
+    }
+
+    /// Whether `value` rounds to a level in `0..=255`.
+    pub fn fits(self, value: f32) -> bool {
+        let level = self.level(value).round();
+        (0.0..=LEVELS).contains(&level)
     }
 
     /// The residual a pixel value stands for.
     pub fn dequantise(self, level: f32) -> f32 {
-        self.min + (self.max - self.min) * (level / LEVELS)
+        (level - MID + self.offset as f32) * self.step
+    }
+
+    /// The residual at level 0.
+    pub fn min(self) -> f32 {
+        self.dequantise(0.0)
+    }
+
+    /// The residual at level 255.
+    pub fn max(self) -> f32 {
+        self.dequantise(LEVELS)
     }
 }
 
 /// The ranges of the x, y and z residual images of one frame.
 pub type FrameRanges = [AxisRange; 3];
 
-/// How residual ranges are shared between frames.
+/// How steps and offsets are shared between frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RangeMode {
-    /// A range per frame and coordinate (intra coding).
+    /// An offset per frame and coordinate (intra coding).
     PerFrame,
-    /// One range per group of `n` frames and coordinate (P-frame coding).
+    /// One step and offset per group of `n` frames and coordinate (P-frame coding).
     PerGroup(usize),
 }
 
-/// The ranges of every frame's residuals (`residuals[f][v]`), shared as `mode` says.
-pub fn frame_ranges(residuals: &[Vec<[f32; 3]>], mode: RangeMode) -> Vec<FrameRanges> {
-    let own: Vec<FrameRanges> = residuals
+impl RangeMode {
+    /// Frames per group (1 for intra coding).
+    pub fn group(self) -> usize {
+        match self {
+            RangeMode::PerFrame => 1,
+            RangeMode::PerGroup(n) => n.max(1),
+        }
+    }
+}
+
+/// Every frame's ranges at pixel step `pixel_step` (`residuals[f][v]`, grouped as `mode` says),
+/// and the corrections of the values they clip.
+pub fn choose(
+    residuals: &[Vec<[f32; 3]>],
+    mode: RangeMode,
+    pixel_step: f32,
+) -> (Vec<FrameRanges>, Corrections) {
+    let n = mode.group();
+    let mut ranges = Vec::with_capacity(residuals.len());
+    for group in residuals.chunks(n) {
+        let shared: FrameRanges = std::array::from_fn(|a| group_range(group, a, pixel_step));
+        ranges.extend(std::iter::repeat_n(shared, group.len()));
+    }
+    let corrections = Corrections::of_clipped(residuals, &ranges, pixel_step);
+    (ranges, corrections)
+}
+
+/// The step and offset of axis `a` over a group: at the pixel step, centred on the [`SPAN`]-level
+/// window that holds most of the group's values, if it leaves out at most [`CORRECTION_SHARE`] of
+/// them; else centred on the narrowest window that does, at the step that makes it [`SPAN`] levels.
+fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange {
+    let mut values: Vec<f64> = group
         .iter()
-        .map(|frame| std::array::from_fn(|a| AxisRange::spanning(frame.iter().map(|r| r[a]))))
+        .flatten()
+        .map(|r| f64::from(r[a]) / f64::from(pixel_step))
+        .filter(|v| v.is_finite())
         .collect();
-    match mode {
-        RangeMode::PerFrame => own,
-        RangeMode::PerGroup(n) => {
-            let n = n.max(1);
-            let mut out = Vec::with_capacity(own.len());
-            for group in own.chunks(n) {
-                let shared: FrameRanges = std::array::from_fn(|a| {
-                    group.iter().skip(1).fold(group[0][a], |r, g| r.union(g[a]))
-                });
-                out.extend(std::iter::repeat_n(shared, group.len()));
-            }
-            out
+    if values.is_empty() {
+        return AxisRange::new(pixel_step, 0);
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    let keep = n - (n as f64 * CORRECTION_SHARE).floor() as usize;
+    let (held, lo, hi) = fullest_window(&values);
+    let (lo, hi) = if held >= keep {
+        (lo, hi)
+    } else {
+        (0..=n - keep)
+            .map(|i| (values[i], values[i + keep - 1]))
+            .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+            .unwrap_or((values[0], values[n - 1]))
+    };
+    let scale = ((hi - lo) / SPAN).max(1.0);
+    // f32 rounding must not narrow the step below what the window needs.
+    let mut step = (f64::from(pixel_step) * scale) as f32;
+    if f64::from(step) < f64::from(pixel_step) * scale {
+        step = f32::from_bits(step.to_bits() + 1);
+    }
+    let mid = 0.5 * (lo + hi) * f64::from(pixel_step) / f64::from(step);
+    let offset = mid.round().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
+    AxisRange::new(step, offset)
+}
+
+/// The window of at most [`SPAN`] pixel steps that holds most of the sorted `values` (in pixel
+/// steps): how many it holds, its lowest and its highest value.
+fn fullest_window(sorted: &[f64]) -> (usize, f64, f64) {
+    let (mut best, mut best_at, mut j) = (0usize, 0usize, 0usize);
+    for i in 0..sorted.len() {
+        j = j.max(i);
+        while j + 1 < sorted.len() && sorted[j + 1] - sorted[i] <= SPAN {
+            j += 1;
         }
+        if j + 1 - i > best {
+            (best, best_at) = (j + 1 - i, i);
+        }
+    }
+    match best {
+        0 => (0, 0.0, 0.0),
+        _ => (best, sorted[best_at], sorted[best_at + best - 1]),
     }
 }
 
-/// Widens every range narrower than `floor` × the widest range of its coordinate over the sequence
-/// to that width, about its own midpoint (`floor` 0 leaves them all).
-///
-/// A tight range spends all 256 levels on small residuals, so the image codec's error in levels
-/// becomes a small geometric error bought with many bits, while frames with wide ranges carry the
-/// large errors. A common floor evens the step across frames, which is where a fixed rate buys the
-/// lowest mean error (reverse water-filling).
-pub fn widen(ranges: &mut [FrameRanges], floor: f32) {
-    if floor <= 0.0 {
-        return;
-    }
-    for a in 0..3 {
-        let widest = ranges
-            .iter()
-            .map(|r| r[a].max - r[a].min)
-            .fold(0.0f32, f32::max);
-        let min_width = floor.min(1.0) * widest;
-        for r in ranges.iter_mut() {
-            let width = r[a].max - r[a].min;
-            if width < min_width {
-                let mid = 0.5 * (r[a].max + r[a].min);
-                r[a] = AxisRange {
-                    min: mid - 0.5 * min_width,
-                    max: mid + 0.5 * min_width,
-                };
-            }
-        }
-    }
-}
-
-/// Serialises ranges (6 floats per frame).
-pub fn write_ranges(ranges: &[FrameRanges], w: &mut ByteWriter) {
-    w.u32(ranges.len() as u32);
+/// Serialises the pixel step and every frame's steps and offsets.
+pub fn write_ranges(pixel_step: f32, ranges: &[FrameRanges], w: &mut ByteWriter) {
+    w.f32(pixel_step).u32(ranges.len() as u32);
     for r in ranges.iter().flatten() {
-        w.f32(r.min).f32(r.max);
+        w.f32(r.step).u32(r.offset as u32);
     }
 }
 
-/// Reads ranges written by [`write_ranges`]; `frames` is the count the header promised.
-pub fn read_ranges(r: &mut ByteReader, frames: usize) -> Result<Vec<FrameRanges>> {
+/// Reads what [`write_ranges`] wrote: the pixel step and the ranges; `frames` is the count the
+/// header promised.
+pub fn read_ranges(r: &mut ByteReader, frames: usize) -> Result<(f32, Vec<FrameRanges>)> {
+    let pixel_step = r.f32()?;
+    if !(pixel_step.is_normal() && pixel_step > 0.0) {
+        return Err(Error::Stream(format!(
+            "residual pixel step {pixel_step} is not a positive number"
+        )));
+    }
     let n = r.u32()? as usize;
     if n != frames {
         return Err(Error::Stream(format!(
             "{n} residual ranges for {frames} frames"
         )));
     }
-    if n.saturating_mul(24) > r.remaining() {
+    if n.saturating_mul(3 * AXIS_BYTES) > r.remaining() {
         return Err(Error::Stream("residual ranges are truncated".into()));
     }
-    (0..n)
+    let ranges = (0..n)
         .map(|_| {
-            let mut fr = [AxisRange { min: 0.0, max: 0.0 }; 3];
+            let mut fr = [AxisRange::new(pixel_step, 0); 3];
             for a in fr.iter_mut() {
-                let (min, max) = (r.f32()?, r.f32()?);
-                if min > max {
-                    return Err(Error::Stream("a residual range has min above max".into()));
+                let (step, offset) = (r.f32()?, r.u32()? as i32);
+                if !(step.is_finite() && step >= pixel_step) {
+                    return Err(Error::Stream(format!(
+                        "a residual range has step {step}, below the pixel step {pixel_step}"
+                    )));
                 }
-                *a = AxisRange { min, max };
+                *a = AxisRange::new(step, offset);
             }
             Ok(fr)
         })
-        .collect()
+        .collect::<Result<_>>()?;
+    Ok((pixel_step, ranges))
 }
 
 #[cfg(test)]
@@ -161,62 +231,57 @@ mod tests {
     use super::*;
 
     #[test]
-    fn quantise_round_trip_within_half_a_step() {
-        let r = AxisRange {
-            min: -0.5,
-            max: 1.5,
-        };
-        for i in 0..=100 {
-            let v = -0.5 + 2.0 * i as f32 / 100.0;
+    fn levels_round_trip_within_half_a_step_and_mid_grey_is_the_offset() {
+        let r = AxisRange::new(0.01, 7);
+        assert_eq!(r.quantise(0.07), MID);
+        for i in -127..=127 {
+            let v = 0.07 + i as f32 * 0.0099;
+            assert!(r.fits(v), "{v}");
             let back = r.dequantise(r.quantise(v).round());
-            assert!(
-                (back - v).abs() <= 0.5 * 2.0 / 255.0 + 1e-6,
-                "{v} -> {back}"
-            );
+            assert!((back - v).abs() <= 0.005 + 1e-6, "{v} -> {back}");
         }
-        let flat = AxisRange { min: 3.0, max: 3.0 };
-        assert_eq!(flat.dequantise(flat.quantise(3.0)), 3.0);
+        assert!(!r.fits(0.07 + 1.3) && r.quantise(0.07 + 1.3) == LEVELS);
     }
 
     #[test]
-    fn widening_keeps_each_range_covering_its_values() {
-        let narrow = AxisRange { min: 0.9, max: 1.1 };
-        let wide = AxisRange {
-            min: -2.0,
-            max: 2.0,
-        };
-        let mut ranges = vec![[narrow; 3], [wide; 3]];
-        widen(&mut ranges, 0.0);
-        assert_eq!(ranges[0][0], narrow);
-        widen(&mut ranges, 0.5);
-        assert_eq!(ranges[1][0], wide, "the widest range is left as it is");
-        let r = ranges[0][2];
-        assert!((r.max - r.min - 2.0).abs() < 1e-6, "{r:?}");
-        assert!(r.min <= narrow.min && r.max >= narrow.max, "{r:?}");
+    fn a_few_outliers_are_clipped_many_widen_the_step() {
+        let step = 0.01;
+        // 1000 values within ±1, i.e. ±100 steps: they fit at step 0.01.
+        let mut frame: Vec<[f32; 3]> = (0..1000)
+            .map(|i| [(i as f32 / 500.0 - 1.0), 0.0, 0.5])
+            .collect();
+        frame[3][0] = 50.0;
+        let (ranges, corrections) = choose(&[frame.clone()], RangeMode::PerFrame, step);
+        assert_eq!(ranges[0][0].step, step, "{:?}", ranges[0][0]);
+        assert_eq!(ranges[0][2].offset, 50);
+        assert_eq!(corrections.frame(0).len(), 1);
+        assert_eq!(corrections.frame(0)[0].vertex, 3);
+        // Values over ±300 steps: the step widens to fit them in 254 levels, one outlier aside.
+        let wide: Vec<[f32; 3]> = frame.iter().map(|r| [3.0 * r[0], 0.0, 0.0]).collect();
+        let (ranges, corrections) = choose(std::slice::from_ref(&wide), RangeMode::PerFrame, step);
+        let r = ranges[0][0];
+        assert!(r.step > 2.3 * step && r.step < 2.4 * step, "{r:?}");
+        let corrected = corrections.frame(0);
+        assert!(corrected.len() <= 3 && corrected.iter().any(|c| c.vertex == 3));
+        assert!(wide.iter().skip(4).take(900).all(|v| r.fits(v[0])));
     }
 
     #[test]
-    fn group_ranges_cover_each_member() {
+    fn groups_share_a_range_and_ranges_round_trip() {
         let res = vec![
             vec![[0.0, 1.0, 2.0]],
-            vec![[-1.0, 5.0, 2.0]],
+            vec![[-1.0, 1.5, 2.0]],
             vec![[4.0, 0.0, 0.0]],
         ];
-        let g = frame_ranges(&res, RangeMode::PerGroup(2));
+        let (g, _) = choose(&res, RangeMode::PerGroup(2), 0.25);
         assert_eq!(g[0], g[1]);
-        assert_eq!(
-            g[0][0],
-            AxisRange {
-                min: -1.0,
-                max: 0.0
-            }
-        );
-        assert_eq!(g[2][0], AxisRange { min: 4.0, max: 4.0 });
+        assert_eq!(g[0][0].offset, -2);
+        assert_eq!(g[2][0].offset, 16);
         let mut w = ByteWriter::new();
-        write_ranges(&g, &mut w);
+        write_ranges(0.25, &g, &mut w);
         let bytes = w.into_bytes();
-        let back = read_ranges(&mut ByteReader::new(&bytes, "ranges"), 3).unwrap();
-        assert_eq!(back, g);
+        let (step, back) = read_ranges(&mut ByteReader::new(&bytes, "ranges"), 3).unwrap();
+        assert_eq!((step, back), (0.25, g));
         assert!(read_ranges(&mut ByteReader::new(&bytes, "ranges"), 4).is_err());
     }
 }

@@ -15,7 +15,7 @@ use std::path::Path;
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
 /// The container version this build writes and reads.
-pub const VERSION: u16 = 1;
+pub const VERSION: u16 = 2;
 
 /// Bytes of a part header: tag, checksum kind, length, CRC.
 pub const PART_HEADER_LEN: usize = 17;
@@ -367,9 +367,16 @@ fn read_file_header<R: Read>(source: &mut R) -> Result<u32> {
         ));
     }
     let version = r.u16()?;
+    if version < VERSION {
+        return Err(Error::Stream(format!(
+            "this file was written by an older mcgv-video (stream version {version}); this build \
+             reads stream version {VERSION} only: re-encode the animation from its source"
+        )));
+    }
     if version != VERSION {
         return Err(Error::Stream(format!(
-            "stream version {version}; this build reads version {VERSION}"
+            "stream version {version} is newer than this build reads (version {VERSION}): \
+             update mcgv-video"
         )));
     }
     let _reserved = r.u16()?;
@@ -404,6 +411,14 @@ fn read_part_entry<R: Read>(
     let mut r = ByteReader::new(&ph, "part header");
     let mut tag = [0u8; 4];
     tag.copy_from_slice(r.take(4)?);
+    // Part tags are outside every CRC: a damaged tag would otherwise drop an optional part
+    // (the attributes) silently. Every part of this version is known, so any other is refused.
+    if Tag(tag).name() == "unknown part" {
+        return Err(Error::Stream(format!(
+            "part {i}: unknown tag {} (damaged file?)",
+            Tag(tag)
+        )));
+    }
     let checksum = match r.u8()? {
         0 => Checksum::Whole,
         1 => Checksum::Chunked,

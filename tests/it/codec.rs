@@ -2,7 +2,7 @@
 //! robustness against damaged input.
 
 use mcgv_video::codec::mpeg4::{self, Mpeg4Options, Packet};
-use mcgv_video::codec::{abbreviated, jpeg, quality_to_qscale, Plane};
+use mcgv_video::codec::{abbreviated, jpeg, mpeg4_law, Plane};
 use mcgv_video::Result;
 use std::f64::consts::TAU;
 use std::process::Command;
@@ -394,9 +394,9 @@ fn measure_rate_distortion_and_speed() -> Result<()> {
     }
     println!(
         "quality → qscale: 50→{} 75→{} 90→{}",
-        quality_to_qscale(50),
-        quality_to_qscale(75),
-        quality_to_qscale(90)
+        mpeg4_law(50).quantiser,
+        mpeg4_law(75).quantiser,
+        mpeg4_law(90).quantiser
     );
     let sample = jpeg::encode(&planes[0], 75)?;
     println!(

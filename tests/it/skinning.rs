@@ -34,9 +34,9 @@ fn jpeg_skinning_round_trip_keeps_connectivity_and_bounds_error() {
     assert_eq!(decoded.frame_count(), mesh.frame_count());
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
-    // Measured 1.4e-5 since the affine maps follow the quality's step (5.1e-6 with the former
-    // 17-bit maps; the affine predictor reached 2.3e-5 at the same settings); the bound is about twice.
-    assert!(m.rmse < 3e-5, "RMSE {}", m.rmse);
+    // Measured 1.9e-5 (release build, `mcgv-video eval`); the bound is about twice that, and below
+    // what the affine predictor reaches at the same settings (5.6e-5).
+    assert!(m.rmse < 4e-5, "RMSE {}", m.rmse);
     // Random access goes through the same prediction.
     let f = 7;
     assert_eq!(
@@ -58,9 +58,8 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
     let decoded = decode_all(bytes.clone()).unwrap();
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
-    // Measured 5.1e-6 with maps at the quality's step (2.0e-6 with 17-bit maps; affine predictor:
-    // 2.0e-5 at the same settings); the bound is twice that.
-    assert!(m.rmse < 1e-5, "RMSE {}", m.rmse);
+    // Measured 1.7e-5 (affine: 9.7e-5 at the same settings); the bound is 2.4 times that.
+    assert!(m.rmse < 4e-5, "RMSE {}", m.rmse);
     let f = 15;
     let alone = decoder(bytes).unwrap().decode_frame(f).unwrap();
     assert_eq!(alone, decoded.frame(f));

@@ -287,12 +287,18 @@ fn step_overrides_quality_and_is_checked() {
             ..tdct(50)
         },
         EncodeOptions {
-            step: Some(0.001),
+            step: Some(1.5),
             ..EncodeOptions::default()
         },
     ] {
         assert!(encode(&mesh, &bad).is_err());
     }
+    // The step is every codec's since the error law (issue 15): the image codecs' pixel step.
+    let jpeg = EncodeOptions {
+        step: Some(0.001),
+        ..EncodeOptions::default()
+    };
+    assert!(encode(&mesh, &jpeg).is_ok());
 }
 
 /// Dead-zone quantisation against plain rounding, at equal error: bytes of the coefficients and

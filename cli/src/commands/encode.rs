@@ -62,6 +62,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         codec,
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
         qscale: args.qscale,
+        jpeg_quality: args.jpeg_quality,
         clusters: args.clusters.unwrap_or(defaults.clusters),
         segmentation,
         affine_precision: args.affine_precision,
@@ -76,7 +77,6 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             PredictorChoice::Skinning => PredictorKind::Skinning,
         },
         weight_bits: args.weight_bits,
-        range_floor: args.range_floor,
         step: args.step,
         uv_bits: args.uv_bits,
         ..defaults
@@ -85,10 +85,17 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
 
 /// One rule for options of another codec: a usage error naming the codec(s) they belong to.
 fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Result<()> {
-    let given: [(&'static str, bool, &[Codec]); 6] = [
+    if args.range_floor.is_some() {
+        return Err(Error::option(
+            "range_floor",
+            "was retired: --quality now sets one quantisation step for every frame, so frames \
+             with small residuals already cost few bits; leave it out",
+        ));
+    }
+    let given: [(&'static str, bool, &[Codec]); 5] = [
         ("qscale", args.qscale.is_some(), &[Codec::Mpeg4]),
+        ("jpeg_quality", args.jpeg_quality.is_some(), &[Codec::Jpeg]),
         ("gop", args.gop.is_some(), &[Codec::Mpeg4]),
-        ("step", args.step.is_some(), &[Codec::Tdct]),
         (
             "padding",
             args.padding.is_some(),
@@ -97,11 +104,6 @@ fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Res
         (
             "lattice",
             lattice != Lattice::Auto,
-            &[Codec::Jpeg, Codec::Mpeg4],
-        ),
-        (
-            "range_floor",
-            args.range_floor != 0.0,
             &[Codec::Jpeg, Codec::Mpeg4],
         ),
     ];

@@ -139,8 +139,11 @@ fn band_table(bands: &[u64], decoded: usize) -> String {
 
 fn summary(h: &Header, path: &Path) -> String {
     let codec = match h.codec {
-        Codec::Jpeg => format!("jpeg quality {}", h.quality),
-        Codec::Mpeg4 => format!("mpeg4 qscale {} gop {}", h.qscale, h.gop),
+        Codec::Jpeg => format!("jpeg quality {} (pictures at {})", h.quality, h.qscale),
+        Codec::Mpeg4 => format!(
+            "mpeg4 quality {} qscale {} gop {}",
+            h.quality, h.qscale, h.gop
+        ),
         Codec::Tdct => {
             return format!(
                 "{}: {} vertices x {} frames, {} faces; tdct quality {}; {} clusters, {} predictor, no atlas",

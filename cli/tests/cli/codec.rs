@@ -305,7 +305,7 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
     let coarse = json(&out);
     assert!(coarse["rmse"].as_f64().unwrap() > full["rmse"].as_f64().unwrap());
 
-    // --bands and --step belong to tdct.
+    // --bands belongs to tdct; --range-floor is retired, with a word of why.
     let jpeg = dir.path().join("fig_jpeg.mcgv");
     let out = run(&[
         "encode",
@@ -314,12 +314,16 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
         &sample,
         "-o",
         jpeg.to_str().unwrap(),
-        "--step",
-        "0.001",
+        "--range-floor",
+        "0.5",
         "--quiet",
     ]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--step applies to the tdct codec"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("range") && stderr.contains("retired"),
+        "{stderr}"
+    );
     ok(&run(&[
         "encode",
         "--codec",

@@ -219,8 +219,8 @@ fn f8_options_of_another_codec_are_usage_errors() {
             vec!["--gop", "mpeg4", "jpeg"],
         ),
         (
-            vec!["--codec", "jpeg", "--step", "0.01"],
-            vec!["--step", "tdct"],
+            vec!["--codec", "mpeg4", "--jpeg-quality", "80"],
+            vec!["--jpeg-quality", "jpeg"],
         ),
         (vec!["--padding", "cg"], vec!["--padding", "jpeg and mpeg4"]),
         (

@@ -49,8 +49,7 @@ const MAX_LEVEL: f64 = (1u64 << 40) as f64;
 /// The quantiser step for `--quality`: Δ = D · 1e-3 · s(q) / 100, with D the first frame's
 /// bounding-box diagonal and s the IJG scale law (see [`crate::codec::ijg_scale_percent`]).
 pub fn step_for_quality(quality: u8, diagonal: f64) -> f64 {
-    let s = crate::codec::ijg_scale_percent(quality).max(1);
-    diagonal * 1e-3 * f64::from(s) / 100.0
+    crate::codec::quality::target_step(quality, diagonal)
 }
 
 /// The orthonormal DCT-II of every vertex/axis residual sequence, band-major: `out[k][3v + a]` is
