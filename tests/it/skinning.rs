@@ -34,9 +34,10 @@ fn jpeg_skinning_round_trip_keeps_connectivity_and_bounds_error() {
     assert_eq!(decoded.frame_count(), mesh.frame_count());
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
-    // Measured 1.9e-5 (release build, `mcgv-video eval`); the bound is about twice that, and below
-    // what the affine predictor reaches at the same settings (5.6e-5).
-    assert!(m.rmse < 4e-5, "RMSE {}", m.rmse);
+    // Measured 6.3e-5 with the error law and the affine maps at the quality's step (`mcgv-video
+    // encode media/RiggedSimple.glb --codec jpeg --quality 50 --padding cg --predictor skinning`, then
+    // `eval`); the bound leaves 25 % and stays below what the affine predictor reaches (9.2e-5).
+    assert!(m.rmse < 8e-5, "RMSE {}", m.rmse);
     // Random access goes through the same prediction.
     let f = 7;
     assert_eq!(
@@ -58,7 +59,8 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
     let decoded = decode_all(bytes.clone()).unwrap();
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
-    // Measured 1.7e-5 (affine: 9.7e-5 at the same settings); the bound is 2.4 times that.
+    // Measured 2.8e-5 (affine: 5.8e-5 at the same settings, both with the error law and the affine
+    // maps at the quality's step); the bound is 1.4 times that.
     assert!(m.rmse < 4e-5, "RMSE {}", m.rmse);
     let f = 15;
     let alone = decoder(bytes).unwrap().decode_frame(f).unwrap();
