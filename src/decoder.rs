@@ -257,7 +257,10 @@ impl<R: Read + Seek> Decoder<R> {
             .collect::<Result<Vec<_>>>()?;
         self.residuals
             .add_all(&mut self.reader, &mut out, progress)?;
-        AnimatedMesh::new(self.triangles.clone(), out)?.with_attributes(self.attributes.clone())
+        let rate = f64::from(self.header.frame_rate);
+        Ok(AnimatedMesh::new(self.triangles.clone(), out)?
+            .with_attributes(self.attributes.clone())?
+            .with_frame_rate(Some(rate)))
     }
 
     fn predict(&self, f: usize) -> Result<Vec<Point>> {

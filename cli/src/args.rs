@@ -226,9 +226,10 @@ pub struct DecodeArgs {
     /// targets, one per frame). Missing parent folders are created.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// glTF output: frames per second of the animation (the stream does not record the source's).
-    #[arg(long, default_value_t = 30.0)]
-    pub fps: f64,
+    /// glTF output: frames per second of the animation (default: the source's, which the stream
+    /// records for glTF inputs; else 30).
+    #[arg(long)]
+    pub fps: Option<f64>,
     /// glTF output: copy the materials, textures and node name of this glTF file (the encoded
     /// source), so the decoded asset renders as the source did.
     #[arg(long, value_name = "SOURCE.glb")]

@@ -182,6 +182,7 @@ fn header(
         reorder: opts.reorder,
         charts: atlas.map_or(0, |s| s.charts as u32),
         chart_pixels: atlas.map_or(0, |s| s.chart_pixels as u32),
+        frame_rate: mesh.frame_rate().map_or(0.0, |r| r as f32),
         predictor: opts.predictor,
     }
 }

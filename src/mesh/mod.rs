@@ -14,6 +14,9 @@ mod obj;
 mod pc2;
 
 pub use attributes::Attributes;
+
+/// Frames per second of a glTF output when the source's rate is unknown (OBJ and PC2 inputs).
+pub const DEFAULT_FPS: f64 = 30.0;
 pub use gltf::Clip;
 pub use gltf_write::{write_gltf, GltfOptions};
 pub use io::{
@@ -39,6 +42,7 @@ pub struct AnimatedMesh {
     triangles: Vec<Triangle>,
     frames: Vec<Vec<Point>>,
     attributes: Attributes,
+    frame_rate: Option<f64>,
 }
 
 impl AnimatedMesh {
@@ -80,7 +84,20 @@ impl AnimatedMesh {
             triangles,
             frames,
             attributes: Attributes::default(),
+            frame_rate: None,
         })
+    }
+
+    /// The same mesh with its source's frame rate (frames per second; not finite or not positive:
+    /// unknown). glTF inputs know theirs; the stream keeps it, so glTF output plays at that rate.
+    pub fn with_frame_rate(mut self, fps: Option<f64>) -> Self {
+        self.frame_rate = fps.filter(|r| r.is_finite() && *r > 0.0);
+        self
+    }
+
+    /// The source's frames per second, when known.
+    pub fn frame_rate(&self) -> Option<f64> {
+        self.frame_rate
     }
 
     /// The same mesh with texture coordinates and materials (checked against its vertices and
@@ -186,6 +203,7 @@ impl AnimatedMesh {
             triangles,
             frames,
             attributes,
+            frame_rate: self.frame_rate,
         })
     }
 }

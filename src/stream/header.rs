@@ -43,6 +43,8 @@ pub struct Header {
     pub charts: u32,
     /// Lattice pixels covered by chart blocks (informational: packing efficiency).
     pub chart_pixels: u32,
+    /// The source's frames per second (0: unknown, e.g. OBJ sequences): glTF output plays at it.
+    pub frame_rate: f32,
     /// The motion predictor: piecewise affine, or skinning (then a weights part follows).
     pub predictor: PredictorKind,
 }
@@ -100,7 +102,8 @@ impl Header {
             .u32(self.requested_clusters)
             .u8(self.reorder as u8)
             .u32(self.charts)
-            .u32(self.chart_pixels);
+            .u32(self.chart_pixels)
+            .f32(self.frame_rate);
         // The predictor byte is written only when it is not the affine default, so affine streams
         // stay byte-identical to (and readable by) builds from before the skinning predictor, and
         // those builds refuse a skinning stream (trailing header bytes) instead of mispredicting it.
@@ -131,6 +134,7 @@ impl Header {
             reorder: r.u8()? != 0,
             charts: r.u32()?,
             chart_pixels: r.u32()?,
+            frame_rate: r.f32()?,
             predictor: if r.remaining() > 0 {
                 predictor_from_id(r.u8()?)?
             } else {
@@ -141,6 +145,12 @@ impl Header {
         h.check_counts()?;
         h.check_lattice()?;
         h.check_quantisation()?;
+        if !(h.frame_rate.is_finite() && h.frame_rate >= 0.0) {
+            return Err(Error::Stream(format!(
+                "header frame rate {} is not a non-negative number",
+                h.frame_rate
+            )));
+        }
         Ok(h)
     }
 
@@ -241,6 +251,7 @@ mod tests {
             reorder: false,
             charts: 31,
             chart_pixels: 40_000,
+            frame_rate: 24.0,
             predictor: PredictorKind::Affine,
         }
     }

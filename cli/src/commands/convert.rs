@@ -28,7 +28,11 @@ pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
             // A glTF source lends its materials and textures to the rewritten asset.
             let source = std::path::Path::new(&args.input);
             let options = GltfOptions {
-                fps: args.input_args.fps.unwrap_or(30.0),
+                fps: args
+                    .input_args
+                    .fps
+                    .or(mesh.frame_rate())
+                    .unwrap_or(mcgv_video::mesh::DEFAULT_FPS),
                 like: (is_gltf_path(source) && source.is_file()).then(|| source.to_path_buf()),
                 ..GltfOptions::default()
             };

@@ -9,7 +9,7 @@ use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::gltf_write::MANY_MORPH_TARGETS;
 use mcgv_video::mesh::io::{write_obj_mesh_frame, write_obj_sequence_from};
-use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions};
+use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions, DEFAULT_FPS};
 use std::fs::File;
 use std::io::BufReader;
 use std::time::Instant;
@@ -86,7 +86,7 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             create_parent(&args.output)?;
             warn_if_many_targets(mesh.frame_count());
             let options = GltfOptions {
-                fps: args.fps,
+                fps: args.fps.or(mesh.frame_rate()).unwrap_or(DEFAULT_FPS),
                 like: args.like.clone(),
                 ..GltfOptions::default()
             };
@@ -114,6 +114,7 @@ fn decode_mesh(
     quiet: bool,
 ) -> Result<AnimatedMesh> {
     let frames = decoder.header().frames as usize;
+    let rate = Some(f64::from(decoder.header().frame_rate));
     match args.frame {
         Some(f) => {
             if f >= frames {
@@ -123,8 +124,11 @@ fn decode_mesh(
                 ));
             }
             let positions = decoder.decode_frame(f)?;
-            AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
-                .with_attributes(decoder.attributes().clone())
+            Ok(
+                AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
+                    .with_attributes(decoder.attributes().clone())?
+                    .with_frame_rate(rate),
+            )
         }
         None if args.frames.is_some() => {
             let range = args.frames.clone().unwrap_or(0..frames);
@@ -137,8 +141,9 @@ fn decode_mesh(
             let positions = range
                 .map(|f| decoder.decode_frame(f))
                 .collect::<Result<Vec<_>>>()?;
-            AnimatedMesh::new(decoder.triangles().to_vec(), positions)?
-                .with_attributes(decoder.attributes().clone())
+            Ok(AnimatedMesh::new(decoder.triangles().to_vec(), positions)?
+                .with_attributes(decoder.attributes().clone())?
+                .with_frame_rate(rate))
         }
         None => {
             let pb = progress::bar(frames as u64, "decode", quiet);

@@ -197,3 +197,28 @@ fn decode_frames_a_to_b_keeps_their_numbers() {
         assert_eq!(out.status.code(), Some(2), "{bad}");
     }
 }
+
+/// The stream records a glTF source's frame rate, so the decoded glTF plays at it (CesiumMan: 24
+/// fps) unless `--fps` says otherwise; an OBJ source's rate is unknown and the output gets 30.
+#[test]
+fn decoded_gltf_plays_at_the_source_frame_rate() {
+    let dir = tempfile::tempdir().unwrap();
+    let stream = dir.path().join("s.mcgv");
+    let s = stream.to_str().unwrap();
+    let source = media_path("CesiumMan.glb");
+    ok(&run(&["encode", &source, "-o", s, "--quiet"]));
+    let fps_of = |extra: &[&str]| {
+        let out = dir.path().join("out.glb");
+        let o = out.to_str().unwrap();
+        let mut args = vec!["decode", s, "-o", o, "--quiet"];
+        args.extend_from_slice(extra);
+        ok(&run(&args));
+        let info = crate::common::json(&run(&["info", o, "--json"]));
+        info["clips"][0]["fps"]
+            .as_f64()
+            .expect("a clip with a rate")
+    };
+    assert_eq!(fps_of(&[]), 24.0);
+    assert_eq!(fps_of(&["--fps", "12"]), 12.0);
+    assert_eq!(fps_of(&["--frames", "0..10"]), 24.0);
+}

@@ -158,11 +158,13 @@ fn bake(
 
     let times = sample::FrameTimes::new(&channels, fps, geometry.vertex_count, path)?;
     let pose = nodes::Pose::new(&document);
+    let rate = times.rate();
     let frames = times
         .map(|time| geometry.bake(&pose.at(time, &channels), &skins))
         .collect();
     let attributes = geometry.attributes(&document);
     AnimatedMesh::new(geometry.triangles, frames)
         .and_then(|mesh| mesh.with_attributes(attributes))
+        .map(|mesh| mesh.with_frame_rate(Some(rate)))
         .map_err(|e| fail(e.to_string()))
 }

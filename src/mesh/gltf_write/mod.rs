@@ -29,7 +29,8 @@ pub const MANY_MORPH_TARGETS: usize = 256;
 /// How to write a glTF file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GltfOptions {
-    /// Frames per second of the weights animation (the stream does not record the source's rate).
+    /// Frames per second of the weights animation (the CLI passes the source's, which the mesh and
+    /// the stream record for glTF inputs, else [`crate::mesh::DEFAULT_FPS`]).
     pub fps: f64,
     /// Name of the node holding the mesh (default: the `like` source's, else "mcgv-video").
     pub node_name: Option<String>,
@@ -41,7 +42,7 @@ pub struct GltfOptions {
 impl Default for GltfOptions {
     fn default() -> Self {
         Self {
-            fps: 30.0,
+            fps: crate::mesh::DEFAULT_FPS,
             node_name: None,
             like: None,
         }
