@@ -89,18 +89,7 @@ pub fn images(codec: &dyn PictureCodec, input: &ResidualInput) -> Result<Geometr
 /// bounding-box diagonal `diagonal`) or the law's for `opts.quality`, rounded to the `f32` the
 /// stream stores.
 pub fn pixel_step(codec: &dyn PictureCodec, diagonal: f64, opts: &EncodeOptions) -> Result<f32> {
-    let step = match opts.step {
-        Some(fraction) => diagonal * fraction,
-        None => codec.step_factor(opts) * super::target_step(opts.quality, diagonal),
-    };
-    let stored = step as f32;
-    if !(stored.is_normal() && stored > 0.0) {
-        return Err(Error::Mesh(format!(
-            "the pixel step is {step} (first frame's bounding-box diagonal {diagonal}): \
-             a degenerate first frame gives no scale to quantise against"
-        )));
-    }
-    Ok(stored)
+    super::quality::stored_step("pixel step", diagonal, opts, codec.step_factor(opts))
 }
 
 /// The residual images an encoding with `codec` and `opts` makes of `residuals` on the atlas of
@@ -199,9 +188,10 @@ fn code_pictures(
     input: &ResidualInput,
 ) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
     let frames = input.residuals.len();
+    let gop = images.gop.max(1);
     let groups: Vec<std::ops::Range<usize>> = (0..frames)
-        .step_by(images.gop.max(1))
-        .map(|start| start..(start + images.gop.max(1)).min(frames))
+        .step_by(gop)
+        .map(|start| start..(start + gop).min(frames))
         .collect();
     let coded: Vec<Result<(Vec<u8>, Vec<FrameChunk>)>> = groups
         .into_par_iter()

@@ -23,6 +23,30 @@ pub fn target_step(quality: u8, diagonal: f64) -> f64 {
     diagonal * 1e-3 * f64::from(s) / 100.0
 }
 
+/// The absolute step of an encoding in model units: `opts.step` (a fraction of the first frame's
+/// bounding-box diagonal `diagonal`) or `factor` × the target step of `opts.quality`, rounded to
+/// the `f32` the stream stores, so that the encoder quantises with exactly the step the decoder
+/// reads. `what` names the step in the error a degenerate first frame gives.
+pub fn stored_step(
+    what: &str,
+    diagonal: f64,
+    opts: &crate::encoder::EncodeOptions,
+    factor: f64,
+) -> crate::error::Result<f32> {
+    let step = match opts.step {
+        Some(fraction) => diagonal * fraction,
+        None => factor * target_step(opts.quality, diagonal),
+    };
+    let stored = step as f32;
+    if !(stored.is_normal() && stored > 0.0) {
+        return Err(crate::error::Error::Mesh(format!(
+            "the {what} is {step} (first frame's bounding-box diagonal {diagonal}): \
+             a degenerate first frame gives no scale to quantise against"
+        )));
+    }
+    Ok(stored)
+}
+
 /// What one quality means for a picture codec.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PictureLaw {

@@ -28,19 +28,7 @@ pub use coefficients::{step_for_quality, DEAD_ZONE};
 /// bounding-box diagonal) or the one `quality` maps to, rounded to the `f32` the stream stores, so
 /// that the encoder quantises with exactly the step the decoder reads.
 pub fn step(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<f32> {
-    let diagonal = mesh.bbox_diagonal();
-    let step = match opts.step {
-        Some(fraction) => diagonal * fraction,
-        None => step_for_quality(opts.quality, diagonal),
-    };
-    let stored = step as f32;
-    if !(stored.is_normal() && stored > 0.0) {
-        return Err(Error::Mesh(format!(
-            "the temporal-DCT step is {step} (first frame's bounding-box diagonal {diagonal}): \
-             a degenerate first frame gives no scale to quantise against"
-        )));
-    }
-    Ok(stored)
+    crate::codec::quality::stored_step("temporal-DCT step", mesh.bbox_diagonal(), opts, 1.0)
 }
 
 /// The temporal-DCT residual encoder.

@@ -42,7 +42,8 @@ pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Re
     bake(gltf, path.parent(), path, fps, clip)
 }
 
-/// The parsed document of a glTF file and its loaded buffers (for the writer's `like` option).
+/// The parsed document of a glTF file and its loaded buffers (for [`clips`] and the writer's
+/// `like` option).
 pub(crate) fn load_document(path: &Path) -> Result<(gltf::Document, Vec<gltf::buffer::Data>)> {
     let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
@@ -81,11 +82,7 @@ pub struct Clip {
 /// The clips of a glTF file with the frames each bakes to at `fps` (default: each clip's own rate).
 pub(crate) fn clips(path: &Path, fps: Option<f64>) -> Result<Vec<Clip>> {
     let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let gltf::Gltf { document, blob } = validate::from_slice(&bytes, path)?;
-    validate::check_buffer_uris(&document).map_err(fail)?;
-    let buffers = gltf::import_buffers(&document, path.parent(), blob)
-        .map_err(|e| fail(format!("buffer: {e}")))?;
+    let (document, buffers) = load_document(path)?;
     let mut clips = Vec::new();
     for animation in document.animations() {
         let channels = channels::read_channels(&animation, &buffers).map_err(fail)?;

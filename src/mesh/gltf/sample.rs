@@ -7,8 +7,9 @@ use gltf::animation::{Interpolation, Property};
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::path::Path;
 
-/// Frame rate used when the clip's own keyframe rate cannot be told.
-const FALLBACK_FPS: f64 = 30.0;
+/// Frame rate used when the clip's own keyframe rate cannot be told: the one glTF output falls
+/// back on too.
+const FALLBACK_FPS: f64 = crate::mesh::DEFAULT_FPS;
 /// Estimated keyframe rates outside this range are not trusted (sparse or dense keys).
 const PLAUSIBLE_FPS: std::ops::RangeInclusive<f64> = 10.0..=240.0;
 /// More positions (frames × vertices) than this would not fit in memory: surely a mistaken `fps`.
