@@ -217,7 +217,7 @@ impl<R: Read + Seek> Decoder<R> {
     }
 
     /// The decoded picture (x | y | z residual images side by side) of frame `f`.
-    pub fn decoded_plane(&mut self, f: usize) -> Result<Plane> {
+    pub fn decoded_plane(&mut self, f: usize) -> Result<Plane<u16>> {
         self.residuals.picture(&mut self.reader, f)
     }
 

@@ -81,6 +81,7 @@ pub fn encoder_images<R: Read + Seek>(
         layout.pixel_step,
     )?;
     images.ranges = layout.ranges.clone();
+    images.depth = layout.depth;
     images.corrections = layout.corrections.clone();
     frames
         .iter()

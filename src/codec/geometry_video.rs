@@ -35,10 +35,19 @@ pub trait PictureCodec: Sync {
     fn default_padding(&self) -> padding::Method;
     /// The pixel step as a multiple of the target step of `opts.quality`.
     fn step_factor(&self, opts: &EncodeOptions) -> f64;
-    /// The picture codec's own quantiser (MPEG-4 qscale, JPEG quality), recorded in the header.
+    /// The picture codec's own quantiser (MPEG-4 qscale, JPEG quality, HEVC QP), recorded in the header.
     fn quantiser(&self, opts: &EncodeOptions) -> u8;
     /// Frames per group of pictures (1 for intra codecs).
     fn gop(&self, opts: &EncodeOptions) -> u32;
+    /// Bits a sample of the pictures an encoding with `opts` makes (8 unless the codec codes deeper
+    /// samples).
+    fn depth(&self, _opts: &EncodeOptions) -> u8 {
+        8
+    }
+    /// Bits a sample of a stream's pictures, read from its codec set-up part.
+    fn depth_of_setup(&self, _setup: &[u8]) -> Result<u8> {
+        Ok(8)
+    }
     /// An encoder for `width`×`height` pictures whose first picture is frame `first_frame` of the
     /// sequence (a key frame: every group of pictures gets its own encoder).
     fn encoder(
@@ -54,8 +63,8 @@ pub trait PictureCodec: Sync {
 
 /// Codes pictures in frame order.
 pub trait PictureEncoder {
-    /// Codes the next frame's picture.
-    fn push(&mut self, plane: &Plane) -> Result<()>;
+    /// Codes the next frame's picture (samples of the codec's depth).
+    fn push(&mut self, plane: &Plane<u16>) -> Result<()>;
     /// Ends the sequence: the codec set-up part and one chunk per frame.
     fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)>;
 }
@@ -63,7 +72,7 @@ pub trait PictureEncoder {
 /// Decodes pictures, starting at a key frame and continuing in order.
 pub trait PictureDecoder {
     /// Decodes frame `f` from its chunk.
-    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane>;
+    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane<u16>>;
 }
 
 /// The padding an encoding uses: the option's, else the picture codec's measured best.
@@ -108,7 +117,7 @@ pub fn images_of(
         size,
         atlas,
         residuals,
-        codec.range_mode(opts),
+        (codec.range_mode(opts), codec.depth(opts)),
         pixel_step,
         padding::PaddingOptions {
             method: padding_method(codec, opts),
@@ -237,7 +246,12 @@ fn code_group(
     for f in group {
         let prev = previous.as_ref().filter(|_| images.continues(f));
         let padded = images.padded(&input.residuals[f], f, prev)?;
-        encoder.push(&tile::compose([&padded[0], &padded[1], &padded[2]], w, h))?;
+        encoder.push(&tile::compose(
+            [&padded[0], &padded[1], &padded[2]],
+            w,
+            h,
+            images.depth,
+        ))?;
         previous = Some(padded);
         input.progress.frames(1);
     }
@@ -260,6 +274,8 @@ pub struct ImageLayout {
     pub setup: Vec<u8>,
     /// Lattice width and height.
     pub lattice: (u16, u16),
+    /// Bits a sample of the pictures.
+    pub depth: u8,
 }
 
 /// The geometry-video residual decoder over one picture codec.
@@ -280,12 +296,13 @@ impl<P: PictureCodec> Decoder<P> {
         let lattice = (h.lattice_width, h.lattice_height);
         let pixels =
             side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, stream.triangles)?;
+        let setup = reader.part(Tag::CODEC_SETUP)?;
+        let depth = codec.depth_of_setup(&setup)?;
         let ranges_bytes = reader.part(Tag::RANGES)?;
         let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
-        let (pixel_step, ranges) = quantise::read_ranges(&mut r, frames)?;
+        let (pixel_step, ranges) = quantise::read_ranges(&mut r, frames, depth)?;
         let corrections = Corrections::read(&mut r, frames, v)?;
         r.finish()?;
-        let setup = reader.part(Tag::CODEC_SETUP)?;
         let images_len = reader.entry(Tag::FRAMES)?.len;
         let index = FrameIndex::from_bytes(&reader.part(Tag::FRAME_INDEX)?, frames, images_len)?;
         Ok(Self {
@@ -298,6 +315,7 @@ impl<P: PictureCodec> Decoder<P> {
                 index,
                 setup,
                 lattice,
+                depth,
             },
         })
     }
@@ -319,14 +337,14 @@ impl<P: PictureCodec> Decoder<P> {
         decoder: &mut dyn PictureDecoder,
         reader: &mut ContainerReader<R>,
         f: usize,
-    ) -> Result<Plane> {
+    ) -> Result<Plane<u16>> {
         let e = self.layout.index.entry(f)?;
         let chunk = reader.chunk(Tag::FRAMES, e.offset, e.len, e.crc, &format!("frame {f}"))?;
         decoder.decode(f, &chunk)
     }
 
     /// Adds frame `f`'s residuals, read from `plane`, to `frame`.
-    fn add(&self, f: usize, plane: &Plane, frame: &mut [Point]) -> Result<()> {
+    fn add(&self, f: usize, plane: &Plane<u16>, frame: &mut [Point]) -> Result<()> {
         let (w, h) = self.picture_size();
         if plane.width != w || plane.height != h {
             return Err(Error::Stream(format!(
@@ -387,7 +405,7 @@ impl<P: PictureCodec, R: Read + Seek> ResidualDecoder<R> for Decoder<P> {
         Some(&self.layout)
     }
 
-    fn picture(&mut self, reader: &mut ContainerReader<R>, f: usize) -> Result<Plane> {
+    fn picture(&mut self, reader: &mut ContainerReader<R>, f: usize) -> Result<Plane<u16>> {
         self.layout.index.entry(f)?;
         let key = self.layout.index.key_before(f);
         let mut decoder = self.picture_decoder()?;

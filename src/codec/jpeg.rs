@@ -158,8 +158,8 @@ struct FrameEncoder {
 }
 
 impl PictureEncoder for FrameEncoder {
-    fn push(&mut self, plane: &Plane) -> Result<()> {
-        let jpeg = encode(plane, self.quality)?;
+    fn push(&mut self, plane: &Plane<u16>) -> Result<()> {
+        let jpeg = encode(&plane.to_8bit()?, self.quality)?;
         let parts = abbreviated::split(&jpeg)?;
         match &self.shared {
             None => self.shared = Some(parts.shared.clone()),
@@ -189,13 +189,14 @@ struct FrameDecoder {
 }
 
 impl PictureDecoder for FrameDecoder {
-    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane> {
+    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane<u16>> {
         let mut r = ByteReader::new(chunk, "JPEG frame");
         let tables = r.blob()?;
         let scan = r.take(r.remaining())?;
         let bytes = abbreviated::join(&self.setup, tables, scan)
             .map_err(|e| Error::Stream(format!("frame {f}: {e}")))?;
         decode(&bytes, self.width, self.height)
+            .map(|p| p.widen())
             .map_err(|e| Error::Stream(format!("frame {f}: {e}")))
     }
 }

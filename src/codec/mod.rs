@@ -7,7 +7,8 @@
 //! - [`jpeg`] and [`mpeg4`] are the paper's geometry video: the residuals are splatted onto a
 //!   multi-chart atlas ([`geometry_video`]), padded, and coded as pictures — one JPEG per frame
 //!   (any frame decodes alone) or MPEG-4 Part 2 I- and P-frames through FFmpeg (cargo feature
-//!   `mpeg4`).
+//!   `mpeg4`). [`hevc`] codes the same pictures at 10 or 12 bits a sample with libx265 (same
+//!   feature: it needs FFmpeg too).
 //! - [`tdct`] is the follow-up paper's temporal DCT: each vertex's residual trajectory transformed
 //!   over all frames and coded band by band, no images.
 //!
@@ -15,6 +16,8 @@
 
 pub mod abbreviated;
 pub mod geometry_video;
+#[cfg(feature = "mpeg4")]
+pub mod hevc;
 pub mod jpeg;
 #[cfg(feature = "mpeg4")]
 pub mod mpeg4;
@@ -23,7 +26,7 @@ pub mod quality;
 pub mod tdct;
 
 pub use plane::Plane;
-pub use quality::{ijg_scale_percent, jpeg_law, mpeg4_law, target_step, PictureLaw};
+pub use quality::{hevc_law, ijg_scale_percent, jpeg_law, mpeg4_law, target_step, PictureLaw};
 
 use crate::encoder::EncodeOptions;
 use crate::error::{Error, Result};
@@ -48,11 +51,14 @@ pub enum Codec {
     /// No images: each vertex's residuals as a temporal DCT over all frames, coded from low to high
     /// frequency, so that a truncated stream still decodes a coarser animation.
     Tdct,
+    /// HEVC at 10 or 12 bits a sample (libx265): IDR frames every `gop` frames, P-frames between
+    /// (`gop` 1: all-intra, every frame decodes alone).
+    Hevc,
 }
 
 impl Codec {
     /// Every codec, in the order of their stream ids.
-    pub const ALL: [Codec; 3] = [Codec::Jpeg, Codec::Mpeg4, Codec::Tdct];
+    pub const ALL: [Codec; 4] = [Codec::Jpeg, Codec::Mpeg4, Codec::Tdct, Codec::Hevc];
 
     /// The codec's id in the stream header. The temporal DCT's is 3 since its bands are coded with
     /// spatial prediction (issue 18): id 2 was the format before, which this build refuses.
@@ -61,6 +67,7 @@ impl Codec {
             Codec::Jpeg => 0,
             Codec::Mpeg4 => 1,
             Codec::Tdct => 3,
+            Codec::Hevc => 4,
         }
     }
 
@@ -85,6 +92,7 @@ impl Codec {
             Codec::Jpeg => "jpeg",
             Codec::Mpeg4 => "mpeg4",
             Codec::Tdct => "tdct",
+            Codec::Hevc => "hevc",
         }
     }
 
@@ -93,9 +101,9 @@ impl Codec {
         !matches!(self, Codec::Tdct)
     }
 
-    /// Whether this build can code the codec (MPEG-4 needs the `mpeg4` feature, i.e. FFmpeg).
+    /// Whether this build can code the codec (MPEG-4 and HEVC need the `mpeg4` feature, i.e. FFmpeg).
     pub fn available(self) -> bool {
-        !matches!(self, Codec::Mpeg4) || cfg!(feature = "mpeg4")
+        !matches!(self, Codec::Mpeg4 | Codec::Hevc) || cfg!(feature = "mpeg4")
     }
 
     /// The codec's encoder.
@@ -104,8 +112,10 @@ impl Codec {
             Codec::Jpeg => Box::new(geometry_video::Encoder::new(jpeg::Pictures)),
             #[cfg(feature = "mpeg4")]
             Codec::Mpeg4 => Box::new(geometry_video::Encoder::new(mpeg4::Pictures)),
+            #[cfg(feature = "mpeg4")]
+            Codec::Hevc => Box::new(geometry_video::Encoder::new(hevc::Pictures)),
             #[cfg(not(feature = "mpeg4"))]
-            Codec::Mpeg4 => return Err(unavailable()),
+            Codec::Mpeg4 | Codec::Hevc => return Err(unavailable()),
             Codec::Tdct => Box::new(tdct::Encoder),
         })
     }
@@ -116,8 +126,10 @@ impl Codec {
             Codec::Jpeg => Some(Box::new(jpeg::Pictures)),
             #[cfg(feature = "mpeg4")]
             Codec::Mpeg4 => Some(Box::new(mpeg4::Pictures)),
+            #[cfg(feature = "mpeg4")]
+            Codec::Hevc => Some(Box::new(hevc::Pictures)),
             #[cfg(not(feature = "mpeg4"))]
-            Codec::Mpeg4 => return Err(unavailable()),
+            Codec::Mpeg4 | Codec::Hevc => return Err(unavailable()),
             Codec::Tdct => None,
         })
     }
@@ -142,8 +154,14 @@ impl Codec {
                 stream,
                 reader,
             )?),
+            #[cfg(feature = "mpeg4")]
+            Codec::Hevc => Box::new(geometry_video::Decoder::open(
+                hevc::Pictures,
+                stream,
+                reader,
+            )?),
             #[cfg(not(feature = "mpeg4"))]
-            Codec::Mpeg4 => return Err(unavailable()),
+            Codec::Mpeg4 | Codec::Hevc => return Err(unavailable()),
             Codec::Tdct => Box::new(tdct::Decoder::open(stream, reader, max_bands)?),
         })
     }
@@ -151,7 +169,9 @@ impl Codec {
 
 #[cfg(not(feature = "mpeg4"))]
 fn unavailable() -> Error {
-    Error::Codec("this build has no MPEG-4 codec (built without the `mpeg4` feature)".into())
+    Error::Codec(
+        "this build has no MPEG-4 or HEVC codec (built without the `mpeg4` feature, FFmpeg)".into(),
+    )
 }
 
 /// What the encoder hands a residual coder: the animation, the decoder's reference frame and
@@ -176,7 +196,8 @@ pub struct ResidualInput<'a> {
 pub struct CodecParams {
     /// Geometry-image lattice, (0, 0) without images.
     pub lattice: (u16, u16),
-    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality (0 without pictures).
+    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality, HEVC QP (0 without
+    /// pictures).
     pub qscale: u8,
     /// Frames per group of pictures (1 for intra codecs).
     pub gop: u32,
@@ -235,8 +256,9 @@ pub trait ResidualDecoder<R> {
         None
     }
 
-    /// Frame `f`'s decoded picture (x | y | z residual images side by side), for codecs that code images.
-    fn picture(&mut self, _reader: &mut ContainerReader<R>, _f: usize) -> Result<Plane> {
+    /// Frame `f`'s decoded picture (x | y | z residual images side by side, samples of the stream's
+    /// depth), for codecs that code images.
+    fn picture(&mut self, _reader: &mut ContainerReader<R>, _f: usize) -> Result<Plane<u16>> {
         Err(Error::Usage(
             "a tdct stream has no images: its residuals are temporal-DCT bands".into(),
         ))
@@ -259,6 +281,6 @@ mod tests {
         }
         let old = Codec::from_id(RETIRED_TDCT_ID).unwrap_err().to_string();
         assert!(old.contains("re-encode"), "{old}");
-        assert!(Codec::from_id(4).is_err());
+        assert!(Codec::from_id(5).is_err());
     }
 }

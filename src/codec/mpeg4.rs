@@ -59,7 +59,7 @@ fn ff_error(context: &str, e: ffmpeg::Error) -> Error {
 }
 
 /// Initialises FFmpeg once per process and quiets its logging to errors only.
-fn init() -> Result<()> {
+pub(crate) fn init() -> Result<()> {
     static INIT: OnceLock<std::result::Result<(), String>> = OnceLock::new();
     INIT.get_or_init(|| {
         ffmpeg::init().map_err(|e| e.to_string())?;
@@ -404,8 +404,8 @@ struct PacketEncoder {
 }
 
 impl PictureEncoder for PacketEncoder {
-    fn push(&mut self, plane: &Plane) -> Result<()> {
-        self.packets.extend(self.encoder.encode(plane)?);
+    fn push(&mut self, plane: &Plane<u16>) -> Result<()> {
+        self.packets.extend(self.encoder.encode(&plane.to_8bit()?)?);
         Ok(())
     }
 
@@ -427,12 +427,12 @@ impl PictureEncoder for PacketEncoder {
 struct PacketDecoder(Decoder);
 
 impl PictureDecoder for PacketDecoder {
-    fn decode(&mut self, f: usize, packet: &[u8]) -> Result<Plane> {
+    fn decode(&mut self, f: usize, packet: &[u8]) -> Result<Plane<u16>> {
         let mut planes = self.0.decode(packet)?;
         if planes.is_empty() {
             planes = self.0.flush()?;
         }
-        planes.pop().ok_or_else(|| {
+        planes.pop().map(|p| p.widen()).ok_or_else(|| {
             Error::Stream(format!(
                 "frame {f}: the MPEG-4 packet decoded to no picture"
             ))

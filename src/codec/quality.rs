@@ -99,6 +99,30 @@ pub fn jpeg_law(quality: u8) -> PictureLaw {
     read_law(&JPEG_LAW, quality)
 }
 
+/// HEVC's law at 10 bits a sample: one pixel step factor, [`HEVC_STEP_FACTOR`] × the target step,
+/// and the QP that follows the target step, 6 per halving ([`HEVC_QP_AT_50`] at quality 50), so
+/// that HEVC's own quantiser, not the picture's levels, makes the error: a fine pixel step costs
+/// HEVC nothing in smooth residual images. Fitted as the other laws, over pixel step × QP
+/// (docs/results.md).
+pub const HEVC_STEP_FACTOR: f64 = 0.05;
+/// The QP of quality 50 at 10 bits a sample.
+pub const HEVC_QP_AT_50: f64 = 28.0;
+
+/// HEVC's pixel step factor and QP for a user quality 1..100 at `depth` bits a sample. A deeper
+/// sample takes the same pixel step and a QP 6 higher per bit over 10 (the same quantiser step in
+/// model units), so its gain is headroom: residuals 4× wider at 12 bits fit without a coarser
+/// step. Past QP 0 or 51, the pixel step takes the rest.
+pub fn hevc_law(quality: u8, depth: u8) -> PictureLaw {
+    let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
+    let exact = HEVC_QP_AT_50 + 6.0 * scale.log2() + 6.0 * (f64::from(depth) - 10.0);
+    let qp = exact.round().clamp(0.0, 51.0);
+    let beyond = if exact.round() == qp { 0.0 } else { exact - qp };
+    PictureLaw {
+        step_factor: HEVC_STEP_FACTOR * 2f64.powf(beyond / 6.0),
+        quantiser: qp as u8,
+    }
+}
+
 /// MPEG-4's pixel step factor and qscale for a user quality 1..100.
 pub fn mpeg4_law(quality: u8) -> PictureLaw {
     read_law(&MPEG4_LAW, quality)
@@ -137,7 +161,9 @@ mod tests {
 
     #[test]
     fn pixel_steps_fall_and_quantisers_do_not_coarsen_with_quality() {
-        for law in [jpeg_law, mpeg4_law] {
+        let hevc10 = |q| hevc_law(q, 10);
+        let hevc12 = |q| hevc_law(q, 12);
+        for law in [jpeg_law, mpeg4_law, hevc10, hevc12] {
             for q in 1..100u8 {
                 let (a, b) = (law(q), law(q + 1));
                 let step = |l: PictureLaw, q| l.step_factor * target_step(q, 1.0);
@@ -148,6 +174,10 @@ mod tests {
             assert!(jpeg_law(q + 1).quantiser >= jpeg_law(q).quantiser);
             assert!(mpeg4_law(q + 1).quantiser <= mpeg4_law(q).quantiser);
             assert!((1..=31).contains(&mpeg4_law(q).quantiser));
+            assert!(hevc_law(q + 1, 10).quantiser <= hevc_law(q, 10).quantiser);
+            assert!(hevc_law(q, 12).quantiser <= 51);
         }
+        assert_eq!(hevc_law(50, 10).quantiser, HEVC_QP_AT_50 as u8);
+        assert_eq!(hevc_law(50, 12).quantiser, HEVC_QP_AT_50 as u8 + 12);
     }
 }

@@ -19,8 +19,12 @@ pub struct EncodeOptions {
     pub codec: Codec,
     /// Rate knob 1..100 (higher = better).
     pub quality: u8,
-    /// MPEG-4 quantiser; `None` derives it from `quality`.
+    /// The video codec's own quantiser, MPEG-4 qscale (1..=31) or HEVC QP (0..=51); `None` derives
+    /// it from `quality`.
     pub qscale: Option<u8>,
+    /// Bits a sample of the HEVC pictures, 10 or 12; `None` picks the measured default
+    /// ([`crate::codec::hevc::DEFAULT_DEPTH`]). JPEG and MPEG-4 code 8.
+    pub bit_depth: Option<u8>,
     /// JPEG's own quality 1..100 for the residual pictures; `None` derives it from `quality`.
     pub jpeg_quality: Option<u8>,
     /// Motion clusters K (k-means only; decimation finds its own).
@@ -38,7 +42,8 @@ pub struct EncodeOptions {
     pub lattice: Lattice,
     /// Padding of the free pixels; `None` picks the codec's measured best.
     pub padding: Option<padding::Method>,
-    /// MPEG-4 group of pictures.
+    /// Frames per group of pictures of MPEG-4 and HEVC: an intra frame, then `gop − 1` P-frames.
+    /// 1 makes HEVC all-intra (every frame decodes alone, as JPEG's).
     pub gop: usize,
     /// Let the first-frame coder permute vertices.
     pub reorder: bool,
@@ -59,6 +64,7 @@ impl Default for EncodeOptions {
             codec: Codec::Jpeg,
             quality: DEFAULT_QUALITY,
             qscale: None,
+            bit_depth: None,
             jpeg_quality: None,
             clusters: 20,
             segmentation: Segmentation::KMeans,
@@ -84,7 +90,8 @@ impl Default for EncodeOptions {
 /// at 1/4, 80 564 at 1/16, all at RMSE 7.9e-4).
 pub fn default_affine_precision(codec: Codec) -> f64 {
     match codec {
-        Codec::Mpeg4 => 1.0 / 16.0,
+        // HEVC's P-frames as MPEG-4's (not measured apart).
+        Codec::Mpeg4 | Codec::Hevc => 1.0 / 16.0,
         _ => motion::DEFAULT_AFFINE_PRECISION,
     }
 }
@@ -119,7 +126,13 @@ impl EncodeOptions {
         Ok(Self {
             codec: header.codec,
             quality: header.quality,
-            qscale: Some(header.qscale).filter(|&q| q > 0 && header.codec == Codec::Mpeg4),
+            qscale: match header.codec {
+                Codec::Mpeg4 => Some(header.qscale).filter(|&q| q > 0),
+                Codec::Hevc => Some(header.qscale),
+                _ => None,
+            },
+            // In the codec's set-up part, not the header: the pictures' decoder reads it.
+            bit_depth: None,
             jpeg_quality: Some(header.qscale).filter(|&q| q > 0 && header.codec == Codec::Jpeg),
             clusters: header.requested_clusters as usize,
             // The segmentation is not redone: the stream carries its partition.
@@ -201,6 +214,19 @@ impl EncodeOptions {
         }
         if self.gop == 0 {
             return Err(Error::option("gop", "must be at least 1"));
+        }
+        if let Some(depth) = self.bit_depth {
+            if !matches!(depth, 10 | 12) {
+                return Err(Error::option("bit_depth", "must be 10 or 12"));
+            }
+        }
+        if let (Codec::Hevc, Some(q)) = (self.codec, self.qscale) {
+            if q > 51 {
+                return Err(Error::option(
+                    "qscale",
+                    "must be between 0 and 51 for hevc (its QP)",
+                ));
+            }
         }
         if !(1..=24).contains(&self.uv_bits) {
             return Err(Error::option("uv_bits", "must be between 1 and 24"));

@@ -23,20 +23,22 @@ pub struct GeometryImages {
     /// Frames per group: the first frame of a group is padded on its own, the others continue the
     /// previous frame's padding (P-frames); 1 for intra codecs.
     pub gop: usize,
+    /// Bits a sample of the pictures (8 for JPEG and MPEG-4).
+    pub depth: u8,
 }
 
 impl GeometryImages {
-    /// The images of an encoding on `atlas` at `pixel_step`, with offsets centred on the
-    /// `residuals` of each frame or group as `mode` groups them.
+    /// The images of an encoding on `atlas` at `pixel_step` and `depth` bits a sample, with
+    /// offsets centred on the `residuals` of each frame or group as `mode` groups them.
     pub fn new(
         lattice: (u16, u16),
         atlas: atlas::Atlas,
         residuals: &[Vec<[f32; 3]>],
-        mode: RangeMode,
+        (mode, depth): (RangeMode, u8),
         pixel_step: f32,
         padding: padding::PaddingOptions,
     ) -> Self {
-        let (ranges, corrections) = quantise::choose(residuals, mode, pixel_step);
+        let (ranges, corrections) = quantise::choose(residuals, mode, pixel_step, depth);
         Self {
             lattice,
             atlas,
@@ -45,6 +47,7 @@ impl GeometryImages {
             corrections,
             padding,
             gop: mode.group(),
+            depth,
         }
     }
 
@@ -52,7 +55,7 @@ impl GeometryImages {
         (self.lattice.0 as usize, self.lattice.1 as usize)
     }
 
-    /// Frame `f`'s residuals of coordinate `axis` as levels in `0..=255` on the lattice, before
+    /// Frame `f`'s residuals of coordinate `axis` as levels in `0..=max level` on the lattice, before
     /// padding (free pixels are 0).
     pub fn level_image(&self, frame: &[[f32; 3]], f: usize, axis: usize) -> Result<Vec<f32>> {
         let range = self.ranges[f][axis];
@@ -75,7 +78,7 @@ impl GeometryImages {
         Ok(out)
     }
 
-    /// The three padded images of frame `f` (levels in `0..=255`, before rounding). `previous`
+    /// The three padded images of frame `f` (levels in `0..=max level`, before rounding). `previous`
     /// holds the previous frame's padded images when `f` continues a group (see [`Self::continues`]).
     pub fn padded(
         &self,

@@ -1,18 +1,19 @@
 //! Residual quantisation: one step for the whole sequence, set by the target error, not by each
 //! frame's range (issue 15).
 //!
-//! A residual `r` of one coordinate becomes the level `r / step − offset + 128`: mid-grey is the
-//! offset, one grey level one step. The step is the encoding's pixel step (a fraction of the first
+//! A residual `r` of one coordinate becomes the level `r / step − offset + mid`, mid-grey being
+//! 2^(depth − 1) at the picture codec's sample depth (128 for the 8-bit JPEG and MPEG-4, 512 or 2048
+//! for HEVC at 10 or 12 bits): mid-grey is the offset, one grey level one step. The step is the encoding's pixel step (a fraction of the first
 //! frame's bounding-box diagonal that `quality` sets, [`crate::codec::quality`]), so a frame whose
 //! residuals are small makes a near-flat picture that costs almost nothing, and a better predictor
 //! buys fewer bits rather than finer levels. The offset (an integer number of steps) centres the
-//! 256 levels on the frame's residuals.
+//! 2^depth levels on the frame's residuals.
 //!
 //! Intra (JPEG) frames take an offset per frame and coordinate. MPEG-4 P-frames predict a frame's
 //! pixels from the previous frame's, which only works if a pixel value means the same residual in
 //! both: there step and offset are shared by a whole group of pictures.
 //!
-//! Residuals that do not fit the 256 levels around the offset: if only a few do (at most
+//! Residuals that do not fit the 2^depth levels around the offset: if only a few do (at most
 //! [`CORRECTION_SHARE`] of the group's values), they are clipped in the picture and sent exactly
 //! (at the pixel step) in a sparse correction list ([`super::corrections`]); if more, the group's
 //! step is widened just enough that that holds (stored per frame and coordinate), so such a group
@@ -24,57 +25,86 @@ use super::corrections::Corrections;
 use crate::error::{Error, Result};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 
-/// Largest quantised value (8-bit images).
+/// Largest quantised value of 8-bit images.
 pub const LEVELS: f32 = 255.0;
-/// The level of the offset: mid-grey.
+/// The level of the offset in 8-bit images: mid-grey.
 pub const MID: f32 = 128.0;
 /// The share of a group's values that may be clipped and corrected before its step is widened.
 pub const CORRECTION_SHARE: f64 = 1.0 / 256.0;
-/// Levels a group's kept values may span: 254 rather than 255 leaves room for rounding at both ends.
-const SPAN: f64 = LEVELS as f64 - 1.0;
+/// Sample depths the images can be made at, in bits.
+pub const DEPTHS: std::ops::RangeInclusive<u8> = 8..=16;
+
+/// Largest level at `depth` bits a sample (255 at 8 bits).
+pub fn max_level(depth: u8) -> f32 {
+    ((1u32 << depth) - 1) as f32
+}
+
+/// Mid-grey at `depth` bits a sample (128 at 8 bits).
+pub fn mid_level(depth: u8) -> f32 {
+    (1u32 << (depth - 1)) as f32
+}
+
+/// Levels a group's kept values may span: one less than the largest level leaves room for
+/// rounding at both ends (254 at 8 bits).
+fn span(depth: u8) -> f64 {
+    f64::from(max_level(depth)) - 1.0
+}
 /// Bytes per frame and coordinate in the ranges part: step (f32) and offset (i32).
 const AXIS_BYTES: usize = 8;
 
-/// How one coordinate's residuals of one frame map to levels: residual = (level − 128 + offset) × step.
+/// How one coordinate's residuals of one frame map to levels:
+/// residual = (level − mid-grey + offset) × step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisRange {
     /// One grey level, in model units: the pixel step, or more for a group whose residuals span
-    /// more than 256 of them.
+    /// more than 2^depth of them.
     pub step: f32,
     /// The residual at mid-grey, in steps.
     pub offset: i32,
+    /// Bits a sample of the picture (8 for JPEG and MPEG-4); not stored per range: the stream
+    /// has one depth.
+    pub depth: u8,
 }
 
 impl AxisRange {
-    /// The range of one grey level `step`, centred on `offset` steps.
+    /// The range of one grey level `step` of 8-bit pictures, centred on `offset` steps.
     pub fn new(step: f32, offset: i32) -> Self {
-        Self { step, offset }
+        Self::at_depth(step, offset, 8)
+    }
+
+    /// The range of one grey level `step` of `depth`-bit pictures, centred on `offset` steps.
+    pub fn at_depth(step: f32, offset: i32, depth: u8) -> Self {
+        Self {
+            step,
+            offset,
+            depth,
+        }
     }
 
     /// `value` as a real level, not clamped (rounding is left to the caller, after padding).
     fn level(self, value: f32) -> f32 {
-        value / self.step - self.offset as f32 + MID
+        value / self.step - self.offset as f32 + mid_level(self.depth)
     }
 
-    /// `value` as a real number in `0..=255`: values beyond the range are clipped.
+    /// `value` as a real number in `0..=max level`: values beyond the range are clipped.
     pub fn quantise(self, value: f32) -> f32 {
         let level = self.level(value);
         if level.is_nan() {
-            MID
+            mid_level(self.depth)
         } else {
-            level.clamp(0.0, LEVELS)
+            level.clamp(0.0, max_level(self.depth))
         }
     }
 
-    /// Whether `value` rounds to a level in `0..=255`.
+    /// Whether `value` rounds to a level in `0..=max level`.
     pub fn fits(self, value: f32) -> bool {
         let level = self.level(value).round();
-        (0.0..=LEVELS).contains(&level)
+        (0.0..=max_level(self.depth)).contains(&level)
     }
 
     /// The residual a pixel value stands for.
     pub fn dequantise(self, level: f32) -> f32 {
-        (level - MID + self.offset as f32) * self.step
+        (level - mid_level(self.depth) + self.offset as f32) * self.step
     }
 
     /// The residual at level 0.
@@ -82,9 +112,9 @@ impl AxisRange {
         self.dequantise(0.0)
     }
 
-    /// The residual at level 255.
+    /// The residual at the largest level.
     pub fn max(self) -> f32 {
-        self.dequantise(LEVELS)
+        self.dequantise(max_level(self.depth))
     }
 }
 
@@ -110,27 +140,29 @@ impl RangeMode {
     }
 }
 
-/// Every frame's ranges at pixel step `pixel_step` (`residuals[f][v]`, grouped as `mode` says),
-/// and the corrections of the values they clip.
+/// Every frame's ranges at pixel step `pixel_step` and `depth` bits a sample (`residuals[f][v]`,
+/// grouped as `mode` says), and the corrections of the values they clip.
 pub fn choose(
     residuals: &[Vec<[f32; 3]>],
     mode: RangeMode,
     pixel_step: f32,
+    depth: u8,
 ) -> (Vec<FrameRanges>, Corrections) {
     let n = mode.group();
     let mut ranges = Vec::with_capacity(residuals.len());
     for group in residuals.chunks(n) {
-        let shared: FrameRanges = std::array::from_fn(|a| group_range(group, a, pixel_step));
+        let shared: FrameRanges =
+            std::array::from_fn(|a| group_range(group, a, pixel_step, depth));
         ranges.extend(std::iter::repeat_n(shared, group.len()));
     }
     let corrections = Corrections::of_clipped(residuals, &ranges, pixel_step);
     (ranges, corrections)
 }
 
-/// The step and offset of axis `a` over a group: at the pixel step, centred on the [`SPAN`]-level
+/// The step and offset of axis `a` over a group: at the pixel step, centred on the [`span`]-level
 /// window that holds most of the group's values, if it leaves out at most [`CORRECTION_SHARE`] of
-/// them; else centred on the narrowest window that does, at the step that makes it [`SPAN`] levels.
-fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange {
+/// them; else centred on the narrowest window that does, at the step that makes it [`span`] levels.
+fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32, depth: u8) -> AxisRange {
     let mut values: Vec<f64> = group
         .iter()
         .flatten()
@@ -138,12 +170,12 @@ fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange 
         .filter(|v| v.is_finite())
         .collect();
     if values.is_empty() {
-        return AxisRange::new(pixel_step, 0);
+        return AxisRange::at_depth(pixel_step, 0, depth);
     }
     values.sort_by(f64::total_cmp);
     let n = values.len();
     let keep = n - (n as f64 * CORRECTION_SHARE).floor() as usize;
-    let (held, lo, hi) = fullest_window(&values);
+    let (held, lo, hi) = fullest_window(&values, span(depth));
     let (lo, hi) = if held >= keep {
         (lo, hi)
     } else {
@@ -152,7 +184,7 @@ fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange 
             .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
             .unwrap_or((values[0], values[n - 1]))
     };
-    let scale = ((hi - lo) / SPAN).max(1.0);
+    let scale = ((hi - lo) / span(depth)).max(1.0);
     // f32 rounding must not narrow the step below what the window needs.
     let mut step = (f64::from(pixel_step) * scale) as f32;
     if f64::from(step) < f64::from(pixel_step) * scale {
@@ -160,16 +192,16 @@ fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> AxisRange 
     }
     let mid = 0.5 * (lo + hi) * f64::from(pixel_step) / f64::from(step);
     let offset = mid.round().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
-    AxisRange::new(step, offset)
+    AxisRange::at_depth(step, offset, depth)
 }
 
-/// The window of at most [`SPAN`] pixel steps that holds most of the sorted `values` (in pixel
+/// The window of at most `span` pixel steps that holds most of the sorted `values` (in pixel
 /// steps): how many it holds, its lowest and its highest value.
-fn fullest_window(sorted: &[f64]) -> (usize, f64, f64) {
+fn fullest_window(sorted: &[f64], span: f64) -> (usize, f64, f64) {
     let (mut best, mut best_at, mut j) = (0usize, 0usize, 0usize);
     for i in 0..sorted.len() {
         j = j.max(i);
-        while j + 1 < sorted.len() && sorted[j + 1] - sorted[i] <= SPAN {
+        while j + 1 < sorted.len() && sorted[j + 1] - sorted[i] <= span {
             j += 1;
         }
         if j + 1 - i > best {
@@ -190,9 +222,13 @@ pub fn write_ranges(pixel_step: f32, ranges: &[FrameRanges], w: &mut ByteWriter)
     }
 }
 
-/// Reads what [`write_ranges`] wrote: the pixel step and the ranges; `frames` is the count the
-/// header promised.
-pub fn read_ranges(r: &mut ByteReader, frames: usize) -> Result<(f32, Vec<FrameRanges>)> {
+/// Reads what [`write_ranges`] wrote: the pixel step and the ranges of `depth`-bit pictures;
+/// `frames` is the count the header promised.
+pub fn read_ranges(
+    r: &mut ByteReader,
+    frames: usize,
+    depth: u8,
+) -> Result<(f32, Vec<FrameRanges>)> {
     let pixel_step = r.f32()?;
     if !(pixel_step.is_normal() && pixel_step > 0.0) {
         return Err(Error::Stream(format!(
@@ -210,7 +246,7 @@ pub fn read_ranges(r: &mut ByteReader, frames: usize) -> Result<(f32, Vec<FrameR
     }
     let ranges = (0..n)
         .map(|_| {
-            let mut fr = [AxisRange::new(pixel_step, 0); 3];
+            let mut fr = [AxisRange::at_depth(pixel_step, 0, depth); 3];
             for a in fr.iter_mut() {
                 let (step, offset) = (r.f32()?, r.u32()? as i32);
                 if !(step.is_finite() && step >= pixel_step) {
@@ -218,7 +254,7 @@ pub fn read_ranges(r: &mut ByteReader, frames: usize) -> Result<(f32, Vec<FrameR
                         "a residual range has step {step}, below the pixel step {pixel_step}"
                     )));
                 }
-                *a = AxisRange::new(step, offset);
+                *a = AxisRange::at_depth(step, offset, depth);
             }
             Ok(fr)
         })
@@ -251,14 +287,15 @@ mod tests {
             .map(|i| [(i as f32 / 500.0 - 1.0), 0.0, 0.5])
             .collect();
         frame[3][0] = 50.0;
-        let (ranges, corrections) = choose(&[frame.clone()], RangeMode::PerFrame, step);
+        let (ranges, corrections) = choose(&[frame.clone()], RangeMode::PerFrame, step, 8);
         assert_eq!(ranges[0][0].step, step, "{:?}", ranges[0][0]);
         assert_eq!(ranges[0][2].offset, 50);
         assert_eq!(corrections.frame(0).len(), 1);
         assert_eq!(corrections.frame(0)[0].vertex, 3);
         // Values over ±300 steps: the step widens to fit them in 254 levels, one outlier aside.
         let wide: Vec<[f32; 3]> = frame.iter().map(|r| [3.0 * r[0], 0.0, 0.0]).collect();
-        let (ranges, corrections) = choose(std::slice::from_ref(&wide), RangeMode::PerFrame, step);
+        let (ranges, corrections) =
+            choose(std::slice::from_ref(&wide), RangeMode::PerFrame, step, 8);
         let r = ranges[0][0];
         assert!(r.step > 2.3 * step && r.step < 2.4 * step, "{r:?}");
         let corrected = corrections.frame(0);
@@ -273,15 +310,34 @@ mod tests {
             vec![[-1.0, 1.5, 2.0]],
             vec![[4.0, 0.0, 0.0]],
         ];
-        let (g, _) = choose(&res, RangeMode::PerGroup(2), 0.25);
+        let (g, _) = choose(&res, RangeMode::PerGroup(2), 0.25, 8);
         assert_eq!(g[0], g[1]);
         assert_eq!(g[0][0].offset, -2);
         assert_eq!(g[2][0].offset, 16);
         let mut w = ByteWriter::new();
         write_ranges(0.25, &g, &mut w);
         let bytes = w.into_bytes();
-        let (step, back) = read_ranges(&mut ByteReader::new(&bytes, "ranges"), 3).unwrap();
+        let (step, back) = read_ranges(&mut ByteReader::new(&bytes, "ranges"), 3, 8).unwrap();
         assert_eq!((step, back), (0.25, g));
-        assert!(read_ranges(&mut ByteReader::new(&bytes, "ranges"), 4).is_err());
+        assert!(read_ranges(&mut ByteReader::new(&bytes, "ranges"), 4, 8).is_err());
+    }
+
+    #[test]
+    fn deeper_samples_hold_wider_residuals_at_the_same_step() {
+        let step = 0.01;
+        // ±3 = ±300 steps: beyond 8 bits' 254 levels, within 10 bits' 1022.
+        let frame: Vec<[f32; 3]> = (0..1000).map(|i| [i as f32 * 0.006 - 3.0, 0.0, 0.0]).collect();
+        let (eight, _) = choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 8);
+        let (ten, corrections) = choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 10);
+        assert!(eight[0][0].step > 2.0 * step);
+        assert_eq!(ten[0][0].step, step);
+        assert!(corrections.is_empty());
+        assert_eq!(mid_level(10), 512.0);
+        assert_eq!(max_level(12), 4095.0);
+        let r = ten[0][0];
+        for v in &frame {
+            assert!(r.fits(v[0]));
+            assert!((r.dequantise(r.quantise(v[0]).round()) - v[0]).abs() <= 0.005 + 1e-5);
+        }
     }
 }

@@ -3,15 +3,17 @@
 
 use crate::codec::Plane;
 
-/// Rounds and clamps three `width × height` images (values in `0..=255`) into one `3·width × height` plane.
-pub fn compose(images: [&[f32]; 3], width: usize, height: usize) -> Plane {
-    let mut data = vec![0u8; 3 * width * height];
+/// Rounds and clamps three `width × height` images (levels of `depth`-bit samples) into one
+/// `3·width × height` plane.
+pub fn compose(images: [&[f32]; 3], width: usize, height: usize, depth: u8) -> Plane<u16> {
+    let top = super::quantise::max_level(depth);
+    let mut data = vec![0u16; 3 * width * height];
     for (a, img) in images.iter().enumerate() {
         for y in 0..height {
             let row = &img[y * width..(y + 1) * width];
             let out = &mut data[y * 3 * width + a * width..y * 3 * width + (a + 1) * width];
             for (o, &v) in out.iter_mut().zip(row) {
-                *o = v.round().clamp(0.0, 255.0) as u8;
+                *o = v.round().clamp(0.0, top) as u16;
             }
         }
     }
@@ -23,7 +25,7 @@ pub fn compose(images: [&[f32]; 3], width: usize, height: usize) -> Plane {
 }
 
 /// One coordinate's image (`axis` 0, 1, 2) cut back out of a composed plane, as `f32` levels.
-pub fn axis_image(plane: &Plane, axis: usize, width: usize, height: usize) -> Vec<f32> {
+pub fn axis_image(plane: &Plane<u16>, axis: usize, width: usize, height: usize) -> Vec<f32> {
     let stride = plane.width as usize;
     let mut out = Vec::with_capacity(width * height);
     for y in 0..height {
@@ -34,7 +36,7 @@ pub fn axis_image(plane: &Plane, axis: usize, width: usize, height: usize) -> Ve
 }
 
 /// The levels at the given lattice pixels of coordinate `axis` of a composed plane.
-pub fn sample(plane: &Plane, axis: usize, width: usize, pixels: &[[u16; 2]]) -> Vec<f32> {
+pub fn sample(plane: &Plane<u16>, axis: usize, width: usize, pixels: &[[u16; 2]]) -> Vec<f32> {
     let stride = plane.width as usize;
     pixels
         .iter()
@@ -52,7 +54,7 @@ mod tests {
         let imgs: Vec<Vec<f32>> = (0..3)
             .map(|a| (0..w * h).map(|i| (i * 3 + a * 50) as f32 + 0.4).collect())
             .collect();
-        let plane = compose([&imgs[0], &imgs[1], &imgs[2]], w, h);
+        let plane = compose([&imgs[0], &imgs[1], &imgs[2]], w, h, 8);
         assert_eq!((plane.width, plane.height), (24, 4));
         for (a, img) in imgs.iter().enumerate() {
             let cut = axis_image(&plane, a, w, h);

@@ -24,7 +24,7 @@ pub struct Header {
     pub codec: Codec,
     /// The `--quality` the stream was made with (1..100).
     pub quality: u8,
-    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality (0 for tdct streams).
+    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality, HEVC QP (0 for tdct streams).
     pub qscale: u8,
     /// Frames per group of pictures (MPEG-4: an I-frame starts each group; JPEG: 1).
     pub gop: u32,

@@ -19,6 +19,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         CodecChoice::Jpeg => Codec::Jpeg,
         CodecChoice::Mpeg4 => Codec::Mpeg4,
         CodecChoice::Tdct => Codec::Tdct,
+        CodecChoice::Hevc => Codec::Hevc,
     };
     check_codec_options(args, codec, lattice)?;
     if args.affine_bits.is_some() {
@@ -61,7 +62,9 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
     Ok(EncodeOptions {
         codec,
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
-        qscale: args.qscale,
+        // One field for the video codecs' quantisers; check_codec_options lets one through.
+        qscale: args.qscale.or(args.qp),
+        bit_depth: args.bit_depth,
         jpeg_quality: args.jpeg_quality,
         clusters: args.clusters.unwrap_or(defaults.clusters),
         segmentation,
@@ -92,20 +95,15 @@ fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Res
              with small residuals already cost few bits; leave it out",
         ));
     }
-    let given: [(&'static str, bool, &[Codec]); 5] = [
+    let images: &[Codec] = &[Codec::Jpeg, Codec::Mpeg4, Codec::Hevc];
+    let given: [(&'static str, bool, &[Codec]); 7] = [
         ("qscale", args.qscale.is_some(), &[Codec::Mpeg4]),
+        ("qp", args.qp.is_some(), &[Codec::Hevc]),
+        ("bit_depth", args.bit_depth.is_some(), &[Codec::Hevc]),
         ("jpeg_quality", args.jpeg_quality.is_some(), &[Codec::Jpeg]),
-        ("gop", args.gop.is_some(), &[Codec::Mpeg4]),
-        (
-            "padding",
-            args.padding.is_some(),
-            &[Codec::Jpeg, Codec::Mpeg4],
-        ),
-        (
-            "lattice",
-            lattice != Lattice::Auto,
-            &[Codec::Jpeg, Codec::Mpeg4],
-        ),
+        ("gop", args.gop.is_some(), &[Codec::Mpeg4, Codec::Hevc]),
+        ("padding", args.padding.is_some(), images),
+        ("lattice", lattice != Lattice::Auto, images),
     ];
     for (option, set, codecs) in given {
         if set && !codecs.contains(&codec) {

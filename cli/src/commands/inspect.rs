@@ -144,6 +144,7 @@ fn summary(h: &Header, path: &Path) -> String {
             "mpeg4 quality {} qscale {} gop {}",
             h.quality, h.qscale, h.gop
         ),
+        Codec::Hevc => format!("hevc quality {} qp {} gop {}", h.quality, h.qscale, h.gop),
         Codec::Tdct => {
             return format!(
                 "{}: {} vertices x {} frames, {} faces; tdct quality {}; {} clusters, {} predictor, no atlas",
@@ -175,14 +176,17 @@ fn summary(h: &Header, path: &Path) -> String {
 
 /// Writes a residual image (levels, x | y | z side by side) with its panels labelled and a scale
 /// bar in model units from the frame's ranges.
+/// Samples deeper than 8 bits are shown by their 8 high bits.
 fn save_residuals(
     path: &Path,
-    plane: Plane,
+    plane: Plane<u16>,
     w: usize,
     title: &str,
     ranges: Option<&FrameRanges>,
 ) -> Result<()> {
-    let grey = image::GrayImage::from_raw(plane.width, plane.height, plane.data)
+    let shift = ranges.map_or(0, |r| r[0].depth.saturating_sub(8));
+    let data = plane.data.iter().map(|&v| (v >> shift).min(255) as u8).collect();
+    let grey = image::GrayImage::from_raw(plane.width, plane.height, data)
         .ok_or_else(|| Error::Usage("image size mismatch".into()))?;
     annotate::residual_picture(&grey, w as u32, title, ranges)
         .save(path)
@@ -289,7 +293,8 @@ fn write_encoder_pngs<R: std::io::Read + std::io::Seek>(
     for images in mcgv_video::inspect::encoder_images(decoder, &mesh, frames)? {
         let f = images.frame;
         for (kind, levels) in [("raw", &images.raw), ("padded", &images.padded)] {
-            let plane = tile::compose([&levels[0], &levels[1], &levels[2]], w, h);
+            let depth = ranges.get(f).map_or(8, |r| r[0].depth);
+            let plane = tile::compose([&levels[0], &levels[1], &levels[2]], w, h, depth);
             save_residuals(
                 &dir.join(format!("frame_{f:04}_{kind}.png")),
                 plane,

@@ -1,0 +1,526 @@
+//! HEVC (H.265) at 10 or 12 bits a sample: FFmpeg's `libx265` encoder and its native `hevc`
+//! decoder, through `ffmpeg-next` (cargo feature `mpeg4`, which brings FFmpeg).
+//!
+//! The x | y | z picture is coded as one monochrome (4:0:0) picture, `gray10le` or `gray12le`; the
+//! three coordinates as the three planes of a 4:4:4 picture were measured larger (docs/results.md).
+//! The quantiser is a fixed QP (`qp=`, no rate control, `tune=psnr`: no psycho-visual tricks, which
+//! spend bits on what looks sharp rather than on the error). No B-frames, no scene cuts, no open
+//! GOPs: an IDR every `gop` frames (every frame with `gop` 1: all-intra), P-frames between, so each
+//! frame gives exactly one packet, in order, and decoding can start at any IDR. Headers are
+//! in-band (`repeat-headers`: VPS/SPS/PPS on every IDR). x265 runs without its thread pool and with
+//! one frame thread, so its output does not depend on scheduling: the geometry-video coder runs
+//! groups of pictures on several threads instead.
+//!
+//! The stream's codec set-up part holds the sample depth (one byte), which the decoder needs
+//! before any picture to read the residual ranges.
+
+use super::geometry_video::{PictureCodec, PictureDecoder, PictureEncoder};
+use super::{Codec, Plane};
+use crate::encoder::EncodeOptions;
+use crate::geometry_image::{quantise, RangeMode};
+use crate::stream::frame_index::FrameChunk;
+use crate::{Error, Result};
+use ffmpeg_next as ffmpeg;
+use ffmpeg_next::util::error::EAGAIN;
+use ffmpeg_next::{codec, decoder, encoder, format::Pixel, frame, Dictionary};
+
+/// Sample depths the codec takes, in bits.
+pub const DEPTHS: [u8; 2] = [10, 12];
+/// The default depth: 10 bits, measured as good as 12 at every quality of the sweep
+/// (docs/results.md) and the depth every hardware HEVC decoder (Main 10) takes.
+pub const DEFAULT_DEPTH: u8 = 10;
+/// The largest QP x265 takes.
+pub const MAX_QP: u8 = 51;
+/// The time base only labels frames.
+const TIME_BASE: (i32, i32) = (1, 25);
+
+/// Encoder settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HevcOptions {
+    /// Fixed quantiser, 0 (finest) ..= 51; see [`super::hevc_law`].
+    pub qp: u8,
+    /// Frames per group of pictures: an IDR frame, then `gop − 1` P-frames (1: all-intra).
+    pub gop: usize,
+    /// Bits a sample: 10 or 12.
+    pub depth: u8,
+}
+
+impl Default for HevcOptions {
+    fn default() -> Self {
+        HevcOptions {
+            qp: 22,
+            gop: 50,
+            depth: DEFAULT_DEPTH,
+        }
+    }
+}
+
+/// One coded frame.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Packet {
+    /// The HEVC bitstream of the frame (Annex B, with VPS/SPS/PPS on IDR frames).
+    pub data: Vec<u8>,
+    /// True for an IDR frame: decoding may start here.
+    pub key: bool,
+}
+
+fn ff_error(context: &str, e: ffmpeg::Error) -> Error {
+    Error::Codec(format!("hevc {context}: {e}"))
+}
+
+fn pixel_format(depth: u8) -> Result<Pixel> {
+    match depth {
+        10 => Ok(Pixel::GRAY10LE),
+        12 => Ok(Pixel::GRAY12LE),
+        _ => Err(Error::Codec(format!(
+            "hevc sample depth {depth}: expected one of {DEPTHS:?}"
+        ))),
+    }
+}
+
+/// The `x265-params` of a fixed-QP, deterministic encoding with IDR frames every `gop` frames.
+fn x265_params(options: &HevcOptions, gop: u32) -> String {
+    format!(
+        "qp={qp}:keyint={gop}:min-keyint={gop}:scenecut=0:open-gop=0:bframes=0:\
+         repeat-headers=1:info=0:pools=none:frame-threads=1:log-level=error",
+        qp = options.qp
+    )
+}
+
+/// A fixed-QP HEVC encoder for a sequence of same-size monochrome planes.
+pub struct Encoder {
+    inner: encoder::Video,
+    width: u32,
+    height: u32,
+    depth: u8,
+    next_pts: i64,
+}
+
+impl Encoder {
+    /// Opens an encoder for `width × height` planes whose first plane is frame `first_frame`.
+    pub fn new(width: u32, height: u32, options: &HevcOptions, first_frame: usize) -> Result<Self> {
+        super::mpeg4::init()?;
+        let format = pixel_format(options.depth)?;
+        if width < 16 || height < 16 || width % 2 != 0 || height % 2 != 0 {
+            return Err(Error::Codec(format!(
+                "hevc size {width}×{height}: sides must be even and at least 16"
+            )));
+        }
+        if options.qp > MAX_QP {
+            return Err(Error::Codec(format!(
+                "hevc qp {} outside 0..={MAX_QP}",
+                options.qp
+            )));
+        }
+        let gop = u32::try_from(options.gop)
+            .ok()
+            .filter(|g| (1..=i32::MAX as u32).contains(g))
+            .ok_or_else(|| Error::Codec(format!("hevc gop {} must be ≥ 1", options.gop)))?;
+        let codec = encoder::find_by_name("libx265")
+            .ok_or_else(|| Error::Codec("libx265 encoder missing from libavcodec".into()))?;
+        let mut video = codec::Context::new_with_codec(codec)
+            .encoder()
+            .video()
+            .map_err(|e| ff_error("encoder context", e))?;
+        video.set_width(width);
+        video.set_height(height);
+        video.set_format(format);
+        video.set_time_base(TIME_BASE);
+        video.set_gop(gop);
+        video.set_max_b_frames(0);
+        video.set_threading(codec::threading::Config {
+            count: 1,
+            ..Default::default()
+        });
+        let mut dict = Dictionary::new();
+        dict.set("preset", "medium");
+        dict.set("tune", "psnr");
+        dict.set("x265-params", &x265_params(options, gop));
+        let inner = video
+            .open_as_with(codec, dict)
+            .map_err(|e| ff_error(&format!("open libx265 {width}×{height}"), e))?;
+        Ok(Encoder {
+            inner,
+            width,
+            height,
+            depth: options.depth,
+            next_pts: i64::try_from(first_frame)
+                .map_err(|_| Error::Codec(format!("hevc first frame {first_frame} too large")))?,
+        })
+    }
+
+    /// Codes the next plane; returns the packets ready so far (x265 holds a few frames back).
+    pub fn encode(&mut self, plane: &Plane<u16>) -> Result<Vec<Packet>> {
+        plane.check()?;
+        if (plane.width, plane.height) != (self.width, self.height) {
+            return Err(Error::Codec(format!(
+                "hevc plane {}×{} given to a {}×{} encoder",
+                plane.width, plane.height, self.width, self.height
+            )));
+        }
+        let top = quantise::max_level(self.depth) as u16;
+        if plane.data.iter().any(|&v| v > top) {
+            return Err(Error::Codec(format!(
+                "hevc plane has samples above {top}, the largest at {} bits",
+                self.depth
+            )));
+        }
+        let mut picture = frame::Video::new(pixel_format(self.depth)?, self.width, self.height);
+        fill_samples(&mut picture, plane)?;
+        picture.set_pts(Some(self.next_pts));
+        self.inner
+            .send_frame(&picture)
+            .map_err(|e| ff_error(&format!("encode frame {}", self.next_pts), e))?;
+        self.next_pts += 1;
+        self.receive()
+    }
+
+    /// Ends the sequence and returns the packets still held by the encoder.
+    pub fn finish(mut self) -> Result<Vec<Packet>> {
+        self.inner
+            .send_eof()
+            .map_err(|e| ff_error("flush encoder", e))?;
+        self.receive()
+    }
+
+    fn receive(&mut self) -> Result<Vec<Packet>> {
+        let mut packets = Vec::new();
+        loop {
+            let mut packet = ffmpeg::Packet::empty();
+            match self.inner.receive_packet(&mut packet) {
+                Ok(()) => packets.push(Packet {
+                    data: packet.data().unwrap_or_default().to_vec(),
+                    key: packet.is_key(),
+                }),
+                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
+                    return Ok(packets)
+                }
+                Err(e) => return Err(ff_error("receive packet", e)),
+            }
+        }
+    }
+}
+
+/// Copies the plane into the 16-bit little-endian samples of `picture`, row by row (FFmpeg pads
+/// rows to its own stride, in bytes).
+fn fill_samples(picture: &mut frame::Video, plane: &Plane<u16>) -> Result<()> {
+    let stride = picture.stride(0);
+    let width = plane.width as usize;
+    let buffer = picture.data_mut(0);
+    for (y, src) in plane.data.chunks_exact(width).enumerate() {
+        let start = y * stride;
+        let dst = buffer
+            .get_mut(start..start + 2 * width)
+            .ok_or_else(|| Error::Codec("hevc frame buffer smaller than the plane".into()))?;
+        for (d, v) in dst.chunks_exact_mut(2).zip(src) {
+            d.copy_from_slice(&v.to_le_bytes());
+        }
+    }
+    Ok(())
+}
+
+/// An HEVC decoder giving back the planes of a stream made by [`Encoder`].
+pub struct Decoder {
+    inner: decoder::Video,
+    width: u32,
+    height: u32,
+    depth: u8,
+    /// Whether an IDR frame has been decoded since the last reset: a P-frame without its
+    /// reference must be an error, not a plausible but wrong picture.
+    has_reference: bool,
+}
+
+impl Decoder {
+    /// Opens a decoder that expects `width × height` pictures of `depth`-bit samples.
+    pub fn new(width: u32, height: u32, depth: u8) -> Result<Self> {
+        super::mpeg4::init()?;
+        pixel_format(depth)?;
+        let codec = decoder::find(codec::Id::HEVC)
+            .ok_or_else(|| Error::Codec("hevc decoder missing from libavcodec".into()))?;
+        let mut context = codec::Context::new_with_codec(codec);
+        // One thread: frame threading would delay output by a frame per thread.
+        context.set_threading(codec::threading::Config {
+            count: 1,
+            ..Default::default()
+        });
+        let inner = context
+            .decoder()
+            .video()
+            .map_err(|e| ff_error("open decoder", e))?;
+        Ok(Decoder {
+            inner,
+            width,
+            height,
+            depth,
+            has_reference: false,
+        })
+    }
+
+    /// Decodes one packet; returns the pictures it completes (one per packet for our streams).
+    pub fn decode(&mut self, packet: &[u8]) -> Result<Vec<Plane<u16>>> {
+        if packet.is_empty() {
+            return Err(Error::Codec("hevc empty packet".into()));
+        }
+        self.inner
+            .send_packet(&ffmpeg::Packet::copy(packet))
+            .map_err(|e| ff_error(&format!("decode packet of {} bytes", packet.len()), e))?;
+        self.receive()
+    }
+
+    /// Signals the end of the stream and returns the pictures still held by the decoder.
+    pub fn flush(&mut self) -> Result<Vec<Plane<u16>>> {
+        self.inner
+            .send_eof()
+            .map_err(|e| ff_error("flush decoder", e))?;
+        let planes = self.receive()?;
+        self.inner.flush();
+        self.has_reference = false;
+        Ok(planes)
+    }
+
+    fn receive(&mut self) -> Result<Vec<Plane<u16>>> {
+        let mut planes = Vec::new();
+        loop {
+            let mut picture = frame::Video::empty();
+            match self.inner.receive_frame(&mut picture) {
+                Ok(()) => planes.push(self.samples(&picture)?),
+                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
+                    return Ok(planes)
+                }
+                Err(e) => return Err(ff_error("receive picture", e)),
+            }
+        }
+    }
+
+    fn samples(&mut self, picture: &frame::Video) -> Result<Plane<u16>> {
+        if picture.is_corrupt() || picture.has_decode_errors() {
+            return Err(Error::Codec("hevc picture decoded with errors".into()));
+        }
+        if picture.is_key() {
+            self.has_reference = true;
+        } else if !self.has_reference {
+            return Err(Error::Codec(
+                "hevc P-frame before any IDR frame: decoding must start at an IDR frame".into(),
+            ));
+        }
+        let format = pixel_format(self.depth)?;
+        if picture.format() != format
+            || (picture.width(), picture.height()) != (self.width, self.height)
+        {
+            return Err(Error::Codec(format!(
+                "hevc picture is {:?} {}×{}, expected {format:?} {}×{}",
+                picture.format(),
+                picture.width(),
+                picture.height(),
+                self.width,
+                self.height
+            )));
+        }
+        let (width, height) = (self.width as usize, self.height as usize);
+        let stride = picture.stride(0);
+        let bytes = picture.data(0);
+        let mut data = Vec::with_capacity(width * height);
+        for y in 0..height {
+            let row = bytes
+                .get(y * stride..y * stride + 2 * width)
+                .ok_or_else(|| Error::Codec("hevc picture buffer shorter than its size".into()))?;
+            data.extend(
+                row.chunks_exact(2)
+                    .map(|b| u16::from_le_bytes([b[0], b[1]])),
+            );
+        }
+        Plane::new(self.width, self.height, data)
+    }
+}
+
+/// HEVC as the geometry-video picture codec: an IDR frame every `gop` frames, P-frames between,
+/// residual ranges shared by a group so that P-frames predict like from like.
+pub struct Pictures;
+
+impl Pictures {
+    fn options(&self, opts: &EncodeOptions) -> HevcOptions {
+        HevcOptions {
+            qp: self.quantiser(opts),
+            gop: opts.gop,
+            depth: self.depth(opts),
+        }
+    }
+}
+
+impl PictureCodec for Pictures {
+    fn codec(&self) -> Codec {
+        Codec::Hevc
+    }
+
+    fn range_mode(&self, opts: &EncodeOptions) -> RangeMode {
+        RangeMode::PerGroup(opts.gop)
+    }
+
+    /// `biharmonic`: smooth across chart borders, what a transform codec codes cheaply; measured
+    /// against the other methods at HEVC's QPs in docs/results.md.
+    fn default_padding(&self) -> padding::Method {
+        padding::Method::Biharmonic
+    }
+
+    fn step_factor(&self, opts: &EncodeOptions) -> f64 {
+        super::hevc_law(opts.quality, self.depth(opts)).step_factor
+    }
+
+    fn quantiser(&self, opts: &EncodeOptions) -> u8 {
+        opts.qscale
+            .unwrap_or_else(|| super::hevc_law(opts.quality, self.depth(opts)).quantiser)
+    }
+
+    fn gop(&self, opts: &EncodeOptions) -> u32 {
+        opts.gop as u32
+    }
+
+    fn depth(&self, opts: &EncodeOptions) -> u8 {
+        opts.bit_depth.unwrap_or(DEFAULT_DEPTH)
+    }
+
+    fn depth_of_setup(&self, setup: &[u8]) -> Result<u8> {
+        match setup {
+            [depth] if DEPTHS.contains(depth) => Ok(*depth),
+            _ => Err(Error::Stream(format!(
+                "hevc set-up {setup:?}: expected one byte, the sample depth ({DEPTHS:?})"
+            ))),
+        }
+    }
+
+    fn encoder(
+        &self,
+        width: u32,
+        height: u32,
+        first_frame: usize,
+        opts: &EncodeOptions,
+    ) -> Result<Box<dyn PictureEncoder>> {
+        let options = self.options(opts);
+        Ok(Box::new(PacketEncoder {
+            encoder: Encoder::new(width, height, &options, first_frame)?,
+            depth: options.depth,
+            packets: Vec::new(),
+        }))
+    }
+
+    fn decoder(&self, width: u32, height: u32, setup: &[u8]) -> Result<Box<dyn PictureDecoder>> {
+        let depth = self.depth_of_setup(setup)?;
+        Ok(Box::new(PacketDecoder(Decoder::new(width, height, depth)?)))
+    }
+}
+
+struct PacketEncoder {
+    encoder: Encoder,
+    depth: u8,
+    packets: Vec<Packet>,
+}
+
+impl PictureEncoder for PacketEncoder {
+    fn push(&mut self, plane: &Plane<u16>) -> Result<()> {
+        self.packets.extend(self.encoder.encode(plane)?);
+        Ok(())
+    }
+
+    fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
+        let mut packets = self.packets;
+        packets.extend(self.encoder.finish()?);
+        let chunks = packets
+            .into_iter()
+            .map(|p| FrameChunk {
+                data: p.data,
+                key: p.key,
+            })
+            .collect();
+        Ok((vec![self.depth], chunks))
+    }
+}
+
+/// One packet per frame and no B-frames: no reordering.
+struct PacketDecoder(Decoder);
+
+impl PictureDecoder for PacketDecoder {
+    fn decode(&mut self, f: usize, packet: &[u8]) -> Result<Plane<u16>> {
+        let mut planes = self.0.decode(packet)?;
+        if planes.is_empty() {
+            planes = self.0.flush()?;
+        }
+        planes.pop().ok_or_else(|| {
+            Error::Stream(format!("frame {f}: the HEVC packet decoded to no picture"))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(width: u32, height: u32, t: u32, depth: u8) -> Plane<u16> {
+        let top = f64::from(quantise::max_level(depth));
+        let data = (0..width * height)
+            .map(|i| {
+                let (x, y) = (f64::from(i % width), f64::from(i / width));
+                let v = 0.5 + 0.3 * ((x + 2.0 * f64::from(t)) / 9.0).sin() * (y / 7.0).cos();
+                (v * top).round() as u16
+            })
+            .collect();
+        Plane::new(width, height, data).unwrap()
+    }
+
+    fn code(planes: &[Plane<u16>], options: &HevcOptions) -> Vec<Packet> {
+        let (w, h) = (planes[0].width, planes[0].height);
+        let mut encoder = Encoder::new(w, h, options, 0).unwrap();
+        let mut packets = Vec::new();
+        for p in planes {
+            packets.extend(encoder.encode(p).unwrap());
+        }
+        packets.extend(encoder.finish().unwrap());
+        packets
+    }
+
+    #[test]
+    fn deep_planes_round_trip_with_idr_frames_every_gop() {
+        for depth in DEPTHS {
+            let planes: Vec<_> = (0..5).map(|t| ramp(64, 48, t, depth)).collect();
+            let options = HevcOptions {
+                qp: 4,
+                gop: 2,
+                depth,
+            };
+            let packets = code(&planes, &options);
+            let keys: Vec<bool> = packets.iter().map(|p| p.key).collect();
+            assert_eq!(keys, [true, false, true, false, true], "{depth} bits");
+            assert_eq!(packets, code(&planes, &options), "not deterministic");
+            let mut decoder = Decoder::new(64, 48, depth).unwrap();
+            for (plane, packet) in planes.iter().zip(&packets) {
+                let back = decoder.decode(&packet.data).unwrap();
+                let worst = back[0]
+                    .data
+                    .iter()
+                    .zip(&plane.data)
+                    .map(|(a, b)| a.abs_diff(*b))
+                    .max()
+                    .unwrap();
+                // QP 4 is a step of about one 8-bit level: 4 levels at 10 bits, 16 at 12.
+                assert!(worst <= 1 << (depth - 6), "{depth} bits: {worst}");
+            }
+            // A P-frame without its IDR frame gives no picture.
+            let mut cold = Decoder::new(64, 48, depth).unwrap();
+            let first = cold.decode(&packets[1].data);
+            assert!(first.map_or(true, |p| p.is_empty()));
+        }
+    }
+
+    #[test]
+    fn bad_settings_are_errors() {
+        let options = HevcOptions::default();
+        assert!(Encoder::new(15, 32, &options, 0).is_err());
+        assert!(Encoder::new(32, 32, &HevcOptions { qp: 52, ..options }, 0).is_err());
+        assert!(Encoder::new(32, 32, &HevcOptions { depth: 8, ..options }, 0).is_err());
+        let mut encoder = Encoder::new(32, 32, &options, 0).unwrap();
+        assert!(encoder.encode(&Plane::filled(32, 32, 1024)).is_err());
+        assert!(encoder.encode(&Plane::filled(16, 32, 0)).is_err());
+        assert!(Pictures.depth_of_setup(&[]).is_err());
+        assert!(Pictures.depth_of_setup(&[9]).is_err());
+        assert_eq!(Pictures.depth_of_setup(&[12]).unwrap(), 12);
+    }
+}
