@@ -1,5 +1,6 @@
 //! The sweep behind the error law of `codec::quality` (issue 15): per sequence, JPEG and MPEG-4
-//! over pixel step × the picture codec's own quantiser, and tdct over `--quality`, one CSV row per
+//! over pixel step × the picture codec's own quantiser, HEVC (issue 16) over its own pixel steps
+//! × QP, and tdct over `--quality`, one CSV row per
 //! encoding with its bpvf and vertex RMSE (RMS vertex displacement / first frame's bbox diagonal).
 //! `scripts/error_law_fit.py` reads the rows, keeps each codec's lower convex hull and prints, per
 //! quality, the hull point at tdct's error.
@@ -8,7 +9,8 @@
 //! cargo run --release --example error_law_sweep -- OUT.csv INPUT...
 //! ```
 //! env (space-separated lists): STEPS (pixel steps, fractions of the diagonal), JPEG_QUALITIES,
-//! QSCALES, TDCT_QUALITIES; EXTRA_PREDICTOR=skinning for the skinning predictor.
+//! QSCALES, TDCT_QUALITIES, HEVC_STEPS, HEVC_QPS (default none), BIT_DEPTH (10 or 12, HEVC),
+//! HEVC_GOP (HEVC's gop, 1 for all-intra); EXTRA_PREDICTOR=skinning for the skinning predictor.
 //! The mesh is read and the rows appended once per input; encodings run in this one process.
 
 use mcgv_video::{encode, read_animation, Codec, Decoder, EncodeOptions, ReadOptions};
@@ -44,6 +46,10 @@ fn main() -> Res<()> {
     let jpeg: Vec<u8> = list("JPEG_QUALITIES", "50 75 90 97")?;
     let qscales: Vec<u8> = list("QSCALES", "1 2 4 8")?;
     let tdct: Vec<u8> = list("TDCT_QUALITIES", "10 30 50 75 90 97")?;
+    let hevc_steps: Vec<f64> = list("HEVC_STEPS", "0.0000125 0.000025 0.00005 0.0001 0.0002")?;
+    let hevc_qps: Vec<u8> = list("HEVC_QPS", "")?;
+    let bit_depth: Option<u8> = list("BIT_DEPTH", "")?.first().copied();
+    let hevc_gop: Option<usize> = list("HEVC_GOP", "")?.first().copied();
     let skinning = std::env::var("EXTRA_PREDICTOR").is_ok_and(|p| p == "skinning");
     let fresh = !std::path::Path::new(out).exists();
     let mut file = std::fs::OpenOptions::new()
@@ -96,6 +102,19 @@ fn main() -> Res<()> {
                     ..base.clone()
                 };
                 runs.push((o, format!("mpeg4,{s},{q},")));
+            }
+        }
+        for &s in &hevc_steps {
+            for &q in &hevc_qps {
+                let o = EncodeOptions {
+                    codec: Codec::Hevc,
+                    step: Some(s),
+                    qscale: Some(q),
+                    bit_depth,
+                    gop: hevc_gop.unwrap_or(base.gop),
+                    ..base.clone()
+                };
+                runs.push((o, format!("hevc,{s},{q},")));
             }
         }
         for (opts, label) in runs {

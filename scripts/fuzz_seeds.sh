@@ -15,6 +15,10 @@ mkdir -p "$out/decode_stream" "$out/read_mesh"
 small=(--lattice 64x64 --clusters 4 --fps 6 --quiet)
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg.mcgv" --codec jpeg "${small[@]}"
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/mpeg4.mcgv" --codec mpeg4 --gop 3 "${small[@]}"
+# HEVC: a set-up part with the sample depth, 10- and 12-bit pictures, P-frames and all-intra.
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/hevc.mcgv" --codec hevc --gop 3 "${small[@]}"
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/hevc-intra12.mcgv" --codec hevc --gop 1 \
+	--bit-depth 12 "${small[@]}"
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-reorder.mcgv" --codec jpeg --reorder \
 	--lattice 64x64 --clusters 2 --fps 2 --quality 10 --quiet
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-skinning.mcgv" --codec jpeg \

@@ -25,7 +25,8 @@ import sys
 from collections import defaultdict
 
 PAPER_RATES = (2.2, 4.0, 8.0)
-OURS = ("jpeg", "mpeg4", "tdct")   # mcgv-video's image codecs; a variant is CODEC+VARIANT
+# mcgv-video's codecs (hevc-intra: `--gop 1`; @12: `--bit-depth 12`); a variant is CODEC+VARIANT
+OURS = ("jpeg", "mpeg4", "tdct", "hevc", "hevc-intra", "hevc@12", "hevc-intra@12")
 VARIANTS = ("", "skinning", "decimation", "skinning+decimation")   # column order of the variant table
 TARGETS = (2e-4, 5e-5)   # RMSE targets of the equal-error table
 GRID = 200  # rates per sequence at which codecs are compared for the closing line

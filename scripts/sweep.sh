@@ -5,7 +5,8 @@
 # GNU time: wall seconds, CPU seconds (user + system, steadier than wall on a shared machine) and
 # peak resident memory.
 #   scripts/sweep.sh OUT.csv INPUT...
-# env: JPEG_QUALITIES, MPEG4_QUALITIES, QSCALES, TDCT_QUALITIES, VARIANTS, MCGV_BIN
+# env: JPEG_QUALITIES, MPEG4_QUALITIES, QSCALES, TDCT_QUALITIES, HEVC_QUALITIES,
+#      HEVC_INTRA_QUALITIES, HEVC_DEPTHS, VARIANTS, MCGV_BIN
 #   VARIANTS   space-separated encoder variants, each a '+'-joined list of
 #              skinning (--predictor skinning) and decimation (--segmentation decimation), or
 #              `default` (no extra flag). Unset: the default encoder only. A variant's rows are
@@ -17,12 +18,24 @@
 #              --quality picks); unset or empty: none.
 #   TDCT_QUALITIES  --quality values of `--codec tdct` runs, made only when the binary's
 #              `encode --help` mentions tdct (default: the JPEG qualities); empty: none.
+#   HEVC_QUALITIES, HEVC_INTRA_QUALITIES  --quality values of `--codec hevc` runs (P-frames; codec
+#              column `hevc`) and of all-intra `--codec hevc --gop 1` runs (`hevc-intra`), made only
+#              when the binary's `encode --help` mentions hevc; unset or empty: none.
+#   HEVC_DEPTHS  --bit-depth values of the hevc runs (default: the binary's default only); a depth
+#              other than the default is labelled hevc@12, hevc-intra@12.
 set -euo pipefail
 bin=${MCGV_BIN:-target/release/mcgv-video}
 out=$1; shift
 qualities=${JPEG_QUALITIES-"10 30 50 75 90"}
 mpeg4_qualities=${MPEG4_QUALITIES-"10 30 50 75 90 97"}
 qscales=${QSCALES-}
+hevc_qualities=${HEVC_QUALITIES-}
+hevc_intra_qualities=${HEVC_INTRA_QUALITIES-}
+hevc_depths=${HEVC_DEPTHS:-default}
+if [ -n "$hevc_qualities$hevc_intra_qualities" ] && ! "$bin" encode --help | grep -qw hevc; then
+    echo "sweep.sh: $bin has no hevc codec; HEVC_QUALITIES ignored" >&2
+    hevc_qualities=""; hevc_intra_qualities=""
+fi
 tdct_qualities=${TDCT_QUALITIES-$qualities}
 variants=${VARIANTS:-default}
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -64,13 +77,22 @@ for input in "$@"; do
     if [ "$tdct" = yes ]; then
         for q in $tdct_qualities; do runs+=("tdct --quality $q"); done
     fi
+    for depth in $hevc_depths; do
+        at=""; [ "$depth" = default ] || at="@$depth"
+        for q in $hevc_qualities; do runs+=("hevc$at --quality $q"); done
+        for q in $hevc_intra_qualities; do runs+=("hevc-intra$at --quality $q"); done
+    done
     for variant in $variants; do
         read -ra extra <<<"$(variant_flags "$variant")"
         suffix=""; [ "$variant" = default ] || suffix="+$variant"
         for run in "${runs[@]}"; do
             read -r codec flag value <<<"$run"
             stream="$tmp/$name.mcgv"
-            read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" --codec "$codec" "$flag" "$value" \
+            # hevc-intra@12 is `--codec hevc --gop 1 --bit-depth 12`.
+            codec_flags=(--codec "${codec%%[-@]*}")
+            case $codec in hevc-intra*) codec_flags+=(--gop 1) ;; esac
+            case $codec in *@*) codec_flags+=(--bit-depth "${codec#*@}") ;; esac
+            read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" "${codec_flags[@]}" "$flag" "$value" \
                 ${extra[@]+"${extra[@]}"} --quiet)
             read -r dw dc dm < <(measure "$bin" decode "$stream" -o "$tmp/dec.pc2" --quiet)
             m=$("$bin" eval "$input" "$stream" --json --quiet)

@@ -515,7 +515,16 @@ mod tests {
         let options = HevcOptions::default();
         assert!(Encoder::new(15, 32, &options, 0).is_err());
         assert!(Encoder::new(32, 32, &HevcOptions { qp: 52, ..options }, 0).is_err());
-        assert!(Encoder::new(32, 32, &HevcOptions { depth: 8, ..options }, 0).is_err());
+        assert!(Encoder::new(
+            32,
+            32,
+            &HevcOptions {
+                depth: 8,
+                ..options
+            },
+            0
+        )
+        .is_err());
         let mut encoder = Encoder::new(32, 32, &options, 0).unwrap();
         assert!(encoder.encode(&Plane::filled(32, 32, 1024)).is_err());
         assert!(encoder.encode(&Plane::filled(16, 32, 0)).is_err());

@@ -151,8 +151,7 @@ pub fn choose(
     let n = mode.group();
     let mut ranges = Vec::with_capacity(residuals.len());
     for group in residuals.chunks(n) {
-        let shared: FrameRanges =
-            std::array::from_fn(|a| group_range(group, a, pixel_step, depth));
+        let shared: FrameRanges = std::array::from_fn(|a| group_range(group, a, pixel_step, depth));
         ranges.extend(std::iter::repeat_n(shared, group.len()));
     }
     let corrections = Corrections::of_clipped(residuals, &ranges, pixel_step);
@@ -326,9 +325,12 @@ mod tests {
     fn deeper_samples_hold_wider_residuals_at_the_same_step() {
         let step = 0.01;
         // ±3 = ±300 steps: beyond 8 bits' 254 levels, within 10 bits' 1022.
-        let frame: Vec<[f32; 3]> = (0..1000).map(|i| [i as f32 * 0.006 - 3.0, 0.0, 0.0]).collect();
+        let frame: Vec<[f32; 3]> = (0..1000)
+            .map(|i| [i as f32 * 0.006 - 3.0, 0.0, 0.0])
+            .collect();
         let (eight, _) = choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 8);
-        let (ten, corrections) = choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 10);
+        let (ten, corrections) =
+            choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 10);
         assert!(eight[0][0].step > 2.0 * step);
         assert_eq!(ten[0][0].step, step);
         assert!(corrections.is_empty());

@@ -41,6 +41,7 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "quality": header.quality,
             "qscale": header.qscale,
             "gop": header.gop,
+            "bit_depth": decoder.images().map(|i| i.depth),
             "clusters": header.clusters,
             "predictor": header.predictor.name(),
             "weight_bits": decoder.weights().map(|w| w.bits),
@@ -185,7 +186,11 @@ fn save_residuals(
     ranges: Option<&FrameRanges>,
 ) -> Result<()> {
     let shift = ranges.map_or(0, |r| r[0].depth.saturating_sub(8));
-    let data = plane.data.iter().map(|&v| (v >> shift).min(255) as u8).collect();
+    let data = plane
+        .data
+        .iter()
+        .map(|&v| (v >> shift).min(255) as u8)
+        .collect();
     let grey = image::GrayImage::from_raw(plane.width, plane.height, data)
         .ok_or_else(|| Error::Usage("image size mismatch".into()))?;
     annotate::residual_picture(&grey, w as u32, title, ranges)
