@@ -90,7 +90,8 @@ impl Default for EncodeOptions {
 /// at 1/4, 80 564 at 1/16, all at RMSE 7.9e-4).
 pub fn default_affine_precision(codec: Codec) -> f64 {
     match codec {
-        // HEVC's P-frames as MPEG-4's (not measured apart).
+        // HEVC's P-frames as MPEG-4's: CesiumMan q50 measured 3.045 bpvf at 1/16, 3.055 at 1/4, at
+        // equal RMSE (3.9e-4).
         Codec::Mpeg4 | Codec::Hevc => 1.0 / 16.0,
         _ => motion::DEFAULT_AFFINE_PRECISION,
     }
