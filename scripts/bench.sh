@@ -30,7 +30,9 @@ if [ -d "$shared" ]; then
 fi
 cargo bench --quiet --bench motion -- "${inputs[@]}" | tee bench-out/motion.txt
 rm -f bench-out/sweep.csv bench-out/sweep-variants.csv bench-out/peers.csv bench-out/peers.skipped.csv
-VARIANTS=default bash scripts/sweep.sh bench-out/sweep.csv "${inputs[@]}"
+VARIANTS=default HEVC_QUALITIES=${HEVC_QUALITIES-"10 30 50 75 90 97"} \
+    HEVC_INTRA_QUALITIES=${HEVC_INTRA_QUALITIES-"10 30 50 75 90"} \
+    bash scripts/sweep.sh bench-out/sweep.csv "${inputs[@]}"
 csvs=(bench-out/sweep.csv)
 variants=${BENCH_VARIANTS-"skinning decimation skinning+decimation"}
 if [ -n "$variants" ]; then

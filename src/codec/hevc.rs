@@ -616,9 +616,9 @@ mod tests {
             Encoder::new(64, 32, &yuv, 0).is_err(),
             "not three images wide"
         );
-        let mut encoder = Encoder::new(32, 32, &options, 0).unwrap();
-        assert!(encoder.encode(&Plane::filled(32, 32, 1024)).is_err());
-        assert!(encoder.encode(&Plane::filled(16, 32, 0)).is_err());
+        let mut encoder = Encoder::new(96, 32, &options, 0).unwrap();
+        assert!(encoder.encode(&Plane::filled(96, 32, 1024)).is_err());
+        assert!(encoder.encode(&Plane::filled(48, 32, 0)).is_err());
         assert!(Pictures.depth_of_setup(&[]).is_err());
         assert!(Pictures.depth_of_setup(&[10]).is_err());
         assert!(Pictures.depth_of_setup(&[9, 0]).is_err());
