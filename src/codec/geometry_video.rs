@@ -125,6 +125,7 @@ pub fn images_of(
                 Codec::Jpeg => codec.quantiser(opts),
                 _ => opts.quality,
             },
+            jpeg_table: super::jpeg::TABLE,
             ..padding::PaddingOptions::default()
         },
     ))
