@@ -280,6 +280,15 @@ fn encode_one(
         seconds,
         r.header.frames as f64 / seconds.max(1e-9)
     );
+    let line = match &r.choice {
+        Some(choice) => format!(
+            "{line}\nauto: kept {} of {} candidates: {}",
+            choice.chosen,
+            choice.candidates.len(),
+            choice.reason
+        ),
+        None => line,
+    };
     // With `-o -` stdout carries the stream: the report goes to stderr.
     if to_stdout {
         eprintln!("{line}");
