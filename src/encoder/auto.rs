@@ -15,6 +15,7 @@ use crate::codec::ResidualInput;
 use crate::encoder::{EncodeOptions, MotionModel, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
+use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::{AnimatedMesh, Point};
 use crate::motion::{Partition, PredictorKind};
 use crate::progress::Progress;
@@ -56,22 +57,25 @@ pub struct Candidate {
 }
 
 /// The best candidate so far: its whole stream, or (sampled trials) what coding it in full needs.
-struct Best {
+struct Best<'a> {
     index: usize,
     bytes: u64,
-    kept: Kept,
+    kept: Kept<'a>,
 }
 
-enum Kept {
+enum Kept<'a> {
     Stream(Box<Encoded>),
-    Analysis(
-        Box<(
-            Partition,
-            analysis::SegmentationReport,
-            analysis::Prediction,
-        )>,
-    ),
+    Analysis(Box<Trial<'a>>),
 }
+
+/// What coding a sampled trial's candidate in full needs: its partition, segmentation report,
+/// prediction and atlas.
+type Trial<'a> = (
+    Partition,
+    analysis::SegmentationReport,
+    analysis::Prediction,
+    &'a AtlasCache,
+);
 
 /// Tries every motion model of `models` on `mesh` (already in the stream's vertex order, its
 /// first frame coded as `ff`) and returns the smallest stream, its report saying why.
@@ -92,7 +96,12 @@ pub(super) fn choose(
     let reference = &ff.decoded_positions;
     let mut candidates = Vec::with_capacity(models.len());
     let mut best: Option<Best> = None;
-    for segmentation in segmentations(models) {
+    let segmentations = segmentations(models);
+    let atlases: Vec<AtlasCache> = segmentations
+        .iter()
+        .map(|_| AtlasCache::default())
+        .collect();
+    for (&segmentation, atlas) in segmentations.iter().zip(&atlases) {
         progress.stage(&format!("segmentation ({})", segmentation.name()));
         let (partition, segmented) = analysis::segment(mesh, segmentation, opts.clusters)?;
         let track = analysis::fit_track(mesh, reference, &partition, opts)?;
@@ -117,6 +126,7 @@ pub(super) fn choose(
                 partition: &partition,
                 segmentation: segmented.clone(),
                 prediction: &prediction,
+                atlas: Some(atlas),
             };
             let (bytes, kept) = match &sample {
                 None => {
@@ -134,7 +144,7 @@ pub(super) fn choose(
                 Some(sample) => {
                     let trial = (reference.as_slice(), leading.as_slice());
                     let bytes = sample.estimate(mesh, trial, opts, &analysed, &progress)?;
-                    let analysis = (partition.clone(), segmented.clone(), prediction);
+                    let analysis = (partition.clone(), segmented.clone(), prediction, atlas);
                     (bytes, Kept::Analysis(Box::new(analysis)))
                 }
             };
@@ -161,12 +171,13 @@ pub(super) fn choose(
             encoded
         }
         Kept::Analysis(analysis) => {
-            let (partition, segmentation, prediction) = *analysis;
+            let (partition, segmentation, prediction, atlas) = *analysis;
             let analysed = Analysed {
                 model,
                 partition: &partition,
                 segmentation,
                 prediction: &prediction,
+                atlas: Some(atlas),
             };
             code(mesh, ff, leading, opts, &analysed, progress, clock)?
         }
@@ -264,6 +275,7 @@ impl Sample {
             residuals: &residuals,
             options: opts,
             progress,
+            atlas: analysed.atlas,
         })?;
         let partition = analysed.partition;
         let params = &coded.params;

@@ -17,6 +17,7 @@ pub use options::{
 use crate::codec::{CodecParams, ResidualInput};
 use crate::error::Result;
 use crate::first_frame::EncodedFirstFrame;
+use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::AnimatedMesh;
 use crate::motion::Partition;
 use crate::progress::{Progress, Silent};
@@ -112,6 +113,7 @@ pub fn encode_with_progress(
         partition: &partition,
         segmentation,
         prediction: &prediction,
+        atlas: None,
     };
     code(mesh, &ff, leading, opts, &analysed, progress, clock)
 }
@@ -136,6 +138,8 @@ struct Analysed<'a> {
     partition: &'a Partition,
     segmentation: SegmentationReport,
     prediction: &'a Prediction,
+    /// The partition's atlas, shared by the encodings on it (codecs with an atlas).
+    atlas: Option<&'a AtlasCache>,
 }
 
 /// Codes the residuals of `analysed` and assembles the stream behind the `leading` parts; the
@@ -157,6 +161,7 @@ fn code(
         residuals: &prediction.residuals,
         options: opts,
         progress,
+        atlas: analysed.atlas,
     })?;
     clock.stages.extend(coded.stage_seconds);
     clock.restart();
