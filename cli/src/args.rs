@@ -121,7 +121,7 @@ pub struct EncodeArgs {
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or
     /// auto: both are tried at the quality's step and the smaller stream is kept (see --json).
-    #[arg(long, value_enum, default_value_t = SegmentationChoice::Kmeans)]
+    #[arg(long, value_enum, default_value_t = SegmentationChoice::Auto)]
     pub segmentation: SegmentationChoice,
     /// Decimation's error threshold E0: RMS affine-fit error per vertex and frame, as a fraction of
     /// the bounding-box diagonal (default 0.003, the paper's; decimation and auto).
@@ -153,7 +153,7 @@ pub struct EncodeArgs {
     /// Motion predictor: one affine map per cluster, per-vertex skinning weights over
     /// neighbouring clusters' maps (coded in the stream; the decoder follows the stream's choice),
     /// or auto: both are tried at the quality's step and the smaller stream is kept.
-    #[arg(long, value_enum, default_value_t = PredictorChoice::Affine)]
+    #[arg(long, value_enum, default_value_t = PredictorChoice::Auto)]
     pub predictor: PredictorChoice,
     /// Bits per quantised skinning weight, sign included (the paper's 16; the motion bench saw
     /// the same residual energy at 12 for about 60 % of the weights' bits).

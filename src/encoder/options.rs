@@ -25,8 +25,8 @@ pub struct EncodeOptions {
     pub jpeg_quality: Option<u8>,
     /// Motion clusters K (k-means only; decimation finds its own).
     pub clusters: usize,
-    /// How the vertices are split into motion clusters, or `Auto`: the encoder tries k-means and
-    /// decimation and keeps the smaller stream.
+    /// How the vertices are split into motion clusters, or `Auto` (the default): the encoder tries
+    /// k-means and decimation and keeps the smaller stream.
     pub segmentation: SegmentationChoice,
     /// The affine coefficients' quantiser step as a multiple `k` of the residual step Δ (the
     /// translation's step is `k·Δ`, the linear part's `k·Δ / r̄` with `r̄` the cluster's RMS radius);
@@ -43,8 +43,8 @@ pub struct EncodeOptions {
     pub gop: usize,
     /// Let the first-frame coder permute vertices.
     pub reorder: bool,
-    /// The motion predictor (piecewise affine by default), or `Auto`: the encoder tries each and
-    /// keeps the smaller stream.
+    /// The motion predictor, or `Auto` (the default): the encoder tries each and keeps the smaller
+    /// stream.
     pub predictor: PredictorChoice,
     /// Bits per skinning weight, sign included (the paper's 16 by default).
     pub weight_bits: u8,
@@ -64,14 +64,16 @@ impl Default for EncodeOptions {
             qscale: None,
             jpeg_quality: None,
             clusters: 20,
-            segmentation: SegmentationChoice::Fixed(Segmentation::KMeans),
+            // Automatic since issue 18: the smallest stream at the quality's step, and on the
+            // media samples at equal error too (docs/results.md), for 15–70 % more encoding time.
+            segmentation: SegmentationChoice::auto(),
             affine_precision: None,
             first_frame_bits: 12,
             lattice: Lattice::Auto,
             padding: None,
             gop: 50,
             reorder: false,
-            predictor: PredictorChoice::Fixed(PredictorKind::Affine),
+            predictor: PredictorChoice::Auto,
             weight_bits: motion::WEIGHT_BITS,
             step: None,
             uv_bits: 12,

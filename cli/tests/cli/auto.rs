@@ -35,10 +35,20 @@ fn auto_reports_its_candidates_and_keeps_the_smallest() {
     let info = json(&run(&["inspect", s, "--json"]));
     assert_eq!(info["predictor"], smallest["predictor"]);
 
-    // The text report says what was kept; fixed flags choose nothing.
+    // auto is the default; the text report says what was kept; fixed flags choose nothing.
+    let default = json(&run(&[&base[..], &["--json", "--e0", "0.004"]].concat()));
+    assert_eq!(default["choice"]["chosen"], choice["chosen"], "{default}");
+    assert_eq!(default["bytes"], enc["bytes"]);
     let text = ok(&run(&[&base[..4], &auto, &["--clusters", "5"]].concat()));
     assert!(text.contains("auto: kept"), "{text}");
-    let fixed = json(&run(&[&base[..], &["--json"]].concat()));
+    let fixed = [
+        "--predictor",
+        "affine",
+        "--segmentation",
+        "kmeans",
+        "--json",
+    ];
+    let fixed = json(&run(&[&base[..], &fixed].concat()));
     assert!(fixed["choice"].is_null(), "{fixed}");
 }
 
