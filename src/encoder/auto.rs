@@ -6,12 +6,13 @@
 //!
 //! Shared between the candidates: the first frame, each segmentation (used by every predictor)
 //! and its affine track (skinning blends its maps). tdct codes every candidate whole (its
-//! residual coder is cheap next to the segmentation); the picture codecs, whose pictures cost most
-//! of an encoding, code a sample of frames per candidate, scale the sample's per-frame parts to
-//! the whole and then code the winner once in full.
+//! residual coder is cheap next to the segmentation), and so does MPEG-4 (a sample misranks its
+//! P-frames); JPEG, whose pictures cost most of an encoding and are coded each on its own, codes a
+//! sample of frames per candidate, scales the sample's per-frame parts to the whole and then codes
+//! the winner once in full.
 
 use super::{analysis, assemble, code, header, Analysed, Encoded, Stopwatch};
-use crate::codec::ResidualInput;
+use crate::codec::{Codec, ResidualInput};
 use crate::encoder::{EncodeOptions, MotionModel, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
@@ -238,10 +239,13 @@ struct Sample {
 }
 
 impl Sample {
-    /// `None` when every candidate is coded whole: tdct (cheap) or a short animation.
+    /// `None` when every candidate is coded whole: tdct (cheap), MPEG-4 (its P-frames predict
+    /// from the frame before, so spread frames misrank the candidates: Fox q50 kept a stream 20 %
+    /// larger than the smallest), or a short animation.
     fn of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Option<Self>> {
         let count = mesh.frame_count();
-        if !opts.codec.has_images() || count <= 2 * TRIAL_FRAMES {
+        let whole = matches!(opts.codec, Codec::Tdct | Codec::Mpeg4);
+        if whole || count <= 2 * TRIAL_FRAMES {
             return Ok(None);
         }
         let frames: Vec<usize> = (0..TRIAL_FRAMES)

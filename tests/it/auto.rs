@@ -208,7 +208,13 @@ impl Progress for Counter {
 fn progress_announces_the_trials_frames_and_reports_them_all() {
     let mesh = skinned_bend();
     let frames = mesh.frame_count() as u64;
-    for (codec, expected) in [(Codec::Tdct, 4 * frames), (Codec::Jpeg, 4 * 12 + frames)] {
+    // tdct and MPEG-4 code every candidate whole; JPEG 12 frames each, then the winner whole.
+    let codecs = [
+        (Codec::Tdct, 4 * frames),
+        (Codec::Mpeg4, 4 * frames),
+        (Codec::Jpeg, 4 * 12 + frames),
+    ];
+    for (codec, expected) in codecs {
         let counter = Counter::default();
         let options = opts(codec, PredictorChoice::Auto, SegmentationChoice::auto());
         encode_with_progress(&mesh, &options, &counter).expect("encodes");
