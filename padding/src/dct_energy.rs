@@ -104,15 +104,19 @@ impl DctEnergy {
 
 impl DctEnergy {
     /// After each solve, alternate (SNAP_ROUNDS times) between the JPEG quantiser at `quality`
-    /// (Annex K table scaled as libjpeg does) and putting the fixed pixels back.
-    pub fn with_snap(mut self, quality: u8) -> Self {
+    /// (`table` scaled as libjpeg does) and putting the fixed pixels back.
+    pub fn with_snap(mut self, quality: u8, table: crate::JpegTable) -> Self {
         let quality = u32::from(quality.clamp(1, 100));
         let scale = if quality < 50 {
             5000 / quality
         } else {
             200 - quality * 2
         };
-        self.snap_steps = Some(ANNEX_K_LUMA.map(|t| {
+        let base = match table {
+            crate::JpegTable::AnnexK => ANNEX_K_LUMA,
+            crate::JpegTable::Flat => [16.0; N],
+        };
+        self.snap_steps = Some(base.map(|t| {
             ((t * scale as f64 + 50.0) / 100.0)
                 .floor()
                 .clamp(1.0, 255.0)

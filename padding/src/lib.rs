@@ -27,7 +27,7 @@ mod options;
 mod push_pull;
 
 pub use error::PaddingError;
-pub use options::{EmptyBlocks, Method, PaddingOptions};
+pub use options::{EmptyBlocks, JpegTable, Method, PaddingOptions};
 
 use block_laplace::BlockLaplace;
 use dct_energy::{DctEnergy, Weighting};
@@ -146,7 +146,7 @@ impl BlockSolver {
             Method::DctEnergy => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Quantiser))),
             Method::Biharmonic => BlockSolver::Dct(Box::new(DctEnergy::new(Weighting::Biharmonic))),
             Method::Snap => BlockSolver::Dct(Box::new(
-                DctEnergy::new(Weighting::Biharmonic).with_snap(opts.jpeg_quality),
+                DctEnergy::new(Weighting::Biharmonic).with_snap(opts.jpeg_quality, opts.jpeg_table),
             )),
             _ => BlockSolver::Mean,
         }

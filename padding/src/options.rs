@@ -141,6 +141,18 @@ pub struct PaddingOptions {
     pub empty_blocks: EmptyBlocks,
     /// The JPEG quality the image will be coded at (1–100); only [`Method::Snap`] uses it.
     pub jpeg_quality: u8,
+    /// The quantisation table the image will be coded with; only [`Method::Snap`] uses it.
+    pub jpeg_table: JpegTable,
+}
+
+/// A JPEG luminance quantisation table, before the quality scales it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JpegTable {
+    /// ITU-T T.81 Annex K (weighted for the eye: coarse high frequencies).
+    #[default]
+    AnnexK,
+    /// 16 everywhere: every frequency quantised alike.
+    Flat,
 }
 
 impl Default for PaddingOptions {
@@ -152,6 +164,7 @@ impl Default for PaddingOptions {
             max_iterations: 400,
             empty_blocks: EmptyBlocks::RasterPrevious,
             jpeg_quality: 75,
+            jpeg_table: JpegTable::AnnexK,
         }
     }
 }

@@ -132,6 +132,7 @@ fn images_on(
                 Codec::Jpeg => codec.quantiser(opts),
                 _ => opts.quality,
             },
+            jpeg_table: super::jpeg::TABLE,
             ..padding::PaddingOptions::default()
         },
     )

@@ -6,15 +6,16 @@ use crate::error::{Error, Result};
 /// Static per-vertex and per-triangle attributes of an animated mesh.
 ///
 /// `texcoords[s][v]` is vertex `v`'s coordinate in set `s` (glTF `TEXCOORD_s`, OBJ `vt` as set 0).
-/// `materials[t]` indexes `material_names` for triangle `t`; empty when the source has one material
-/// or none. [`Attributes::is_empty`] is true for inputs with neither (they add nothing to a stream).
+/// `materials[t]` is triangle `t`'s group, which indexes `material_names`: one group per glTF
+/// primitive (so a glTF output gets one primitive per source primitive, and groups may share a
+/// name) or per OBJ `usemtl` name; empty when the source has no materials. [`Attributes::is_empty`] is true for inputs with neither (they add nothing to a stream).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Attributes {
     /// Texture-coordinate sets, each one `[u, v]` per vertex.
     pub texcoords: Vec<Vec<[f32; 2]>>,
-    /// Material index of each triangle (empty: no material groups).
+    /// Group of each triangle (empty: no groups).
     pub materials: Vec<u32>,
-    /// Material names (OBJ `usemtl`, glTF material name or `material_N`), indexed by `materials`.
+    /// Each group's material name (OBJ `usemtl`, glTF material name or `material_N`).
     pub material_names: Vec<String>,
 }
 

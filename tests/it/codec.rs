@@ -95,6 +95,21 @@ fn jpeg_round_trip_error_is_bounded_and_falls_with_quality() -> Result<()> {
 }
 
 #[test]
+fn jpeg_residual_pictures_quantise_every_frequency_alike() -> Result<()> {
+    // A residual picture is not a photograph: its high frequencies move vertices as far as its low
+    // ones, so the quantisation table is flat (16 scaled by the quality), not Annex K's.
+    let bytes = jpeg::encode(&smooth_frame(64, 64, 0, 0.0), 50)?;
+    let dqt = bytes
+        .windows(2)
+        .position(|w| w == [0xFF, 0xDB])
+        .expect("a quantisation table segment");
+    // Marker, 2-byte length, precision/table id, then 64 8-bit entries.
+    let table = &bytes[dqt + 5..dqt + 5 + 64];
+    assert!(table.iter().all(|&q| q == 16), "{table:?}");
+    Ok(())
+}
+
+#[test]
 fn jpeg_decode_is_deterministic_and_size_checked() -> Result<()> {
     let plane = smooth_frame(64, 48, 1, 0.5);
     let bytes = jpeg::encode(&plane, 75)?;

@@ -1,6 +1,6 @@
 //! Animated-mesh readers and writers through the public API: OBJ sequences, PC2, glTF samples.
 
-use crate::common::media_path;
+use crate::common::{base64, media_path};
 use mcgv_video::mesh::{read_animation, write_obj_sequence, write_pc2, AnimatedMesh, ReadOptions};
 use std::path::{Path, PathBuf};
 
@@ -447,25 +447,4 @@ fn morph_targets_and_shared_vertices_in_gltf() {
         assert_eq!(frame[1], [11.0, 0.0, 0.0]);
         assert_eq!(frame[5], [0.0, 1.0, 0.0], "node 1 has no animated weights");
     }
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for chunk in bytes.chunks(3) {
-        let b = [
-            chunk[0],
-            *chunk.get(1).unwrap_or(&0),
-            *chunk.get(2).unwrap_or(&0),
-        ];
-        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
-        for k in 0..4 {
-            if k <= chunk.len() {
-                out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
 }

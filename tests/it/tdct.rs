@@ -344,3 +344,76 @@ fn measure_dead_zone() {
         }
     }
 }
+
+/// Coefficient bytes and vertex RMSE of the dead-zone quantiser against rate–distortion rounding at
+/// several prices of a bit, and with band `k`'s step widened by a frequency weight 1 + β·k/F, over
+/// a sweep of steps, on the glTF samples, the cloth fixture and any animation named in
+/// `MCGV_MEASURE` (paths separated by `:`).
+/// `cargo test --release --test it measure_rounding -- --ignored --nocapture`.
+#[test]
+#[ignore = "measurement, not a check"]
+fn measure_rounding() {
+    use crate::tdct_spatial::coefficients_of;
+    use mcgv_video::codec::tdct::coefficients::{quantise, BandCoder, Rounding, DEAD_ZONE};
+    use mcgv_video::codec::tdct::spatial::{Neighbourhood, Spatial};
+    use std::sync::Arc;
+    let mut meshes: Vec<(String, AnimatedMesh)> = ["CesiumMan.glb", "Fox.glb", "RiggedFigure.glb"]
+        .iter()
+        .map(|n| (n.to_string(), read_media(n)))
+        .collect();
+    meshes.push(("cloth".into(), crate::cloth::cloth(40, 90)));
+    for path in std::env::var("MCGV_MEASURE").unwrap_or_default().split(':') {
+        if !path.is_empty() {
+            let mesh = mcgv_video::mesh::read_animation(path, &Default::default()).unwrap();
+            meshes.push((path.to_string(), mesh));
+        }
+    }
+    let methods = [
+        (0.0, 0.0),
+        (0.1, 0.0),
+        (0.0, 0.5),
+        (0.1, 0.5),
+        (0.1, 1.0),
+        (0.1, -0.3),
+    ];
+    for (name, mesh) in &meshes {
+        let coefficients = coefficients_of(mesh, &tdct(50));
+        let d = mesh.bbox_diagonal();
+        let frames = coefficients.len() as f64;
+        let n = (coefficients.len() * coefficients[0].len() / 3) as f64;
+        let neighbourhood = Neighbourhood::new(mesh.vertex_count(), mesh.triangles()).unwrap();
+        let neighbourhood = Arc::new(neighbourhood);
+        for (lambda, beta) in methods {
+            for fraction in [2e-4, 4e-4, 7e-4, 1e-3, 1.6e-3, 2.5e-3, 5e-3] {
+                let mut coder = BandCoder::new(neighbourhood.clone());
+                let (mut bytes, mut sq) = (0usize, 0.0f64);
+                for (k, band) in coefficients.iter().enumerate() {
+                    let step = d * fraction * (1.0 + beta * k as f64 / frames);
+                    let theta = if lambda == 0.0 { DEAD_ZONE } else { 0.0 };
+                    let levels = quantise(std::slice::from_ref(band), step, theta).unwrap();
+                    let scaled: Vec<f64> = band.iter().map(|c| c / step).collect();
+                    let rounding = Rounding {
+                        scaled: &scaled,
+                        lambda,
+                    };
+                    let (chunk, coded) = match lambda {
+                        0.0 => (coder.encode(k, &levels[0]).unwrap(), levels[0].clone()),
+                        _ => coder
+                            .encode_rounded(k, &levels[0], &rounding, &Spatial::ALL)
+                            .unwrap(),
+                    };
+                    bytes += chunk.len();
+                    sq += band
+                        .iter()
+                        .zip(&coded)
+                        .map(|(&c, &l)| (c - l as f64 * step).powi(2))
+                        .sum::<f64>();
+                }
+                println!(
+                    "ROUNDING {name} {lambda}/{beta} {fraction:e} {bytes} {:.5e}",
+                    (sq / n).sqrt() / d
+                );
+            }
+        }
+    }
+}

@@ -156,6 +156,35 @@ pub fn quantise(coefficients: &[Vec<f64>], step: f64, dead_zone: f64) -> Result<
         .collect()
 }
 
+/// Rate–distortion rounding of the levels (encoder only; the decoder reads levels as ever): each
+/// level is chosen among the two integers nearest the coefficient and zero by the squared error
+/// in steps plus `lambda` × the bits the adaptive model would spend on it now.
+pub struct Rounding<'a> {
+    /// Each coefficient of the band divided by the step (`[3v + a]`).
+    pub scaled: &'a [f64],
+    /// The price of one bit in squared steps.
+    pub lambda: f64,
+}
+
+impl Rounding<'_> {
+    fn choose(&self, i: usize, prediction: i64, model: &IntModel) -> i64 {
+        let x = self.scaled[i];
+        let below = x.floor() as i64;
+        let price = |l: i64| {
+            let e = x - l as f64;
+            e * e + self.lambda * model.cost(l.wrapping_sub(prediction))
+        };
+        let mut best = (price(0), 0);
+        for l in [below, below + 1] {
+            let p = price(l);
+            if p < best.0 {
+                best = (p, l);
+            }
+        }
+        best.1
+    }
+}
+
 /// The adaptive models of the coefficient coder, carried from band to band.
 ///
 /// A level is coded with one of [`CONTEXTS`] signed-integer models per frequency class, chosen by
@@ -199,13 +228,15 @@ impl BandCoder {
         }
     }
 
-    /// Codes band `k` in either direction: `levels` is read by an encoder, filled by a decoder.
+    /// Codes band `k` in either direction: `levels` is read by an encoder, filled by a decoder. An
+    /// encoder given `rounding` first sets each level to the one it prices lowest.
     fn code<C: SymbolCoder>(
         &mut self,
         coder: &mut C,
         k: usize,
         spatial: Spatial,
         levels: &mut [i64],
+        rounding: Option<&Rounding>,
     ) -> Result<()> {
         let class = ((k + 1).ilog2() as usize).min(CLASSES - 1);
         let models = &mut self.models[class * CONTEXTS..(class + 1) * CONTEXTS];
@@ -223,6 +254,9 @@ impl BandCoder {
                 let near = spatial::nearby(levels, earlier, a);
                 let m = &mut models[(usize::from(*prev) * 2 + sibling) * NEARBY + near];
                 let level = &mut levels[3 * v + a];
+                if let Some(r) = rounding {
+                    *level = r.choose(3 * v + a, prediction, m);
+                }
                 let residual = coder.signed(level.wrapping_sub(prediction), m)?;
                 *level = residual.wrapping_add(prediction);
                 *prev = level.unsigned_abs().min(2) as u8;
@@ -237,12 +271,18 @@ impl BandCoder {
         self.previous.fill(0);
     }
 
-    /// Encodes band `k` with `spatial`: its chunk.
-    fn encode_with(&mut self, k: usize, spatial: Spatial, levels: &[i64]) -> Result<Vec<u8>> {
+    /// Encodes band `k` with `spatial`: its chunk and the levels it holds.
+    fn encode_with(
+        &mut self,
+        k: usize,
+        spatial: Spatial,
+        levels: &[i64],
+        rounding: Option<&Rounding>,
+    ) -> Result<(Vec<u8>, Vec<i64>)> {
         let mut enc = entropy::Encoder::new();
         let mut copy = levels.to_vec();
-        self.code(&mut enc, k, spatial, &mut copy)?;
-        enc.finish()
+        self.code(&mut enc, k, spatial, &mut copy, rounding)?;
+        Ok((enc.finish()?, copy))
     }
 
     /// Encodes band `k` with the spatial predictor that codes it smallest: its chunk, empty when
@@ -258,6 +298,36 @@ impl BandCoder {
         levels: &[i64],
         candidates: &[Spatial],
     ) -> Result<Vec<u8>> {
+        Ok(self.encode_band(k, levels, None, candidates)?.0)
+    }
+
+    /// Encodes band `k` choosing each level by rate and distortion (see [`Rounding`]), starting
+    /// from `levels` (the band quantised without it, which only decides whether the band is empty):
+    /// its chunk and the levels it holds, which the decoder will read.
+    pub fn encode_rounded(
+        &mut self,
+        k: usize,
+        levels: &[i64],
+        rounding: &Rounding,
+        candidates: &[Spatial],
+    ) -> Result<(Vec<u8>, Vec<i64>)> {
+        if rounding.scaled.len() != levels.len() {
+            return Err(Error::Codec(format!(
+                "band {k}: {} coefficients for {} levels",
+                rounding.scaled.len(),
+                levels.len()
+            )));
+        }
+        self.encode_band(k, levels, Some(rounding), candidates)
+    }
+
+    fn encode_band(
+        &mut self,
+        k: usize,
+        levels: &[i64],
+        rounding: Option<&Rounding>,
+        candidates: &[Spatial],
+    ) -> Result<(Vec<u8>, Vec<i64>)> {
         if levels.len() != self.previous.len() {
             return Err(Error::Codec(format!(
                 "band {k} has {} levels for {} coefficients",
@@ -267,20 +337,25 @@ impl BandCoder {
         }
         if levels.iter().all(|&l| l == 0) {
             self.skip();
-            return Ok(Vec::new());
+            return Ok((Vec::new(), levels.to_vec()));
         }
-        let mut best: Option<(Vec<u8>, BandCoder)> = None;
+        let mut best: Option<(Vec<u8>, Vec<i64>, BandCoder)> = None;
         for &spatial in candidates {
             let mut trial = self.clone();
-            let chunk = trial.encode_with(k, spatial, levels)?;
-            if best.as_ref().is_none_or(|(b, _)| chunk.len() < b.len()) {
-                best = Some((chunk, trial));
+            let (chunk, coded) = trial.encode_with(k, spatial, levels, rounding)?;
+            if best.as_ref().is_none_or(|(b, _, _)| chunk.len() < b.len()) {
+                best = Some((chunk, coded, trial));
             }
         }
-        let (chunk, coder) =
+        let (chunk, coded, coder) =
             best.ok_or_else(|| Error::Codec("no spatial predictor to try".into()))?;
+        if coded.iter().all(|&l| l == 0) {
+            // Rounding emptied the band: it is not coded at all, as the decoder expects.
+            self.skip();
+            return Ok((Vec::new(), coded));
+        }
         *self = coder;
-        Ok(chunk)
+        Ok((chunk, coded))
     }
 
     /// Decodes band `k` from its chunk (empty: all zero); `None` for an all-zero band.
@@ -299,7 +374,7 @@ impl BandCoder {
         }
         let mut dec = entropy::Decoder::new(bytes)?;
         let mut levels = vec![0i64; n];
-        self.code(&mut dec, k, Spatial::None, &mut levels)
+        self.code(&mut dec, k, Spatial::None, &mut levels, None)
             .map_err(|e| Error::Stream(format!("temporal-DCT band {k}: {e}")))?;
         // The encoder never writes more: a larger level would dequantise to a meaningless (even
         // infinite) coordinate.
@@ -468,11 +543,47 @@ mod tests {
         let (index, payload) = BandIndex::build(0.01, chunks);
         let index =
             BandIndex::from_bytes(&index.to_bytes().unwrap(), 9, payload.len() as u64).unwrap();
-        let mut dec = BandCoder::new(neighbourhood);
+        let mut dec = BandCoder::new(neighbourhood.clone());
         for (k, e) in index.bands.iter().enumerate() {
             let bytes = &payload[e.offset as usize..(e.offset + e.len) as usize];
             let got = dec.decode(k, bytes).unwrap().unwrap_or_else(|| vec![0; 90]);
             assert_eq!(got, levels[k], "band {k}");
+        }
+        // Rounded by rate and distortion, each level is one of the two integers nearest its
+        // coefficient or zero, some differ from plain rounding, fewer bytes are spent, and the
+        // decoder reads exactly the levels the encoder reports.
+        let c = forward(&r).unwrap();
+        let plain = quantise(&c, 0.01, 0.0).unwrap();
+        let (mut rounded, mut plain_bytes, mut rounded_bytes) = (Vec::new(), 0, 0);
+        let (mut enc, mut plain_enc) = (
+            BandCoder::new(neighbourhood.clone()),
+            BandCoder::new(neighbourhood.clone()),
+        );
+        for (k, band) in plain.iter().enumerate() {
+            let scaled: Vec<f64> = c[k].iter().map(|x| x / 0.01).collect();
+            let rounding = Rounding {
+                scaled: &scaled,
+                lambda: 0.1,
+            };
+            let (chunk, coded) = enc
+                .encode_rounded(k, band, &rounding, &Spatial::ALL)
+                .unwrap();
+            for (&x, &l) in scaled.iter().zip(&coded) {
+                assert!(l == 0 || (x - l as f64).abs() < 1.0, "{x} → {l}");
+            }
+            plain_bytes += plain_enc.encode(k, band).unwrap().len();
+            rounded_bytes += chunk.len();
+            rounded.push((chunk, coded));
+        }
+        assert!(rounded.iter().zip(&plain).any(|((_, r), p)| r != p));
+        assert!(
+            rounded_bytes < plain_bytes,
+            "{rounded_bytes} ≥ {plain_bytes}"
+        );
+        let mut dec = BandCoder::new(neighbourhood);
+        for (k, (chunk, coded)) in rounded.iter().enumerate() {
+            let got = dec.decode(k, chunk).unwrap().unwrap_or_else(|| vec![0; 90]);
+            assert_eq!(&got, coded, "band {k}");
         }
         // Levels the encoder never writes are refused; so are more coefficients than bytes can hold.
         let huge = BandCoder::new(Arc::new(Neighbourhood::isolated(1)))

@@ -18,8 +18,10 @@ pub(super) struct Geometry {
     pub(super) vertex_count: usize,
     /// Per part, its texture-coordinate sets (TEXCOORD_0, TEXCOORD_1, …).
     texcoords: Vec<Vec<Vec<[f32; 2]>>>,
-    /// The glTF material of each triangle (`None`: the primitive has none).
-    materials: Vec<Option<usize>>,
+    /// The drawn primitive each triangle comes from (an index into `group_materials`).
+    groups: Vec<u32>,
+    /// Each drawn primitive's glTF material (`None`: it has none).
+    group_materials: Vec<Option<usize>>,
 }
 
 /// A node and the accessors that feed a primitive's vertices (see [`vertex_accessors`]).
@@ -40,7 +42,8 @@ impl Geometry {
             parts: Vec::new(),
             vertex_count: 0,
             texcoords: Vec::new(),
-            materials: Vec::new(),
+            groups: Vec::new(),
+            group_materials: Vec::new(),
         };
         let mut first_vertex = SharedVertices::new();
         let mut stack: Vec<gltf::Node> = scene.nodes().collect();
@@ -95,14 +98,19 @@ impl Geometry {
             .map(|t| [t[0] + offset, t[1] + offset, t[2] + offset]);
         let before = self.triangles.len();
         self.triangles.extend(shifted);
-        let material = primitive.material().index();
-        self.materials
-            .resize(self.triangles.len().max(before), material);
+        if self.triangles.len() > before {
+            // One group per drawn primitive, not per material: primitives that share a material
+            // come back as primitives of their own.
+            let group = self.group_materials.len() as u32;
+            self.group_materials.push(primitive.material().index());
+            self.groups.resize(self.triangles.len(), group);
+        }
         Ok(())
     }
 
     /// The texture coordinates of every vertex (a part without set `s` gets (0, 0) there) and the
-    /// material of every triangle, named after the document's materials (`default` for none).
+    /// triangle groups: one per drawn primitive, named after its material (`default` for none), so
+    /// two groups may share a name. A scene whose primitives have no material gets no groups.
     pub(super) fn attributes(&self, document: &gltf::Document) -> Attributes {
         let sets = self.texcoords.iter().map(Vec::len).max().unwrap_or(0);
         let texcoords = (0..sets)
@@ -116,28 +124,20 @@ impl Geometry {
                     .collect()
             })
             .collect();
-        if self.materials.iter().all(Option::is_none) {
+        if self.group_materials.iter().all(Option::is_none) {
             return Attributes {
                 texcoords,
                 ..Attributes::default()
             };
         }
-        let mut used: Vec<Option<usize>> = self.materials.clone();
-        used.sort();
-        used.dedup();
         let name = |m: &Option<usize>| match m.and_then(|i| document.materials().nth(i)) {
             Some(material) => super::material_name(&material),
             None => "default".to_string(),
         };
-        let materials = self
-            .materials
-            .iter()
-            .map(|m| used.binary_search(m).unwrap_or(0) as u32)
-            .collect();
         Attributes {
             texcoords,
-            materials,
-            material_names: used.iter().map(name).collect(),
+            materials: self.groups.clone(),
+            material_names: self.group_materials.iter().map(name).collect(),
         }
     }
 

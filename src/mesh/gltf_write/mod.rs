@@ -5,7 +5,7 @@
 //! later frame is one morph target holding its position and normal differences from frame 0. One
 //! animation, "frames", sets the weights with STEP interpolation: at time `f / fps` target `f` has
 //! weight 1 and every other 0, so a viewer shows exactly the decoded frames. One primitive per
-//! material group shares the vertex data. The JSON is built as `gltf::json::Value`s and serialised by
+//! triangle group (per source primitive for glTF inputs) shares the vertex data. The JSON is built as `gltf::json::Value`s and serialised by
 //! `gltf-json` (the `gltf` crate's own JSON layer), so the library needs no JSON crate of its own.
 
 mod buffer;
@@ -152,13 +152,15 @@ fn document(
     }
     let targets = morph_targets(mesh, &welding, &base_normals, buf);
     let groups = material_groups(mesh, attributes);
-    // With a source to look like, a group's material is the source's of the same name.
-    let material_of = |m: u32| match look {
-        Some(look) => attributes
-            .material_names
-            .get(m as usize)
-            .and_then(|name| look.material_index(name)),
-        None => Some(m as usize),
+    // Groups (one per source primitive) may share a material name: each distinct name is one
+    // material, the source's of that name when there is a source to look like.
+    let names = distinct_names(&attributes.material_names);
+    let material_of = |m: u32| {
+        let name = attributes.material_names.get(m as usize)?;
+        match look {
+            Some(look) => look.material_index(name),
+            None => names.iter().position(|n| *n == name),
+        }
     };
     let primitives: Vec<Value> = groups
         .iter()
@@ -210,9 +212,8 @@ fn document(
     ]);
     if let Some(look) = look {
         look.apply(&mut root, buf);
-    } else if !attributes.material_names.is_empty() {
-        let materials: Vec<Value> = attributes
-            .material_names
+    } else if !names.is_empty() {
+        let materials: Vec<Value> = names
             .iter()
             .map(|n| object([("name", n.as_str().into())]))
             .collect();
@@ -255,7 +256,18 @@ fn morph_targets(
         .collect()
 }
 
-/// Triangle indices per material (material groups in index order), or all triangles with no material.
+/// Each name once, in order of first appearance.
+fn distinct_names(names: &[String]) -> Vec<&String> {
+    let mut out: Vec<&String> = Vec::new();
+    for name in names {
+        if !out.contains(&name) {
+            out.push(name);
+        }
+    }
+    out
+}
+
+/// Triangle indices per group (one primitive each, in group order), or all triangles with no groups.
 fn material_groups(mesh: &AnimatedMesh, attributes: &Attributes) -> Vec<(Option<u32>, Vec<u32>)> {
     if attributes.materials.is_empty() {
         return vec![(None, mesh.triangles().iter().flatten().copied().collect())];
