@@ -94,6 +94,13 @@ pub(super) fn choose(
     let trial_frames = sample.as_ref().map_or(frames, |s| s.frames.len());
     let final_frames = if sample.is_some() { frames } else { 0 };
     progress.total((models.len() * trial_frames + final_frames) as u64);
+    let shared = Shared {
+        mesh,
+        ff,
+        leading: &leading,
+        opts,
+        sample: sample.as_ref(),
+    };
     let reference = &ff.decoded_positions;
     let mut candidates = Vec::with_capacity(models.len());
     let mut best: Option<Best> = None;
@@ -114,14 +121,8 @@ pub(super) fn choose(
                 label: model.name(),
             };
             progress.stage("motion");
-            let prediction = analysis::predict_on(
-                mesh,
-                reference,
-                &partition,
-                opts,
-                model.predictor,
-                track.clone(),
-            )?;
+            let (kind, track) = (model.predictor, track.clone());
+            let prediction = analysis::predict_on(mesh, reference, &partition, opts, kind, track)?;
             let analysed = Analysed {
                 model,
                 partition: &partition,
@@ -129,24 +130,12 @@ pub(super) fn choose(
                 prediction: &prediction,
                 atlas: Some(atlas),
             };
-            let (bytes, kept) = match &sample {
+            let (bytes, encoded) = trial(&shared, &analysed, &progress)?;
+            let kept = match encoded {
+                Some(encoded) => Kept::Stream(Box::new(encoded)),
                 None => {
-                    let encoded = code(
-                        mesh,
-                        ff,
-                        leading.clone(),
-                        opts,
-                        &analysed,
-                        &progress,
-                        Stopwatch::new(),
-                    )?;
-                    (encoded.report.bytes, Kept::Stream(Box::new(encoded)))
-                }
-                Some(sample) => {
-                    let trial = (reference.as_slice(), leading.as_slice());
-                    let bytes = sample.estimate(mesh, trial, opts, &analysed, &progress)?;
                     let analysis = (partition.clone(), segmented.clone(), prediction, atlas);
-                    (bytes, Kept::Analysis(Box::new(analysis)))
+                    Kept::Analysis(Box::new(analysis))
                 }
             };
             clock.lap(&format!("trial {}", model.name()));
@@ -165,11 +154,69 @@ pub(super) fn choose(
     }
     let best = best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
     let model = models[best.index];
-    let mut encoded = match best.kept {
+    let mut encoded = keep(&shared, model, best.kept, progress, clock)?;
+    encoded.report.choice = Some(ChoiceReport {
+        chosen: model.name(),
+        trial_frames,
+        reason: reason(&candidates, best.index, trial_frames, frames),
+        candidates,
+    });
+    Ok(encoded)
+}
+
+/// What every trial shares: the animation (in the stream's vertex order), its coded first frame
+/// and the parts before the partition, the options and, for sampled trials, the sample.
+struct Shared<'a> {
+    mesh: &'a AnimatedMesh,
+    ff: &'a EncodedFirstFrame,
+    leading: &'a [Part],
+    opts: &'a EncodeOptions,
+    sample: Option<&'a Sample>,
+}
+
+/// Codes one candidate: its bytes and whole stream, or (sampled trials) its estimated bytes.
+fn trial(
+    shared: &Shared,
+    analysed: &Analysed,
+    progress: &dyn Progress,
+) -> Result<(u64, Option<Encoded>)> {
+    let Shared { mesh, ff, opts, .. } = *shared;
+    match shared.sample {
+        None => {
+            let leading = shared.leading.to_vec();
+            let encoded = code(
+                mesh,
+                ff,
+                leading,
+                opts,
+                analysed,
+                progress,
+                Stopwatch::new(),
+            )?;
+            Ok((encoded.report.bytes, Some(encoded)))
+        }
+        Some(sample) => {
+            let trial = (ff.decoded_positions.as_slice(), shared.leading);
+            let bytes = sample.estimate(mesh, trial, opts, analysed, progress)?;
+            Ok((bytes, None))
+        }
+    }
+}
+
+/// The winner's stream: kept from its trial (its report's stages replaced by the whole
+/// choice's), or coded in full now.
+fn keep(
+    shared: &Shared,
+    model: MotionModel,
+    kept: Kept,
+    progress: &dyn Progress,
+    clock: Stopwatch,
+) -> Result<Encoded> {
+    match kept {
         Kept::Stream(encoded) => {
             let mut encoded = *encoded;
             encoded.report.stage_seconds = clock.stages;
-            encoded
+            Ok(encoded)
         }
         Kept::Analysis(analysis) => {
             let (partition, segmentation, prediction, atlas) = *analysis;
@@ -180,16 +227,11 @@ pub(super) fn choose(
                 prediction: &prediction,
                 atlas: Some(atlas),
             };
-            code(mesh, ff, leading, opts, &analysed, progress, clock)?
+            let Shared { mesh, ff, opts, .. } = *shared;
+            let leading = shared.leading.to_vec();
+            code(mesh, ff, leading, opts, &analysed, progress, clock)
         }
-    };
-    encoded.report.choice = Some(ChoiceReport {
-        chosen: model.name(),
-        trial_frames,
-        reason: reason(&candidates, best.index, trial_frames, frames),
-        candidates,
-    });
-    Ok(encoded)
+    }
 }
 
 /// The distinct segmentations of `models`, in order.
