@@ -5,10 +5,11 @@
 //! `cargo run --release --example dump_residuals -- INPUT OUT_DIR [FRAMES]` (default 24 frames, evenly
 //! spread), then `cargo run --release -p padding --example jpeg_bench -- folder --per-frame 3 OUT_DIR`.
 
-use mcgv_video::codec::geometry_video;
-use mcgv_video::encoder::{analysis, EncodeOptions};
+use mcgv_video::codec::{geometry_video, Codec};
+use mcgv_video::encoder::{analysis, EncodeOptions, Segmentation};
 use mcgv_video::first_frame;
 use mcgv_video::mesh::read_animation;
+use mcgv_video::motion::PredictorKind;
 use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -19,7 +20,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let wanted: usize = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(24);
     let mesh = read_animation(&input, &Default::default())?;
-    let opts = EncodeOptions::default();
+    let opts = EncodeOptions {
+        codec: Codec::Jpeg,
+        ..EncodeOptions::default()
+    };
     let ff = first_frame::encode(
         mesh.frame(0),
         mesh.triangles(),
@@ -28,8 +32,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             reorder: false,
         },
     )?;
-    let (partition, _) = analysis::segment(&mesh, &opts)?;
-    let prediction = analysis::predict(&mesh, &ff.decoded_positions, &partition, &opts)?;
+    let (partition, _) = analysis::segment(&mesh, Segmentation::KMeans, opts.clusters)?;
+    let reference = &ff.decoded_positions;
+    let prediction = analysis::predict(&mesh, reference, &partition, &opts, PredictorKind::Affine)?;
     let pictures = opts.codec.pictures()?.ok_or("the codec makes no images")?;
     let step = geometry_video::pixel_step(pictures.as_ref(), mesh.bbox_diagonal(), &opts)?;
     let images = geometry_video::images_of(

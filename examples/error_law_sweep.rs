@@ -69,9 +69,9 @@ fn main() -> Res<()> {
             .map_or("?".into(), |s| s.to_string_lossy().to_string());
         let base = EncodeOptions {
             predictor: if skinning {
-                mcgv_video::PredictorKind::Skinning
+                mcgv_video::PredictorKind::Skinning.into()
             } else {
-                mcgv_video::PredictorKind::Affine
+                mcgv_video::PredictorKind::Affine.into()
             },
             ..EncodeOptions::default()
         };

@@ -52,7 +52,8 @@ pub mod stream;
 pub use codec::Codec;
 pub use decoder::{DecodeOptions, Decoder};
 pub use encoder::{
-    encode, encode_with_progress, EncodeOptions, EncodeReport, Encoded, Segmentation,
+    encode, encode_with_progress, EncodeOptions, EncodeReport, Encoded, PredictorChoice,
+    Segmentation, SegmentationChoice,
 };
 pub use error::{Error, Result};
 pub use geometry_image::Lattice;

@@ -5,6 +5,9 @@
 pub trait Progress: Sync {
     /// A new stage starts (e.g. `segmentation`, `images`).
     fn stage(&self, _name: &str) {}
+    /// The work ahead is `frames` frames in all: the animation's, or with an automatic choice
+    /// every candidate's trial frames as well. Told before the first [`Progress::frames`].
+    fn total(&self, _frames: u64) {}
     /// `count` more frames are done.
     fn frames(&self, _count: u64) {}
 }

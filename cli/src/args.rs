@@ -121,14 +121,16 @@ pub struct EncodeArgs {
     /// --quality sets.
     #[arg(long)]
     pub step: Option<f64>,
-    /// Number of motion clusters K for k-means (default 20).
+    /// Number of motion clusters K for k-means (default 20; with --segmentation auto, for its
+    /// k-means candidate).
     #[arg(long)]
     pub clusters: Option<usize>,
-    /// Motion segmentation: k-means with K = --clusters, or decimation, which finds K itself.
-    #[arg(long, value_enum, default_value_t = SegmentationChoice::Kmeans)]
+    /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or
+    /// auto: both are tried at the quality's step and the smaller stream is kept (see --json).
+    #[arg(long, value_enum, default_value_t = SegmentationChoice::Auto)]
     pub segmentation: SegmentationChoice,
     /// Decimation's error threshold E0: RMS affine-fit error per vertex and frame, as a fraction of
-    /// the bounding-box diagonal (default 0.003, the paper's).
+    /// the bounding-box diagonal (default 0.003, the paper's; decimation and auto).
     #[arg(long)]
     pub e0: Option<f64>,
     /// The affine coefficients' quantiser step as a multiple of the residual step (whose size
@@ -155,9 +157,10 @@ pub struct EncodeArgs {
     /// Let the first-frame coder reorder vertices for fewer bits (default keeps the input order).
     #[arg(long)]
     pub reorder: bool,
-    /// Motion predictor: one affine map per cluster, or per-vertex skinning weights over
-    /// neighbouring clusters' maps (coded in the stream; the decoder follows the stream's choice).
-    #[arg(long, value_enum, default_value_t = PredictorChoice::Affine)]
+    /// Motion predictor: one affine map per cluster, per-vertex skinning weights over
+    /// neighbouring clusters' maps (coded in the stream; the decoder follows the stream's choice),
+    /// or auto: both are tried at the quality's step and the smaller stream is kept.
+    #[arg(long, value_enum, default_value_t = PredictorChoice::Auto)]
     pub predictor: PredictorChoice,
     /// Bits per quantised skinning weight, sign included (the paper's 16; the motion bench saw
     /// the same residual energy at 12 for about 60 % of the weights' bits).
@@ -199,6 +202,8 @@ pub enum SegmentationChoice {
     Kmeans,
     /// Half-edge collapses by affine-motion cost until the error reaches --e0 (skinning paper).
     Decimation,
+    /// Both, at the quality's step; the smaller stream is kept.
+    Auto,
 }
 
 /// The residual coders.
@@ -222,6 +227,8 @@ pub enum PredictorChoice {
     Affine,
     /// Per-vertex weights blending the own and neighbouring clusters' maps.
     Skinning,
+    /// Both, at the quality's step; the smaller stream is kept.
+    Auto,
 }
 
 /// `decode` arguments.

@@ -36,6 +36,10 @@ impl mcgv_video::Progress for Reporter<'_> {
         self.0.set_message(name.to_string());
     }
 
+    fn total(&self, frames: u64) {
+        self.0.set_length(frames);
+    }
+
     fn frames(&self, count: u64) {
         self.0.inc(count);
     }

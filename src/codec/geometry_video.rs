@@ -83,15 +83,20 @@ pub fn padding_method(codec: &dyn PictureCodec, opts: &EncodeOptions) -> padding
 /// The residual images an encoding with `codec` makes of `input`'s residuals.
 pub fn images(codec: &dyn PictureCodec, input: &ResidualInput) -> Result<GeometryImages> {
     let step = pixel_step(codec, input.mesh.bbox_diagonal(), input.options)?;
-    images_of(
+    let (reference, triangles) = (input.reference, input.mesh.triangles());
+    let build =
+        || lattice::build_atlas(reference, triangles, input.partition, input.options.lattice);
+    let atlas = match input.atlas {
+        Some(cache) => cache.get_or_build(build)?,
+        None => build()?,
+    };
+    Ok(images_on(
         codec,
-        input.reference,
-        input.mesh.triangles(),
-        input.partition,
+        atlas,
         input.residuals,
         input.options,
         step,
-    )
+    ))
 }
 
 /// One grey level of an encoding in model units: `opts.step` (a fraction of the first frame's
@@ -112,8 +117,19 @@ pub fn images_of(
     opts: &EncodeOptions,
     pixel_step: f32,
 ) -> Result<GeometryImages> {
-    let (size, atlas) = lattice::build_atlas(reference, triangles, partition, opts.lattice)?;
-    Ok(GeometryImages::new(
+    let atlas = lattice::build_atlas(reference, triangles, partition, opts.lattice)?;
+    Ok(images_on(codec, atlas, residuals, opts, pixel_step))
+}
+
+/// The residual images of `residuals` on a built atlas (lattice size and atlas).
+fn images_on(
+    codec: &dyn PictureCodec,
+    (size, atlas): ((u16, u16), atlas::Atlas),
+    residuals: &[Vec<[f32; 3]>],
+    opts: &EncodeOptions,
+    pixel_step: f32,
+) -> GeometryImages {
+    GeometryImages::new(
         size,
         atlas,
         residuals,
@@ -128,7 +144,7 @@ pub fn images_of(
             jpeg_table: super::jpeg::TABLE,
             ..padding::PaddingOptions::default()
         },
-    ))
+    )
 }
 
 /// The geometry-video residual encoder over one picture codec.

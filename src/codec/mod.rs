@@ -189,6 +189,9 @@ pub struct ResidualInput<'a> {
     pub options: &'a EncodeOptions,
     /// Where to report frames done.
     pub progress: &'a dyn Progress,
+    /// Codecs with an atlas: the atlas of `reference` and `partition` if already built, else
+    /// where to keep it (encodings sharing one partition share it); `None` builds it afresh.
+    pub atlas: Option<&'a crate::geometry_image::lattice::AtlasCache>,
 }
 
 /// The codec's fields of the stream header.

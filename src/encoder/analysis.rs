@@ -2,7 +2,7 @@
 //! segmentation, and the quantised predictor with every frame's residual against it. `inspect`
 //! redoes it on a stream's own partition to show the images the encoder coded.
 
-use super::options::{EncodeOptions, Segmentation};
+use super::options::{EncodeOptions, PredictorChoice, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::{self, EncodedFirstFrame, FirstFrameOptions};
 use crate::mesh::{AnimatedMesh, Point};
@@ -59,16 +59,17 @@ pub fn first_frame(
     Ok((ff, permuted))
 }
 
-/// The motion segmentation `opts` ask for, and what it did.
+/// The motion segmentation `segmentation` (k-means into `clusters`), and what it did.
 pub fn segment(
     mesh: &AnimatedMesh,
-    opts: &EncodeOptions,
+    segmentation: Segmentation,
+    clusters: usize,
 ) -> Result<(Partition, SegmentationReport)> {
     let start = Instant::now();
-    let (partition, e0, error, components) = match opts.segmentation {
+    let (partition, e0, error, components) = match segmentation {
         Segmentation::KMeans => {
             let options = SegmentOptions {
-                clusters: opts.clusters,
+                clusters,
                 ..SegmentOptions::default()
             };
             (motion::segment(mesh, &options)?, None, None, None)
@@ -83,7 +84,7 @@ pub fn segment(
         }
     };
     let report = SegmentationReport {
-        method: opts.segmentation.name(),
+        method: segmentation.name(),
         clusters: partition.clusters(),
         seconds: start.elapsed().as_secs_f64(),
         e0,
@@ -93,16 +94,39 @@ pub fn segment(
     Ok((partition, report))
 }
 
-/// The quantised predictor (affine track, skinning weights) and every frame's residuals against
-/// it, as the decoder will rebuild them: closed loop.
+/// The quantised predictor `kind` (affine track, skinning weights) and every frame's residuals
+/// against it, as the decoder will rebuild them: closed loop.
 pub fn predict(
     mesh: &AnimatedMesh,
     reference: &[Point],
     partition: &Partition,
     opts: &EncodeOptions,
+    kind: PredictorKind,
 ) -> Result<Prediction> {
-    let track = AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_step())?;
-    let weights = match opts.predictor {
+    let track = fit_track(mesh, reference, partition, opts)?;
+    predict_on(mesh, reference, partition, opts, kind, track)
+}
+
+/// The quantised affine track every predictor builds on (skinning blends its maps).
+pub fn fit_track(
+    mesh: &AnimatedMesh,
+    reference: &[Point],
+    partition: &Partition,
+    opts: &EncodeOptions,
+) -> Result<AffineTrack> {
+    AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_step())
+}
+
+/// [`predict`] on an affine track already fitted to `partition` ([`fit_track`]).
+pub fn predict_on(
+    mesh: &AnimatedMesh,
+    reference: &[Point],
+    partition: &Partition,
+    opts: &EncodeOptions,
+    kind: PredictorKind,
+    track: AffineTrack,
+) -> Result<Prediction> {
+    let weights = match kind {
         PredictorKind::Affine => None,
         PredictorKind::Skinning => Some(SkinningWeights::fit_with(
             mesh.frames(),
@@ -154,7 +178,12 @@ pub fn redo(
             partition.labels().len()
         )));
     }
-    let prediction = predict(mesh, &ff.decoded_positions, partition, opts)?;
+    let PredictorChoice::Fixed(kind) = opts.predictor else {
+        return Err(Error::Usage(
+            "redoing an encoding needs the stream's predictor, not an automatic choice".into(),
+        ));
+    };
+    let prediction = predict(mesh, &ff.decoded_positions, partition, opts, kind)?;
     Ok(Redone {
         triangles: mesh.triangles().to_vec(),
         reference: ff.decoded_positions,

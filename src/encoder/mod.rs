@@ -4,13 +4,20 @@
 
 pub mod analysis;
 mod attributes;
+pub mod auto;
 mod options;
 
 pub use analysis::{Prediction, SegmentationReport};
-pub use options::{default_affine_precision, EncodeOptions, Segmentation, DEFAULT_QUALITY};
+pub use auto::{Candidate, ChoiceReport};
+pub use options::{
+    default_affine_precision, EncodeOptions, MotionModel, PredictorChoice, Segmentation,
+    SegmentationChoice, DEFAULT_QUALITY,
+};
 
 use crate::codec::{CodecParams, ResidualInput};
 use crate::error::Result;
+use crate::first_frame::EncodedFirstFrame;
+use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::AnimatedMesh;
 use crate::motion::Partition;
 use crate::progress::{Progress, Silent};
@@ -43,6 +50,8 @@ pub struct EncodeReport {
     pub stage_seconds: Vec<(String, f64)>,
     /// The segmentation: method, K found, its time (and for decimation, the error reached).
     pub segmentation: SegmentationReport,
+    /// With an automatic predictor or segmentation: the candidates measured and the one kept.
+    pub choice: Option<ChoiceReport>,
     /// If the first-frame coder reordered vertices: new index → input index.
     #[serde(skip)]
     pub permutation: Option<Vec<u32>>,
@@ -73,7 +82,8 @@ pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Encoded> {
     encode_with_progress(mesh, opts, &Silent)
 }
 
-/// Encodes an animation, telling `progress` each stage and each frame coded.
+/// Encodes an animation, telling `progress` each stage and each frame coded. With an automatic
+/// predictor or segmentation, every candidate is tried ([`auto`]) and the smallest stream kept.
 pub fn encode_with_progress(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
@@ -84,32 +94,82 @@ pub fn encode_with_progress(
     progress.stage("first frame");
     let (ff, permuted) = analysis::first_frame(mesh, opts)?;
     let mesh = permuted.as_ref().unwrap_or(mesh);
+    let leading = leading_parts(mesh, &ff.bytes, opts)?;
     clock.lap("first frame");
+    let models = opts.motion_models();
+    let [model] = models[..] else {
+        return auto::choose(mesh, &ff, leading, opts, &models, progress, clock);
+    };
+    progress.total(mesh.frame_count() as u64);
     progress.stage("segmentation");
-    let (partition, segmentation) = analysis::segment(mesh, opts)?;
+    let (partition, segmentation) = analysis::segment(mesh, model.segmentation, opts.clusters)?;
     clock.lap("segmentation");
     progress.stage("motion");
-    let prediction = analysis::predict(mesh, &ff.decoded_positions, &partition, opts)?;
+    let reference = &ff.decoded_positions;
+    let prediction = analysis::predict(mesh, reference, &partition, opts, model.predictor)?;
     clock.lap("motion");
+    let analysed = Analysed {
+        model,
+        partition: &partition,
+        segmentation,
+        prediction: &prediction,
+        atlas: None,
+    };
+    code(mesh, &ff, leading, opts, &analysed, progress, clock)
+}
+
+/// The first frame's part and, for inputs with texture coordinates, the attributes'.
+fn leading_parts(
+    mesh: &AnimatedMesh,
+    first_frame: &[u8],
+    opts: &EncodeOptions,
+) -> Result<Vec<Part>> {
+    let mut leading = vec![Part::whole(Tag::FIRST_FRAME, first_frame.to_vec())];
+    if !mesh.attributes().is_empty() {
+        let bytes = attributes::encode(mesh, first_frame, opts.uv_bits)?;
+        leading.push(Part::whole(Tag::ATTRIBUTES, bytes));
+    }
+    Ok(leading)
+}
+
+/// One motion model's analysis of the animation: what the residual codec is given.
+struct Analysed<'a> {
+    model: MotionModel,
+    partition: &'a Partition,
+    segmentation: SegmentationReport,
+    prediction: &'a Prediction,
+    /// The partition's atlas, shared by the encodings on it (codecs with an atlas).
+    atlas: Option<&'a AtlasCache>,
+}
+
+/// Codes the residuals of `analysed` and assembles the stream behind the `leading` parts; the
+/// report's stages are the `clock`'s and the coder's.
+fn code(
+    mesh: &AnimatedMesh,
+    ff: &EncodedFirstFrame,
+    leading: Vec<Part>,
+    opts: &EncodeOptions,
+    analysed: &Analysed,
+    progress: &dyn Progress,
+    mut clock: Stopwatch,
+) -> Result<Encoded> {
+    let (partition, prediction) = (analysed.partition, analysed.prediction);
     let coded = opts.codec.encoder()?.encode(&ResidualInput {
         mesh,
         reference: &ff.decoded_positions,
-        partition: &partition,
+        partition,
         residuals: &prediction.residuals,
         options: opts,
         progress,
+        atlas: analysed.atlas,
     })?;
     clock.stages.extend(coded.stage_seconds);
     clock.restart();
     let atlas = coded.atlas;
-    let header = header(mesh, opts, &partition, &coded.params, atlas.as_ref());
+    let model = analysed.model;
+    let header = header(mesh, opts, model, partition, &coded.params, atlas.as_ref());
     let parts = (coded.before_predictor, coded.after_predictor);
-    let mut leading = vec![Part::whole(Tag::FIRST_FRAME, ff.bytes)];
-    if !mesh.attributes().is_empty() {
-        let bytes = attributes::encode(mesh, &leading[0].bytes, opts.uv_bits)?;
-        leading.push(Part::whole(Tag::ATTRIBUTES, bytes));
-    }
-    let container = assemble(&header, leading, mesh, &partition, &prediction, parts)?;
+    let container = assemble(&header, leading, mesh, partition, prediction, parts)?;
     clock.lap("side information");
     let report = EncodeReport {
         parts: container.part_sizes(),
@@ -121,8 +181,9 @@ pub fn encode_with_progress(
         moved_vertices: atlas.as_ref().map_or(0, |s| s.moved_vertices),
         l2_stretch: atlas.as_ref().map_or(0.0, |s| s.l2_stretch),
         stage_seconds: clock.stages,
-        segmentation,
-        permutation: ff.permutation,
+        segmentation: analysed.segmentation.clone(),
+        choice: None,
+        permutation: ff.permutation.clone(),
     };
     Ok(Encoded { container, report })
 }
@@ -156,6 +217,7 @@ impl Stopwatch {
 fn header(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
+    model: MotionModel,
     partition: &Partition,
     params: &CodecParams,
     atlas: Option<&atlas::AtlasStats>,
@@ -175,7 +237,7 @@ fn header(
         first_frame_bits: opts.first_frame_bits,
         padding: params.padding.clone(),
         // Decimation asks for no K: the header then records the K it found.
-        requested_clusters: match opts.segmentation {
+        requested_clusters: match model.segmentation {
             Segmentation::KMeans => opts.clusters as u32,
             Segmentation::Decimation { .. } => partition.clusters() as u32,
         },
@@ -183,7 +245,7 @@ fn header(
         charts: atlas.map_or(0, |s| s.charts as u32),
         chart_pixels: atlas.map_or(0, |s| s.chart_pixels as u32),
         frame_rate: mesh.frame_rate().map_or(0.0, |r| r as f32),
-        predictor: opts.predictor,
+        predictor: model.predictor,
     }
 }
 

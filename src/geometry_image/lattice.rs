@@ -53,6 +53,28 @@ pub fn check(w: u16, h: u16) -> Result<()> {
     Ok(())
 }
 
+/// An atlas built once and handed to every encoding on the same first frame, partition and
+/// lattice option: the automatic choice codes several predictors on one partition, and building
+/// the atlas costs as much as coding a dozen frames' pictures.
+#[derive(Debug, Default)]
+pub struct AtlasCache(std::sync::OnceLock<((u16, u16), atlas::Atlas)>);
+
+impl AtlasCache {
+    /// The cached atlas, or `build`'s result (kept for the next call).
+    pub fn get_or_build(
+        &self,
+        build: impl FnOnce() -> Result<((u16, u16), atlas::Atlas)>,
+    ) -> Result<((u16, u16), atlas::Atlas)> {
+        if let Some(built) = self.0.get() {
+            return Ok(built.clone());
+        }
+        let built = build()?;
+        // A racing caller's equal atlas may have been kept instead; either serves.
+        let _ = self.0.set(built.clone());
+        Ok(built)
+    }
+}
+
 /// Builds the atlas on the requested lattice, or for `Lattice::Auto` on the smallest lattice from
 /// [`auto_side`] upwards on which the charts fit.
 pub fn build_atlas(

@@ -1,6 +1,7 @@
 //! Segmentation by decimation (skinning paper §3.1) on synthetic animations with a known answer.
 
 use crate::common::{canonical, decoder, rand_index, read_media, tube};
+use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::topology::ManifoldReport;
 use mcgv_video::mesh::{Point, Triangle};
@@ -280,7 +281,8 @@ fn the_cap_continues_collapsing_past_e0() {
 fn decimation_round_trips_through_the_stream() {
     let mesh = read_media("RiggedSimple.glb");
     let opts = EncodeOptions {
-        segmentation: Segmentation::Decimation { e0: 0.003 },
+        codec: Codec::Jpeg,
+        segmentation: Segmentation::Decimation { e0: 0.003 }.into(),
         // The paper's padding keeps this debug-build test fast.
         padding: Some(padding::Method::Cg),
         ..EncodeOptions::default()

@@ -4,9 +4,10 @@
 
 use crate::common::{animate, decode_all, decoder, encode_bytes, read_media, tiny_stream, tube};
 use mcgv_video::codec::{target_step, Codec};
-use mcgv_video::encoder::EncodeOptions;
+use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::mesh::AnimatedMesh;
 use mcgv_video::metrics::vertex_errors;
+use mcgv_video::motion::PredictorKind;
 
 fn image_codecs() -> Vec<Codec> {
     [Codec::Jpeg, Codec::Mpeg4]
@@ -21,6 +22,8 @@ fn error_at(mesh: &AnimatedMesh, codec: Codec, quality: u8, clusters: usize) -> 
         codec,
         quality,
         clusters,
+        predictor: PredictorKind::Affine.into(),
+        segmentation: Segmentation::KMeans.into(),
         ..EncodeOptions::default()
     };
     let bytes = encode_bytes(mesh, &opts);

@@ -6,6 +6,7 @@ mod common;
 
 mod affine_coding;
 mod attributes;
+mod auto;
 mod cloth;
 mod codec;
 mod decimate;

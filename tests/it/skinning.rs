@@ -3,7 +3,7 @@
 
 use crate::common::{canonical, decode_all, decoder, encode_bytes, parts, read_media, rebuild};
 use mcgv_video::codec::Codec;
-use mcgv_video::encoder::{analysis, EncodeOptions};
+use mcgv_video::encoder::{analysis, EncodeOptions, Segmentation};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{self, PredictorKind};
 use mcgv_video::stream::container::{Checksum, ContainerReader, Tag};
@@ -16,7 +16,9 @@ fn opts(codec: Codec, quality: u8, predictor: PredictorKind) -> EncodeOptions {
         quality,
         gop: 10,
         padding: Some(padding::Method::Cg),
-        predictor,
+        predictor: predictor.into(),
+        // The bounds below were measured on k-means clusters.
+        segmentation: Segmentation::KMeans.into(),
         ..EncodeOptions::default()
     }
 }
@@ -137,8 +139,9 @@ fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
     let reference = mesh.frame(0).to_vec();
     let energy = |predictor| {
         let options = opts(Codec::Jpeg, 50, predictor);
-        let (partition, _) = analysis::segment(&mesh, &options).unwrap();
-        let a = analysis::predict(&mesh, &reference, &partition, &options).unwrap();
+        let (partition, _) =
+            analysis::segment(&mesh, Segmentation::KMeans, options.clusters).unwrap();
+        let a = analysis::predict(&mesh, &reference, &partition, &options, predictor).unwrap();
         assert_eq!(a.weights.is_some(), predictor == PredictorKind::Skinning);
         a.residuals.iter().map(|r| motion::energy(r)).sum::<f64>()
     };

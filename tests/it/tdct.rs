@@ -107,7 +107,7 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
 fn skinning_predictor_and_decimation_round_trip() {
     let mesh = read_media("RiggedFigure.glb");
     let skin = EncodeOptions {
-        predictor: PredictorKind::Skinning,
+        predictor: PredictorKind::Skinning.into(),
         ..tdct(75)
     };
     let decoded = decode_all(encode_bytes(&mesh, &skin), None).unwrap();
@@ -123,7 +123,7 @@ fn skinning_predictor_and_decimation_round_trip() {
 
     let simple = read_media("RiggedSimple.glb");
     let decimation = EncodeOptions {
-        segmentation: Segmentation::Decimation { e0: 0.003 },
+        segmentation: Segmentation::Decimation { e0: 0.003 }.into(),
         ..tdct(75)
     };
     let decoded = decode_all(encode_bytes(&simple, &decimation), None).unwrap();
@@ -251,6 +251,7 @@ fn forged_counts_are_refused_before_allocating() {
     let jpeg = encode_bytes(
         &mesh,
         &EncodeOptions {
+            codec: Codec::Jpeg,
             padding: Some(padding::Method::Cg),
             ..EncodeOptions::default()
         },
@@ -295,6 +296,7 @@ fn step_overrides_quality_and_is_checked() {
     }
     // The step is every codec's since the error law (issue 15): the image codecs' pixel step.
     let jpeg = EncodeOptions {
+        codec: Codec::Jpeg,
         step: Some(0.001),
         ..EncodeOptions::default()
     };

@@ -7,10 +7,11 @@ use mcgv_video::codec::tdct::spatial::{Neighbourhood, Spatial};
 use mcgv_video::codec::Codec;
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::analysis::{predict, segment};
-use mcgv_video::encoder::EncodeOptions;
+use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::AnimatedMesh;
 use mcgv_video::metrics::compare;
+use mcgv_video::motion::PredictorKind;
 use mcgv_video::stream::container::ContainerReader;
 use std::io::Cursor;
 use std::sync::Arc;
@@ -26,10 +27,16 @@ pub fn coefficients_of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<Vec<f64
         },
     )
     .unwrap();
-    let (partition, _) = segment(mesh, opts).unwrap();
-    let residuals = predict(mesh, &ff.decoded_positions, &partition, opts)
-        .unwrap()
-        .residuals;
+    let (partition, _) = segment(mesh, Segmentation::KMeans, opts.clusters).unwrap();
+    let residuals = predict(
+        mesh,
+        &ff.decoded_positions,
+        &partition,
+        opts,
+        PredictorKind::Affine,
+    )
+    .unwrap()
+    .residuals;
     forward(&residuals).unwrap()
 }
 

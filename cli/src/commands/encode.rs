@@ -4,6 +4,7 @@ use crate::args::{CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
+use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
 use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::io::input_files;
 use mcgv_video::mesh::ReadOptions;
@@ -36,27 +37,27 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         ),
         None => None,
     };
+    let e0 = args.e0.unwrap_or(mcgv_video::motion::DEFAULT_E0);
     let segmentation = match args.segmentation {
         SegmentationChoice::Kmeans => {
             if args.e0.is_some() {
                 return Err(Error::option(
                     "e0",
-                    "applies to --segmentation decimation only",
+                    "applies to --segmentation decimation (or auto) only",
                 ));
             }
-            Segmentation::KMeans
+            Segmenting::Fixed(Segmentation::KMeans)
         }
         SegmentationChoice::Decimation => {
             if args.clusters.is_some() {
                 return Err(Error::option(
                     "clusters",
-                    "applies to --segmentation kmeans only: decimation finds K from --e0",
+                    "applies to --segmentation kmeans (or auto) only: decimation finds K from --e0",
                 ));
             }
-            Segmentation::Decimation {
-                e0: args.e0.unwrap_or(mcgv_video::motion::DEFAULT_E0),
-            }
+            Segmenting::Fixed(Segmentation::Decimation { e0 })
         }
+        SegmentationChoice::Auto => Segmenting::Auto { e0 },
     };
     let defaults = EncodeOptions::default();
     Ok(EncodeOptions {
@@ -76,8 +77,9 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             .map_or(defaults.gop, |g| usize::try_from(g).unwrap_or(usize::MAX)),
         reorder: args.reorder,
         predictor: match args.predictor {
-            PredictorChoice::Affine => PredictorKind::Affine,
-            PredictorChoice::Skinning => PredictorKind::Skinning,
+            PredictorChoice::Affine => Predictor::Fixed(PredictorKind::Affine),
+            PredictorChoice::Skinning => Predictor::Fixed(PredictorKind::Skinning),
+            PredictorChoice::Auto => Predictor::Auto,
         },
         weight_bits: args.weight_bits,
         step: args.step,
@@ -276,6 +278,15 @@ fn encode_one(
         seconds,
         r.header.frames as f64 / seconds.max(1e-9)
     );
+    let line = match &r.choice {
+        Some(choice) => format!(
+            "{line}\nauto: kept {} of {} candidates: {}",
+            choice.chosen,
+            choice.candidates.len(),
+            choice.reason
+        ),
+        None => line,
+    };
     // With `-o -` stdout carries the stream: the report goes to stderr.
     if to_stdout {
         eprintln!("{line}");

@@ -4,6 +4,7 @@
 mod browser;
 mod common;
 
+mod auto;
 mod codec;
 mod convert;
 mod eval;

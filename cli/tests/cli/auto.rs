@@ -1,0 +1,80 @@
+//! `encode --predictor auto --segmentation auto` through the binary: the choice in `--json` and
+//! in the text report, the stream's predictor in `inspect`.
+
+use crate::common::{json, media_path, ok, run};
+
+#[test]
+fn auto_reports_its_candidates_and_keeps_the_smallest() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let stream = dir.path().join("s.mcgv");
+    let s = stream.to_str().expect("utf-8 path");
+    let sample = media_path("RiggedSimple.glb");
+    let base = ["encode", sample.as_str(), "-o", s, "--quiet"];
+    let auto = ["--predictor", "auto", "--segmentation", "auto"];
+    let enc = json(&run(
+        &[&base[..], &auto, &["--json", "--e0", "0.004"]].concat()
+    ));
+    let choice = &enc["choice"];
+    let candidates = choice["candidates"].as_array().expect("candidates");
+    assert_eq!(candidates.len(), 4, "{enc}");
+    let smallest = candidates
+        .iter()
+        .min_by_key(|c| c["bytes"].as_u64().expect("bytes"))
+        .expect("a candidate");
+    // tdct codes every candidate whole: the kept one's size is the stream's.
+    assert_eq!(smallest["bytes"], enc["bytes"], "{enc}");
+    let chosen = format!(
+        "{}+{}",
+        smallest["predictor"].as_str().expect("predictor"),
+        smallest["segmentation"].as_str().expect("segmentation")
+    );
+    assert_eq!(choice["chosen"], chosen.as_str(), "{enc}");
+    assert!(choice["reason"].as_str().is_some_and(|r| !r.is_empty()));
+    assert_eq!(enc["header"]["predictor"], smallest["predictor"]);
+    assert_eq!(enc["segmentation"]["method"], smallest["segmentation"]);
+    let info = json(&run(&["inspect", s, "--json"]));
+    assert_eq!(info["predictor"], smallest["predictor"]);
+
+    // auto is the default; the text report says what was kept; fixed flags choose nothing.
+    let default = json(&run(&[&base[..], &["--json", "--e0", "0.004"]].concat()));
+    assert_eq!(default["choice"]["chosen"], choice["chosen"], "{default}");
+    assert_eq!(default["bytes"], enc["bytes"]);
+    let text = ok(&run(&[&base[..4], &auto, &["--clusters", "5"]].concat()));
+    assert!(text.contains("auto: kept"), "{text}");
+    let fixed = [
+        "--predictor",
+        "affine",
+        "--segmentation",
+        "kmeans",
+        "--json",
+    ];
+    let fixed = json(&run(&[&base[..], &fixed].concat()));
+    assert!(fixed["choice"].is_null(), "{fixed}");
+}
+
+#[test]
+fn auto_flags_are_checked() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let out = dir.path().join("s.mcgv");
+    let o = out.to_str().expect("utf-8 path");
+    let sample = media_path("RiggedSimple.glb");
+    for (flag, value) in [("--predictor", "best"), ("--segmentation", "guess")] {
+        let res = run(&["encode", &sample, "-o", o, "--quiet", flag, value]);
+        assert_eq!(res.status.code(), Some(2), "{flag} {value}");
+        assert!(String::from_utf8_lossy(&res.stderr).contains("auto"));
+    }
+    let res = run(&[
+        "encode",
+        &sample,
+        "-o",
+        o,
+        "--quiet",
+        "--segmentation",
+        "auto",
+        "--e0",
+        "0",
+    ]);
+    assert_eq!(res.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&res.stderr).contains("--e0"));
+    assert!(!out.exists());
+}

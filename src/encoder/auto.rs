@@ -1,0 +1,367 @@
+//! The encoder's automatic choice of motion model (`PredictorChoice::Auto`,
+//! `SegmentationChoice::Auto`): every candidate predictor × segmentation is coded at the encoding's
+//! quality, hence at one step, and the smallest stream is kept. Which one wins depends on the
+//! animation (skinning on rigid bones, the affine maps on soft bodies), so it is measured, not
+//! guessed.
+//!
+//! Shared between the candidates: the first frame, each segmentation (used by every predictor)
+//! and its affine track (skinning blends its maps). tdct codes every candidate whole (its
+//! residual coder is cheap next to the segmentation), and so does MPEG-4 (a sample misranks its
+//! P-frames); JPEG, whose pictures cost most of an encoding and are coded each on its own, codes a
+//! sample of frames per candidate, scales the sample's per-frame parts to the whole and then codes
+//! the winner once in full.
+
+use super::{analysis, assemble, code, header, Analysed, Encoded, Stopwatch};
+use crate::codec::{Codec, ResidualInput};
+use crate::encoder::{EncodeOptions, MotionModel, Segmentation};
+use crate::error::{Error, Result};
+use crate::first_frame::EncodedFirstFrame;
+use crate::geometry_image::lattice::AtlasCache;
+use crate::mesh::{AnimatedMesh, Point};
+use crate::motion::{Partition, PredictorKind};
+use crate::progress::Progress;
+use crate::stream::container::Part;
+use std::time::Instant;
+
+/// Frames the picture codecs' trials code per candidate when the animation has more than twice
+/// as many.
+pub const TRIAL_FRAMES: usize = 12;
+
+/// What the automatic choice measured and kept.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ChoiceReport {
+    /// The motion model kept, `predictor+segmentation`.
+    pub chosen: String,
+    /// Frames each candidate's residuals were coded on: every frame, or an evenly spread sample
+    /// (picture codecs on long animations) whose per-frame parts were scaled to the whole.
+    pub trial_frames: usize,
+    /// Every candidate, in the order tried (the default first: it wins ties).
+    pub candidates: Vec<Candidate>,
+    /// Why the chosen one was kept.
+    pub reason: String,
+}
+
+/// One candidate of an automatic choice and its measured size.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Candidate {
+    /// Its predictor.
+    pub predictor: PredictorKind,
+    /// Its segmentation, `kmeans` or `decimation`.
+    pub segmentation: &'static str,
+    /// Clusters its segmentation found.
+    pub clusters: usize,
+    /// Its stream's bytes (estimated when the trial coded a sample of frames).
+    pub bytes: u64,
+    /// Seconds of its trial: prediction and residual coding (the segmentations are in the
+    /// report's stages).
+    pub seconds: f64,
+}
+
+/// The best candidate so far: its whole stream, or (sampled trials) what coding it in full needs.
+struct Best<'a> {
+    index: usize,
+    bytes: u64,
+    kept: Kept<'a>,
+}
+
+enum Kept<'a> {
+    Stream(Box<Encoded>),
+    Analysis(Box<Trial<'a>>),
+}
+
+/// What coding a sampled trial's candidate in full needs: its partition, segmentation report,
+/// prediction and atlas.
+type Trial<'a> = (
+    Partition,
+    analysis::SegmentationReport,
+    analysis::Prediction,
+    &'a AtlasCache,
+);
+
+/// Tries every motion model of `models` on `mesh` (already in the stream's vertex order, its
+/// first frame coded as `ff`) and returns the smallest stream, its report saying why.
+pub(super) fn choose(
+    mesh: &AnimatedMesh,
+    ff: &EncodedFirstFrame,
+    leading: Vec<Part>,
+    opts: &EncodeOptions,
+    models: &[MotionModel],
+    progress: &dyn Progress,
+    mut clock: Stopwatch,
+) -> Result<Encoded> {
+    let sample = Sample::of(mesh, opts)?;
+    let frames = mesh.frame_count();
+    let trial_frames = sample.as_ref().map_or(frames, |s| s.frames.len());
+    let final_frames = if sample.is_some() { frames } else { 0 };
+    progress.total((models.len() * trial_frames + final_frames) as u64);
+    let shared = Shared {
+        mesh,
+        ff,
+        leading: &leading,
+        opts,
+        sample: sample.as_ref(),
+    };
+    let reference = &ff.decoded_positions;
+    let mut candidates = Vec::with_capacity(models.len());
+    let mut best: Option<Best> = None;
+    let segmentations = segmentations(models);
+    let atlases: Vec<AtlasCache> = segmentations
+        .iter()
+        .map(|_| AtlasCache::default())
+        .collect();
+    for (&segmentation, atlas) in segmentations.iter().zip(&atlases) {
+        progress.stage(&format!("segmentation ({})", segmentation.name()));
+        let (partition, segmented) = analysis::segment(mesh, segmentation, opts.clusters)?;
+        let track = analysis::fit_track(mesh, reference, &partition, opts)?;
+        clock.lap(&format!("segmentation ({})", segmentation.name()));
+        for &model in models.iter().filter(|m| m.segmentation == segmentation) {
+            let start = Instant::now();
+            let progress = Labelled {
+                inner: progress,
+                label: model.name(),
+            };
+            progress.stage("motion");
+            let (kind, track) = (model.predictor, track.clone());
+            let prediction = analysis::predict_on(mesh, reference, &partition, opts, kind, track)?;
+            let analysed = Analysed {
+                model,
+                partition: &partition,
+                segmentation: segmented.clone(),
+                prediction: &prediction,
+                atlas: Some(atlas),
+            };
+            let (bytes, encoded) = trial(&shared, &analysed, &progress)?;
+            let kept = match encoded {
+                Some(encoded) => Kept::Stream(Box::new(encoded)),
+                None => {
+                    let analysis = (partition.clone(), segmented.clone(), prediction, atlas);
+                    Kept::Analysis(Box::new(analysis))
+                }
+            };
+            clock.lap(&format!("trial {}", model.name()));
+            candidates.push(Candidate {
+                predictor: model.predictor,
+                segmentation: segmentation.name(),
+                clusters: partition.clusters(),
+                bytes,
+                seconds: start.elapsed().as_secs_f64(),
+            });
+            if best.as_ref().is_none_or(|b| bytes < b.bytes) {
+                let index = candidates.len() - 1;
+                best = Some(Best { index, bytes, kept });
+            }
+        }
+    }
+    let best = best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
+    let model = models[best.index];
+    let mut encoded = keep(&shared, model, best.kept, progress, clock)?;
+    encoded.report.choice = Some(ChoiceReport {
+        chosen: model.name(),
+        trial_frames,
+        reason: reason(&candidates, best.index, trial_frames, frames),
+        candidates,
+    });
+    Ok(encoded)
+}
+
+/// What every trial shares: the animation (in the stream's vertex order), its coded first frame
+/// and the parts before the partition, the options and, for sampled trials, the sample.
+struct Shared<'a> {
+    mesh: &'a AnimatedMesh,
+    ff: &'a EncodedFirstFrame,
+    leading: &'a [Part],
+    opts: &'a EncodeOptions,
+    sample: Option<&'a Sample>,
+}
+
+/// Codes one candidate: its bytes and whole stream, or (sampled trials) its estimated bytes.
+fn trial(
+    shared: &Shared,
+    analysed: &Analysed,
+    progress: &dyn Progress,
+) -> Result<(u64, Option<Encoded>)> {
+    let Shared { mesh, ff, opts, .. } = *shared;
+    match shared.sample {
+        None => {
+            let leading = shared.leading.to_vec();
+            let encoded = code(
+                mesh,
+                ff,
+                leading,
+                opts,
+                analysed,
+                progress,
+                Stopwatch::new(),
+            )?;
+            Ok((encoded.report.bytes, Some(encoded)))
+        }
+        Some(sample) => {
+            let trial = (ff.decoded_positions.as_slice(), shared.leading);
+            let bytes = sample.estimate(mesh, trial, opts, analysed, progress)?;
+            Ok((bytes, None))
+        }
+    }
+}
+
+/// The winner's stream: kept from its trial (its report's stages replaced by the whole
+/// choice's), or coded in full now.
+fn keep(
+    shared: &Shared,
+    model: MotionModel,
+    kept: Kept,
+    progress: &dyn Progress,
+    clock: Stopwatch,
+) -> Result<Encoded> {
+    match kept {
+        Kept::Stream(encoded) => {
+            let mut encoded = *encoded;
+            encoded.report.stage_seconds = clock.stages;
+            Ok(encoded)
+        }
+        Kept::Analysis(analysis) => {
+            let (partition, segmentation, prediction, atlas) = *analysis;
+            let analysed = Analysed {
+                model,
+                partition: &partition,
+                segmentation,
+                prediction: &prediction,
+                atlas: Some(atlas),
+            };
+            let Shared { mesh, ff, opts, .. } = *shared;
+            let leading = shared.leading.to_vec();
+            code(mesh, ff, leading, opts, &analysed, progress, clock)
+        }
+    }
+}
+
+/// The distinct segmentations of `models`, in order.
+fn segmentations(models: &[MotionModel]) -> Vec<Segmentation> {
+    let mut distinct: Vec<Segmentation> = Vec::new();
+    for model in models {
+        if !distinct.contains(&model.segmentation) {
+            distinct.push(model.segmentation);
+        }
+    }
+    distinct
+}
+
+/// Why candidate `chosen` was kept, in words: its margin over the runner-up.
+fn reason(candidates: &[Candidate], chosen: usize, trial_frames: usize, frames: usize) -> String {
+    let name = |c: &Candidate| format!("{}+{}", c.predictor.name(), c.segmentation);
+    let winner = &candidates[chosen];
+    let runner_up = candidates
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| i != chosen)
+        .map(|(_, c)| c)
+        .min_by_key(|c| c.bytes);
+    let mut reason = match runner_up {
+        Some(next) => format!(
+            "smallest stream at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
+            winner.bytes,
+            100.0 * (1.0 - winner.bytes as f64 / next.bytes.max(1) as f64),
+            name(next),
+            next.bytes
+        ),
+        None => "the only candidate".to_string(),
+    };
+    if trial_frames < frames {
+        reason.push_str(&format!(
+            "; sizes estimated from {trial_frames} of {frames} frames"
+        ));
+    }
+    reason
+}
+
+/// The frames a picture codec's trials code: an evenly spread sample from frame 0 (whose bounding
+/// box sets the step) to the last, as an animation of their own.
+struct Sample {
+    frames: Vec<usize>,
+    mesh: AnimatedMesh,
+}
+
+impl Sample {
+    /// `None` when every candidate is coded whole: tdct (cheap), MPEG-4 (its P-frames predict
+    /// from the frame before, so spread frames misrank the candidates: Fox q50 kept a stream 20 %
+    /// larger than the smallest), HEVC (P-frames too; its sampled trials were not measured), or a
+    /// short animation.
+    fn of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Option<Self>> {
+        let count = mesh.frame_count();
+        let whole = matches!(opts.codec, Codec::Tdct | Codec::Mpeg4 | Codec::Hevc);
+        if whole || count <= 2 * TRIAL_FRAMES {
+            return Ok(None);
+        }
+        let frames: Vec<usize> = (0..TRIAL_FRAMES)
+            .map(|i| i * (count - 1) / (TRIAL_FRAMES - 1))
+            .collect();
+        let positions = frames.iter().map(|&f| mesh.frame(f).to_vec()).collect();
+        let mesh = AnimatedMesh::new(mesh.triangles().to_vec(), positions)?;
+        Ok(Some(Self { frames, mesh }))
+    }
+
+    /// The stream bytes of `analysed` estimated from the sample: every part but the codec's
+    /// per-frame ones (those after the predictor's) exact, those scaled from the sample to the
+    /// whole. `reference` is the decoded first frame, `leading` the parts before the partition.
+    fn estimate(
+        &self,
+        mesh: &AnimatedMesh,
+        (reference, leading): (&[Point], &[Part]),
+        opts: &EncodeOptions,
+        analysed: &Analysed,
+        progress: &dyn Progress,
+    ) -> Result<u64> {
+        let residuals: Vec<Vec<[f32; 3]>> = self
+            .frames
+            .iter()
+            .map(|&f| analysed.prediction.residuals[f].clone())
+            .collect();
+        let coded = opts.codec.encoder()?.encode(&ResidualInput {
+            mesh: &self.mesh,
+            reference,
+            partition: analysed.partition,
+            residuals: &residuals,
+            options: opts,
+            progress,
+            atlas: analysed.atlas,
+        })?;
+        let partition = analysed.partition;
+        let params = &coded.params;
+        let header = header(
+            mesh,
+            opts,
+            analysed.model,
+            partition,
+            params,
+            coded.atlas.as_ref(),
+        );
+        let per_frame: usize = coded.after_predictor.iter().map(|p| p.bytes.len()).sum();
+        let parts = (coded.before_predictor, coded.after_predictor);
+        let prediction = analysed.prediction;
+        let container = assemble(
+            &header,
+            leading.to_vec(),
+            mesh,
+            partition,
+            prediction,
+            parts,
+        )?;
+        let scale = mesh.frame_count() as f64 / self.frames.len() as f64 - 1.0;
+        Ok(container.len() + (per_frame as f64 * scale).round() as u64)
+    }
+}
+
+/// Progress of one candidate's trial: its stages named after it.
+struct Labelled<'a> {
+    inner: &'a dyn Progress,
+    label: String,
+}
+
+impl Progress for Labelled<'_> {
+    fn stage(&self, name: &str) {
+        self.inner.stage(&format!("{}: {name}", self.label));
+    }
+
+    fn frames(&self, count: u64) {
+        self.inner.frames(count);
+    }
+}
