@@ -18,13 +18,13 @@
 //! decoder needs before any picture (the depth to read the residual ranges).
 
 use super::geometry_video::{PictureCodec, PictureDecoder, PictureEncoder};
+use super::libav;
 use super::{Codec, Plane};
 use crate::encoder::EncodeOptions;
 use crate::geometry_image::{quantise, RangeMode};
 use crate::stream::frame_index::FrameChunk;
 use crate::{Error, Result};
 use ffmpeg_next as ffmpeg;
-use ffmpeg_next::util::error::EAGAIN;
 use ffmpeg_next::{codec, decoder, encoder, format::Pixel, frame, Dictionary};
 
 /// Sample depths the codec takes, in bits.
@@ -98,8 +98,10 @@ pub struct Packet {
     pub key: bool,
 }
 
+const NAME: &str = "hevc";
+
 fn ff_error(context: &str, e: ffmpeg::Error) -> Error {
-    Error::Codec(format!("hevc {context}: {e}"))
+    libav::error(NAME, context, e)
 }
 
 fn pixel_format(depth: u8, planes: Planes) -> Result<Pixel> {
@@ -147,7 +149,7 @@ pub struct Encoder {
 impl Encoder {
     /// Opens an encoder for `width × height` planes whose first plane is frame `first_frame`.
     pub fn new(width: u32, height: u32, options: &HevcOptions, first_frame: usize) -> Result<Self> {
-        super::mpeg4::init()?;
+        libav::init()?;
         let format = pixel_format(options.depth, options.planes)?;
         if width < 16 || height < 16 || width % 2 != 0 || height % 2 != 0 {
             return Err(Error::Codec(format!(
@@ -160,10 +162,7 @@ impl Encoder {
                 options.qp
             )));
         }
-        let gop = u32::try_from(options.gop)
-            .ok()
-            .filter(|g| (1..=i32::MAX as u32).contains(g))
-            .ok_or_else(|| Error::Codec(format!("hevc gop {} must be ≥ 1", options.gop)))?;
+        let gop = libav::checked_gop(NAME, options.gop)?;
         let codec = encoder::find_by_name("libx265")
             .ok_or_else(|| Error::Codec("libx265 encoder missing from libavcodec".into()))?;
         let mut video = codec::Context::new_with_codec(codec)
@@ -177,10 +176,7 @@ impl Encoder {
         video.set_time_base(TIME_BASE);
         video.set_gop(gop);
         video.set_max_b_frames(0);
-        video.set_threading(codec::threading::Config {
-            count: 1,
-            ..Default::default()
-        });
+        video.set_threading(libav::one_thread());
         let mut dict = Dictionary::new();
         dict.set("preset", "medium");
         dict.set("tune", "psnr");
@@ -238,19 +234,13 @@ impl Encoder {
 
     fn receive(&mut self) -> Result<Vec<Packet>> {
         let mut packets = Vec::new();
-        loop {
-            let mut packet = ffmpeg::Packet::empty();
-            match self.inner.receive_packet(&mut packet) {
-                Ok(()) => packets.push(Packet {
-                    data: packet.data().unwrap_or_default().to_vec(),
-                    key: packet.is_key(),
-                }),
-                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
-                    return Ok(packets)
-                }
-                Err(e) => return Err(ff_error("receive packet", e)),
-            }
+        while let Some(packet) = libav::next_packet(NAME, &mut self.inner)? {
+            packets.push(Packet {
+                data: packet.data().unwrap_or_default().to_vec(),
+                key: packet.is_key(),
+            });
         }
+        Ok(packets)
     }
 }
 
@@ -294,21 +284,9 @@ impl Decoder {
     /// Opens a decoder that expects `width × height` x | y | z planes of `depth`-bit samples,
     /// coded as `planes` says.
     pub fn new(width: u32, height: u32, depth: u8, planes: Planes) -> Result<Self> {
-        super::mpeg4::init()?;
         pixel_format(depth, planes)?;
         picture_size(width, height, planes)?;
-        let codec = decoder::find(codec::Id::HEVC)
-            .ok_or_else(|| Error::Codec("hevc decoder missing from libavcodec".into()))?;
-        let mut context = codec::Context::new_with_codec(codec);
-        // One thread: frame threading would delay output by a frame per thread.
-        context.set_threading(codec::threading::Config {
-            count: 1,
-            ..Default::default()
-        });
-        let inner = context
-            .decoder()
-            .video()
-            .map_err(|e| ff_error("open decoder", e))?;
+        let inner = libav::open_decoder(NAME, codec::Id::HEVC)?;
         Ok(Decoder {
             inner,
             width,
@@ -321,12 +299,7 @@ impl Decoder {
 
     /// Decodes one packet; returns the pictures it completes (one per packet for our streams).
     pub fn decode(&mut self, packet: &[u8]) -> Result<Vec<Plane<u16>>> {
-        if packet.is_empty() {
-            return Err(Error::Codec("hevc empty packet".into()));
-        }
-        self.inner
-            .send_packet(&ffmpeg::Packet::copy(packet))
-            .map_err(|e| ff_error(&format!("decode packet of {} bytes", packet.len()), e))?;
+        libav::send_packet(NAME, &mut self.inner, packet)?;
         self.receive()
     }
 
@@ -343,16 +316,10 @@ impl Decoder {
 
     fn receive(&mut self) -> Result<Vec<Plane<u16>>> {
         let mut planes = Vec::new();
-        loop {
-            let mut picture = frame::Video::empty();
-            match self.inner.receive_frame(&mut picture) {
-                Ok(()) => planes.push(self.samples(&picture)?),
-                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
-                    return Ok(planes)
-                }
-                Err(e) => return Err(ff_error("receive picture", e)),
-            }
+        while let Some(picture) = libav::next_picture(NAME, &mut self.inner)? {
+            planes.push(self.samples(&picture)?);
         }
+        Ok(planes)
     }
 
     fn samples(&mut self, picture: &frame::Video) -> Result<Plane<u16>> {

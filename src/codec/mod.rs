@@ -20,6 +20,8 @@ pub mod geometry_video;
 pub mod hevc;
 pub mod jpeg;
 #[cfg(feature = "mpeg4")]
+mod libav;
+#[cfg(feature = "mpeg4")]
 pub mod mpeg4;
 mod plane;
 pub mod quality;

@@ -9,15 +9,15 @@
 //! start at any I-frame.
 
 use super::geometry_video::{PictureCodec, PictureDecoder, PictureEncoder};
+use super::libav;
 use super::{Codec, Plane};
 use crate::encoder::EncodeOptions;
 use crate::geometry_image::RangeMode;
 use crate::stream::frame_index::FrameChunk;
 use crate::{Error, Result};
 use ffmpeg_next as ffmpeg;
-use ffmpeg_next::util::{error::EAGAIN, picture};
+use ffmpeg_next::util::picture;
 use ffmpeg_next::{codec, decoder, encoder, format::Pixel, frame, Dictionary};
-use std::sync::OnceLock;
 
 /// Chroma value of a neutral (grey) picture: the planes carry no information.
 const NEUTRAL_CHROMA: u8 = 128;
@@ -54,20 +54,10 @@ pub struct Packet {
     pub key: bool,
 }
 
-fn ff_error(context: &str, e: ffmpeg::Error) -> Error {
-    Error::Codec(format!("mpeg4 {context}: {e}"))
-}
+const NAME: &str = "mpeg4";
 
-/// Initialises FFmpeg once per process and quiets its logging to errors only.
-pub(crate) fn init() -> Result<()> {
-    static INIT: OnceLock<std::result::Result<(), String>> = OnceLock::new();
-    INIT.get_or_init(|| {
-        ffmpeg::init().map_err(|e| e.to_string())?;
-        ffmpeg::util::log::set_level(ffmpeg::util::log::Level::Error);
-        Ok(())
-    })
-    .clone()
-    .map_err(|e| Error::Codec(format!("ffmpeg init: {e}")))
+fn ff_error(context: &str, e: ffmpeg::Error) -> Error {
+    libav::error(NAME, context, e)
 }
 
 /// The sizes the encoder takes: 4:2:0 chroma needs even sides, the VOL header 13 bits.
@@ -107,7 +97,7 @@ impl Encoder {
         options: &Mpeg4Options,
         first_frame: usize,
     ) -> Result<Self> {
-        init()?;
+        libav::init()?;
         check_size(width, height)?;
         if !(1..=31).contains(&options.qscale) {
             return Err(Error::Codec(format!(
@@ -115,10 +105,7 @@ impl Encoder {
                 options.qscale
             )));
         }
-        let gop = u32::try_from(options.gop)
-            .ok()
-            .filter(|g| (1..=i32::MAX as u32).contains(g))
-            .ok_or_else(|| Error::Codec(format!("mpeg4 gop {} must be ≥ 1", options.gop)))?;
+        let gop = libav::checked_gop(NAME, options.gop)?;
         let codec = encoder::find(codec::Id::MPEG4)
             .ok_or_else(|| Error::Codec("mpeg4 encoder missing from libavcodec".into()))?;
         let mut video = codec::Context::new_with_codec(codec)
@@ -138,10 +125,7 @@ impl Encoder {
         // BITEXACT drops the "Lavc…" user-data string from every I-frame and pins the output across
         // FFmpeg builds.
         video.set_flags(codec::Flags::QSCALE | codec::Flags::BITEXACT);
-        video.set_threading(codec::threading::Config {
-            count: 1,
-            ..Default::default()
-        });
+        video.set_threading(libav::one_thread());
         let mut dict = Dictionary::new();
         dict.set("sc_threshold", NO_SCENE_CUT);
         // Trellis quantisation: measured +0.7..1.1 dB at qscale 2..8 for 1..2 % more bytes, at a third
@@ -206,20 +190,14 @@ impl Encoder {
 
     fn receive(&mut self) -> Result<Vec<Packet>> {
         let mut packets = Vec::new();
-        loop {
-            let mut packet = ffmpeg::Packet::empty();
-            match self.inner.receive_packet(&mut packet) {
-                Ok(()) => packets.push(Packet {
-                    data: packet.data().unwrap_or_default().to_vec(),
-                    pts: packet.pts().unwrap_or(self.next_pts - 1),
-                    key: packet.is_key(),
-                }),
-                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
-                    return Ok(packets)
-                }
-                Err(e) => return Err(ff_error("receive packet", e)),
-            }
+        while let Some(packet) = libav::next_packet(NAME, &mut self.inner)? {
+            packets.push(Packet {
+                data: packet.data().unwrap_or_default().to_vec(),
+                pts: packet.pts().unwrap_or(self.next_pts - 1),
+                key: packet.is_key(),
+            });
         }
+        Ok(packets)
     }
 }
 
@@ -251,20 +229,8 @@ pub struct Decoder {
 impl Decoder {
     /// Opens a decoder that expects `width × height` pictures.
     pub fn new(width: u32, height: u32) -> Result<Self> {
-        init()?;
         check_size(width, height)?;
-        let codec = decoder::find(codec::Id::MPEG4)
-            .ok_or_else(|| Error::Codec("mpeg4 decoder missing from libavcodec".into()))?;
-        let mut context = codec::Context::new_with_codec(codec);
-        // One thread: frame threading would delay output by a frame per thread.
-        context.set_threading(codec::threading::Config {
-            count: 1,
-            ..Default::default()
-        });
-        let inner = context
-            .decoder()
-            .video()
-            .map_err(|e| ff_error("open decoder", e))?;
+        let inner = libav::open_decoder(NAME, codec::Id::MPEG4)?;
         Ok(Decoder {
             inner,
             width,
@@ -277,13 +243,7 @@ impl Decoder {
     ///
     /// The first packet after [`Decoder::new`] or [`Decoder::reset`] must be an I-frame.
     pub fn decode(&mut self, packet: &[u8]) -> Result<Vec<Plane>> {
-        if packet.is_empty() {
-            // An empty packet would tell FFmpeg to drain; that is `flush`'s job.
-            return Err(Error::Codec("mpeg4 empty packet".into()));
-        }
-        self.inner
-            .send_packet(&ffmpeg::Packet::copy(packet))
-            .map_err(|e| ff_error(&format!("decode packet of {} bytes", packet.len()), e))?;
+        libav::send_packet(NAME, &mut self.inner, packet)?;
         self.receive()
     }
 
@@ -305,16 +265,10 @@ impl Decoder {
 
     fn receive(&mut self) -> Result<Vec<Plane>> {
         let mut planes = Vec::new();
-        loop {
-            let mut picture = frame::Video::empty();
-            match self.inner.receive_frame(&mut picture) {
-                Ok(()) => planes.push(self.luma(&picture)?),
-                Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => {
-                    return Ok(planes)
-                }
-                Err(e) => return Err(ff_error("receive picture", e)),
-            }
+        while let Some(picture) = libav::next_picture(NAME, &mut self.inner)? {
+            planes.push(self.luma(&picture)?);
         }
+        Ok(planes)
     }
 
     fn luma(&mut self, picture: &frame::Video) -> Result<Plane> {
