@@ -119,19 +119,29 @@ fn jpeg_frame_decodes_alone_when_every_other_frame_is_destroyed() {
 fn truncated_and_bit_flipped_streams_are_errors_not_panics() {
     let mesh = read_media("RiggedSimple.glb");
     let bytes = encode_bytes(&mesh, &opts(Codec::Jpeg, 50));
-    let want = decode_all(bytes.clone()).unwrap();
     // Every cut length in the part headers and a spread of cuts through the payloads.
     let step = (bytes.len() / 300).max(1);
-    for cut in (0..200.min(bytes.len())).chain((200..bytes.len()).step_by(step)) {
+    let cuts = (0..200.min(bytes.len())).chain((200..bytes.len()).step_by(step));
+    assert_cuts_fail_and_flips_never_mislead(&bytes, cuts, step);
+}
+
+/// Every stream cut at `cuts` is an error, and a bit flipped every `step` bytes is caught by a
+/// checksum (or decodes to exactly the same animation if it hit something unused, which the format
+/// has none of): never a silent wrong mesh.
+fn assert_cuts_fail_and_flips_never_mislead(
+    bytes: &[u8],
+    cuts: impl Iterator<Item = usize>,
+    step: usize,
+) {
+    let want = decode_all(bytes.to_vec()).unwrap();
+    for cut in cuts {
         assert!(
             decode_all(bytes[..cut].to_vec()).is_err(),
             "cut at {cut} decoded"
         );
     }
-    // A flipped bit anywhere is caught by a checksum (or decodes to exactly the same animation if
-    // it hit something unused, which the format has none of): never a silent wrong mesh.
     for pos in (0..bytes.len()).step_by(step) {
-        let mut bad = bytes.clone();
+        let mut bad = bytes.to_vec();
         bad[pos] ^= 0x04;
         if let Ok(got) = decode_all(bad) {
             assert_eq!(got, want, "flip at {pos} gave a different animation");
@@ -196,19 +206,6 @@ fn all_intra_hevc_frame_decodes_alone() {
 fn truncated_and_bit_flipped_hevc_streams_are_errors_not_panics() {
     let mesh = read_media("RiggedSimple.glb");
     let bytes = encode_bytes(&mesh, &opts(Codec::Hevc, 50));
-    let want = decode_all(bytes.clone()).unwrap();
     let step = (bytes.len() / 200).max(1);
-    for cut in (0..bytes.len()).step_by(step) {
-        assert!(
-            decode_all(bytes[..cut].to_vec()).is_err(),
-            "cut at {cut} decoded"
-        );
-    }
-    for pos in (0..bytes.len()).step_by(step) {
-        let mut bad = bytes.clone();
-        bad[pos] ^= 0x04;
-        if let Ok(got) = decode_all(bad) {
-            assert_eq!(got, want, "flip at {pos} gave a different animation");
-        }
-    }
+    assert_cuts_fail_and_flips_never_mislead(&bytes, (0..bytes.len()).step_by(step), step);
 }
