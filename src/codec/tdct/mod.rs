@@ -9,6 +9,7 @@
 pub mod coefficients;
 pub mod index;
 pub mod spatial;
+pub mod transform;
 
 use super::StreamLayout;
 use super::{CodecParams, CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
