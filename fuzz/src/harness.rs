@@ -1,7 +1,7 @@
 //! The fuzz targets' bodies. Uses only `mcgv_video` and `crc32fast`, so the regression test
 //! (`tests/fuzz_regressions.rs`) includes this file by path and replays crashers through the same code.
 
-use mcgv_video::codec::tdct::coefficients::BandIndex;
+use mcgv_video::codec::tdct::index::BandIndex;
 use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::first_frame::{self, FirstFrameOptions};

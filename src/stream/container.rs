@@ -14,8 +14,10 @@ use std::path::Path;
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
-/// The container version this build writes and reads.
-pub const VERSION: u16 = 2;
+/// The container version this build writes and reads. 2: one error law for every codec (issue 15);
+/// 3: the temporal-DCT coder's magnitude and sign contexts (issue 18), which a version-2 reader
+/// would decode to a wrong animation without noticing.
+pub const VERSION: u16 = 3;
 
 /// Bytes of a part header: tag, checksum kind, length, CRC.
 pub const PART_HEADER_LEN: usize = 17;

@@ -67,7 +67,7 @@ impl BitModel {
     }
 
     /// Bits that coding `bit` would cost now (an estimate for rate–distortion choices).
-    fn cost(&self, bit: bool) -> f64 {
+    pub fn cost(&self, bit: bool) -> f64 {
         let p = if bit { self.p_true } else { ONE - self.p_true };
         -(f64::from(p) / f64::from(ONE)).log2()
     }

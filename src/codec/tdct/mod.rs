@@ -7,7 +7,9 @@
 //! every complete band (a coarser animation).
 
 pub mod coefficients;
+pub mod index;
 pub mod spatial;
+pub mod transform;
 
 use super::StreamLayout;
 use super::{CodecParams, CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
@@ -16,7 +18,8 @@ use crate::error::{Error, Result};
 use crate::mesh::{AnimatedMesh, Point};
 use crate::progress::Progress;
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
-use coefficients::{BandCoder, BandIndex, Rounding};
+use coefficients::{BandCoder, Rounding};
+use index::BandIndex;
 use spatial::{Neighbourhood, Spatial};
 use std::io::{Read, Seek};
 use std::sync::Arc;

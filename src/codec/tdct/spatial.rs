@@ -135,14 +135,29 @@ fn breadth_first(adjacency: &VertexAdjacency) -> Vec<u32> {
     order
 }
 
-/// min(|level|, 2) of the largest level of axis `a` among `earlier`: the neighbourhood part of the
-/// coder's context (0 without neighbours).
-pub fn nearby(levels: &[i64], earlier: &[u32], a: usize) -> usize {
+/// The largest magnitude of axis `a` among `earlier` in `values` (`[3w + a]`): the neighbourhood
+/// part of the coder's magnitude context (0 without neighbours).
+pub fn largest(values: &[i64], earlier: &[u32], a: usize) -> u64 {
     earlier
         .iter()
-        .map(|&w| levels[3 * w as usize + a].unsigned_abs().min(2) as usize)
+        .map(|&w| values[3 * w as usize + a].unsigned_abs())
         .max()
         .unwrap_or(0)
+}
+
+/// The sign class (0: zero, 1: positive, 2: negative) of the sum of the signs of axis `a` among
+/// `earlier` in `values`: the coder's sign context. Neighbouring vertices move alike, so their
+/// coded values tend to share a sign, with or without the mean predictor.
+pub fn sign_class(values: &[i64], earlier: &[u32], a: usize) -> usize {
+    let sum: i64 = earlier
+        .iter()
+        .map(|&w| values[3 * w as usize + a].signum())
+        .sum();
+    match sum.signum() {
+        0 => 0,
+        1 => 1,
+        _ => 2,
+    }
 }
 
 /// The prediction of axis `a` of a vertex whose earlier neighbours are `earlier`: the mean of their
