@@ -21,6 +21,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         CodecChoice::Mpeg4 => Codec::Mpeg4,
         CodecChoice::Tdct => Codec::Tdct,
         CodecChoice::Hevc => Codec::Hevc,
+        CodecChoice::Av1 => Codec::Av1,
     };
     check_codec_options(args, codec, lattice)?;
     if args.affine_bits.is_some() {
@@ -97,13 +98,18 @@ fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Res
              with small residuals already cost few bits; leave it out",
         ));
     }
-    let images: &[Codec] = &[Codec::Jpeg, Codec::Mpeg4, Codec::Hevc];
+    let images: &[Codec] = &[Codec::Jpeg, Codec::Mpeg4, Codec::Hevc, Codec::Av1];
+    let deep: &[Codec] = &[Codec::Hevc, Codec::Av1];
     let given: [(&'static str, bool, &[Codec]); 7] = [
         ("qscale", args.qscale.is_some(), &[Codec::Mpeg4]),
-        ("qp", args.qp.is_some(), &[Codec::Hevc]),
-        ("bit_depth", args.bit_depth.is_some(), &[Codec::Hevc]),
+        ("qp", args.qp.is_some(), deep),
+        ("bit_depth", args.bit_depth.is_some(), deep),
         ("jpeg_quality", args.jpeg_quality.is_some(), &[Codec::Jpeg]),
-        ("gop", args.gop.is_some(), &[Codec::Mpeg4, Codec::Hevc]),
+        (
+            "gop",
+            args.gop.is_some(),
+            &[Codec::Mpeg4, Codec::Hevc, Codec::Av1],
+        ),
         ("padding", args.padding.is_some(), images),
         ("lattice", lattice != Lattice::Auto, images),
     ];
