@@ -111,9 +111,12 @@ pub struct EncodeArgs {
     /// HEVC's QP 0..51, or libaom's constant-quality level (crf) 0..63 for av1.
     #[arg(long, value_parser = clap::value_parser!(u8).range(0..=63))]
     pub qp: Option<u8>,
-    /// hevc, av1: bits a sample of the residual pictures, 10 or 12 [default: 10].
-    #[arg(long, value_parser = clap::value_parser!(u8).range(10..=12))]
-    pub bit_depth: Option<u8>,
+    /// hevc, av1: bits a sample of the residual pictures, 10, 12 or auto: 10 below --quality 90,
+    /// 12 from 90 (measured at equal error: below 90, 12 bits cost as much as 10 or up to 20 %
+    /// more; from 90 as much or less, and they reach errors 10 bits cannot on sequences with large
+    /// residuals; docs/results.md).
+    #[arg(long, default_value = "auto", value_parser = parse_bit_depth)]
+    pub bit_depth: BitDepth,
     /// JPEG's own quality 1..100 for the residual pictures; overrides the one --quality sets.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
     pub jpeg_quality: Option<u8>,
@@ -180,6 +183,24 @@ pub struct EncodeArgs {
     /// How to read the input.
     #[command(flatten)]
     pub input_args: InputArgs,
+}
+
+/// `--bit-depth`: a number of bits, or chosen from the quality.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BitDepth {
+    /// The measured rule: 10 bits below quality 90, 12 from 90.
+    Auto,
+    /// 10 or 12 bits.
+    Bits(u8),
+}
+
+fn parse_bit_depth(value: &str) -> Result<BitDepth, String> {
+    match value {
+        "auto" => Ok(BitDepth::Auto),
+        "10" => Ok(BitDepth::Bits(10)),
+        "12" => Ok(BitDepth::Bits(12)),
+        _ => Err("expected 10, 12 or auto".into()),
+    }
 }
 
 /// The padding methods `--padding` takes (the padding crate's names).

@@ -24,9 +24,6 @@ use ffmpeg_next::{codec, Dictionary};
 
 pub use super::deep::{Packet, Planes, DEFAULT_PLANES, DEPTHS};
 
-/// The default depth: 10 bits, measured as good as 12 at every quality of the sweep
-/// (docs/results.md) and the depth every hardware HEVC decoder (Main 10) takes.
-pub const DEFAULT_DEPTH: u8 = 10;
 /// The largest QP x265 takes.
 pub const MAX_QP: u8 = 51;
 
@@ -59,10 +56,6 @@ impl Flavour for X265 {
 
     fn max_qp(&self) -> u8 {
         MAX_QP
-    }
-
-    fn default_depth(&self, _quality: u8) -> u8 {
-        DEFAULT_DEPTH
     }
 
     fn law(&self, quality: u8, depth: u8) -> PictureLaw {

@@ -22,9 +22,9 @@ pub struct EncodeOptions {
     /// The video codec's own quantiser, MPEG-4 qscale (1..=31), HEVC QP (0..=51) or AV1 `crf`
     /// (libaom's constant-quality level, 0..=63); `None` derives it from `quality`.
     pub qscale: Option<u8>,
-    /// Bits a sample of the HEVC and AV1 pictures, 10 or 12; `None` picks the measured default
-    /// ([`crate::codec::hevc::DEFAULT_DEPTH`], [`crate::codec::av1::DEFAULT_DEPTH`]). JPEG and
-    /// MPEG-4 code 8.
+    /// Bits a sample of the HEVC and AV1 pictures, 10 or 12; `None` picks it from `quality` by the
+    /// measured rule of [`crate::codec::deep::auto_depth`] (12 from quality 90). JPEG and MPEG-4
+    /// code 8.
     pub bit_depth: Option<u8>,
     /// JPEG's own quality 1..100 for the residual pictures; `None` derives it from `quality`.
     pub jpeg_quality: Option<u8>,
