@@ -95,14 +95,23 @@ struct Look {
 
 /// mcgv-video's rows are `CODEC` or `CODEC+VARIANT` (scripts/sweep.sh): the variant sets the colour
 /// (default affine + k-means blue, skinning orange, decimation cyan, both brown), the image codec the
-/// marker and line (JPEG triangles on a dashed line, MPEG-4 squares, TDCT diamonds; HEVC squares
-/// and all-intra HEVC triangles on a dashed line, each in a colour of its own), so every plot reads
+/// marker and line (JPEG triangles on a dashed line, MPEG-4 squares, TDCT diamonds; HEVC and AV1
+/// squares and their all-intra modes triangles on a dashed line, each in a colour of its own), so
+/// every plot reads
 /// the same way. Peers keep one fixed colour each, with circles.
 fn look(codec: &str, fallback: usize) -> Look {
     let (base, variant) = codec.split_once('+').unwrap_or((codec, ""));
-    let ours = ["jpeg", "mpeg4", "tdct", "hevc", "hevc-intra"]
-        .iter()
-        .position(|c| *c == base.split('@').next().unwrap_or(base));
+    let ours = [
+        "jpeg",
+        "mpeg4",
+        "tdct",
+        "hevc",
+        "hevc-intra",
+        "av1",
+        "av1-intra",
+    ]
+    .iter()
+    .position(|c| *c == base.split('@').next().unwrap_or(base));
     let pick = || {
         let (r, g, b) = Palette99::pick(fallback).to_rgba().rgb();
         RGBColor(r, g, b)
@@ -111,9 +120,11 @@ fn look(codec: &str, fallback: usize) -> Look {
         let variants = ["", "skinning", "decimation", "skinning+decimation"];
         let v = variants.iter().position(|x| *x == variant);
         let colour = match v {
-            // HEVC's series apart from the paper's codecs: one colour per HEVC mode.
+            // HEVC's and AV1's series apart from the paper's codecs: one colour per mode.
             Some(0) if order == 3 => RGBColor(214, 39, 140),
             Some(0) if order == 4 => RGBColor(120, 60, 160),
+            Some(0) if order == 5 => RGBColor(44, 160, 44),
+            Some(0) if order == 6 => RGBColor(188, 189, 34),
             Some(0) => RGBColor(31, 119, 180),
             Some(1) => RGBColor(255, 127, 14),
             Some(2) => RGBColor(23, 190, 207),
@@ -128,8 +139,10 @@ fn look(codec: &str, fallback: usize) -> Look {
                 Marker::Diamond,
                 Marker::Square,
                 Marker::Triangle,
+                Marker::Square,
+                Marker::Triangle,
             ][order],
-            dashed: base == "jpeg" || base.starts_with("hevc-intra"),
+            dashed: base == "jpeg" || base.contains("-intra"),
             label: format!("mcgv-video {codec}"),
             rank: (0, order as u8, format!("{}{variant}", v.unwrap_or(9))),
         };

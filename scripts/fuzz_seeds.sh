@@ -19,6 +19,10 @@ small=(--lattice 64x64 --clusters 4 --fps 6 --quiet)
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/hevc.mcgv" --codec hevc --gop 3 "${small[@]}"
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/hevc-intra12.mcgv" --codec hevc --gop 1 \
 	--bit-depth 12 "${small[@]}"
+# AV1: the same set-up part behind another codec id and decoder.
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/av1.mcgv" --codec av1 --gop 3 "${small[@]}"
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/av1-intra12.mcgv" --codec av1 --gop 1 \
+	--bit-depth 12 "${small[@]}"
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-reorder.mcgv" --codec jpeg --reorder \
 	--lattice 64x64 --clusters 2 --fps 2 --quality 10 --quiet
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-skinning.mcgv" --codec jpeg \

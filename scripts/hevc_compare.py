@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Issue 16's comparisons from scripts/sweep.sh rows (codec columns mpeg4, hevc, jpeg, hevc-intra):
+"""Issue 16's comparisons from scripts/sweep.sh rows (codec columns mpeg4, hevc, av1, jpeg, hevc-intra,
+av1-intra; the av1 columns only when the CSVs have av1 rows):
 
-- per sequence, the surface RMSE (x 1e-4 of the bbox diagonal) of mpeg4 and hevc at 2.2, 4 and 8
-  bpvf and how much lower hevc's is;
-- per sequence, the bpvf jpeg and hevc-intra (all-intra, `--gop 1`) need at RMSE 4e-4 and 2e-4 and
-  how much less hevc-intra needs;
+- per sequence, the surface RMSE (x 1e-4 of the bbox diagonal) of mpeg4, hevc (and av1) at 2.2, 4
+  and 8 bpvf and how much lower hevc's (and av1's) is than mpeg4's;
+- per sequence, the bpvf jpeg and hevc-intra (and av1-intra; all-intra, `--gop 1`) need at RMSE 4e-4
+  and 2e-4 and how much less the all-intra modes need;
 - encode speed in frames per CPU-second (user + system, whole process) of every codec at
   `--quality 50` on the sequence given by --speed (default pdance).
 
@@ -50,23 +51,29 @@ def main():
     for seq, codecs in points.items():
         for codec, pts in codecs.items():
             fronts[seq][codec] = frontier(pts)
-    print("| sequence | bpvf | mpeg4 RMSE ×1e-4 | hevc | hevc lower by |")
-    print("|---|---|---|---|---|")
+    video = [c for c in ("hevc", "av1") if any(c in f for f in fronts.values())]
+    header = " | ".join(video + [f"{c} lower by" for c in video])
+    print(f"| sequence | bpvf | mpeg4 RMSE ×1e-4 | {header} |")
+    print("|---|---|---|" + "---|" * (2 * len(video)))
     for seq in sorted(fronts):
         f = fronts[seq]
         for rate in RATES:
             m = at_rate(f.get("mpeg4", []), rate)
-            h = at_rate(f.get("hevc", []), rate)
-            print(f"| {seq} | {rate:g} | {fmt(m, 1e4)} | {fmt(h, 1e4)} | {lower(h, m)} |")
+            ours = [at_rate(f.get(c, []), rate) for c in video]
+            cells = [fmt(o, 1e4) for o in ours] + [lower(o, m) for o in ours]
+            print(f"| {seq} | {rate:g} | {fmt(m, 1e4)} | {' | '.join(cells)} |")
     print()
-    print("| sequence | RMSE | jpeg bpvf | hevc-intra bpvf | hevc-intra lower by |")
-    print("|---|---|---|---|---|")
+    intra = [f"{c}-intra" for c in video]
+    header = " bpvf | ".join(intra) + " bpvf | " + " | ".join(f"{c} lower by" for c in intra)
+    print(f"| sequence | RMSE | jpeg bpvf | {header} |")
+    print("|---|---|---|" + "---|" * (2 * len(intra)))
     for seq in sorted(fronts):
         f = fronts[seq]
         for error in ERRORS:
             j = bits_at_error(f.get("jpeg", []), error)
-            h = bits_at_error(f.get("hevc-intra", []), error)
-            print(f"| {seq} | {error:g} | {fmt(j)} | {fmt(h)} | {lower(h, j)} |")
+            ours = [bits_at_error(f.get(c, []), error) for c in intra]
+            cells = [fmt(o) for o in ours] + [lower(o, j) for o in ours]
+            print(f"| {seq} | {error:g} | {fmt(j)} | {' | '.join(cells)} |")
     print()
     print(f"Encode speed on {speed}, `--quality 50`:")
     print()

@@ -25,8 +25,10 @@ import sys
 from collections import defaultdict
 
 PAPER_RATES = (2.2, 4.0, 8.0)
-# mcgv-video's codecs (hevc-intra: `--gop 1`; @12: `--bit-depth 12`); a variant is CODEC+VARIANT
-OURS = ("jpeg", "mpeg4", "tdct", "hevc", "hevc-intra", "hevc@12", "hevc-intra@12")
+# mcgv-video's codecs (hevc-intra, av1-intra: `--gop 1`; @12: `--bit-depth 12`); a variant is
+# CODEC+VARIANT
+OURS = ("jpeg", "mpeg4", "tdct", "hevc", "hevc-intra", "hevc@12", "hevc-intra@12",
+        "av1", "av1-intra", "av1@12", "av1-intra@12")
 VARIANTS = ("", "skinning", "decimation", "skinning+decimation")   # column order of the variant table
 TARGETS = (2e-4, 5e-5)   # RMSE targets of the equal-error table
 GRID = 200  # rates per sequence at which codecs are compared for the closing line

@@ -6,7 +6,8 @@
 # peak resident memory.
 #   scripts/sweep.sh OUT.csv INPUT...
 # env: JPEG_QUALITIES, MPEG4_QUALITIES, QSCALES, TDCT_QUALITIES, HEVC_QUALITIES,
-#      HEVC_INTRA_QUALITIES, HEVC_DEPTHS, VARIANTS, MCGV_BIN
+#      HEVC_INTRA_QUALITIES, HEVC_DEPTHS, AV1_QUALITIES, AV1_INTRA_QUALITIES, AV1_DEPTHS,
+#      VARIANTS, EXTRA, MCGV_BIN
 #   VARIANTS   space-separated encoder variants, each a '+'-joined list of
 #              skinning (--predictor skinning) and decimation (--segmentation decimation), or
 #              `default` (no extra flag). Unset: the default encoder only. A variant's rows are
@@ -23,6 +24,10 @@
 #              when the binary's `encode --help` mentions hevc; unset or empty: none.
 #   HEVC_DEPTHS  --bit-depth values of the hevc runs (default: the binary's default only); a depth
 #              other than the default is labelled hevc@12, hevc-intra@12.
+#   EXTRA      flags added to every encode (e.g. `--predictor affine --segmentation kmeans`, which
+#              codes one motion model instead of the automatic choice's candidates).
+#   AV1_QUALITIES, AV1_INTRA_QUALITIES, AV1_DEPTHS  the same for `--codec av1` (codec columns av1,
+#              av1-intra, av1@12, av1-intra@12), made only when `encode --help` mentions av1.
 set -euo pipefail
 bin=${MCGV_BIN:-target/release/mcgv-video}
 out=$1; shift
@@ -35,6 +40,13 @@ hevc_depths=${HEVC_DEPTHS:-default}
 if [ -n "$hevc_qualities$hevc_intra_qualities" ] && ! "$bin" encode --help | grep -qw hevc; then
     echo "sweep.sh: $bin has no hevc codec; HEVC_QUALITIES ignored" >&2
     hevc_qualities=""; hevc_intra_qualities=""
+fi
+av1_qualities=${AV1_QUALITIES-}
+av1_intra_qualities=${AV1_INTRA_QUALITIES-}
+av1_depths=${AV1_DEPTHS:-default}
+if [ -n "$av1_qualities$av1_intra_qualities" ] && ! "$bin" encode --help | grep -qw av1; then
+    echo "sweep.sh: $bin has no av1 codec; AV1_QUALITIES ignored" >&2
+    av1_qualities=""; av1_intra_qualities=""
 fi
 tdct_qualities=${TDCT_QUALITIES-$qualities}
 variants=${VARIANTS:-default}
@@ -82,15 +94,20 @@ for input in "$@"; do
         for q in $hevc_qualities; do runs+=("hevc$at --quality $q"); done
         for q in $hevc_intra_qualities; do runs+=("hevc-intra$at --quality $q"); done
     done
+    for depth in $av1_depths; do
+        at=""; [ "$depth" = default ] || at="@$depth"
+        for q in $av1_qualities; do runs+=("av1$at --quality $q"); done
+        for q in $av1_intra_qualities; do runs+=("av1-intra$at --quality $q"); done
+    done
     for variant in $variants; do
-        read -ra extra <<<"$(variant_flags "$variant")"
+        read -ra extra <<<"$(variant_flags "$variant") ${EXTRA:-}"
         suffix=""; [ "$variant" = default ] || suffix="+$variant"
         for run in "${runs[@]}"; do
             read -r codec flag value <<<"$run"
             stream="$tmp/$name.mcgv"
-            # hevc-intra@12 is `--codec hevc --gop 1 --bit-depth 12`.
+            # hevc-intra@12 is `--codec hevc --gop 1 --bit-depth 12` (av1 alike).
             codec_flags=(--codec "${codec%%[-@]*}")
-            case $codec in hevc-intra*) codec_flags+=(--gop 1) ;; esac
+            case $codec in hevc-intra* | av1-intra*) codec_flags+=(--gop 1) ;; esac
             case $codec in *@*) codec_flags+=(--bit-depth "${codec#*@}") ;; esac
             read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" "${codec_flags[@]}" "$flag" "$value" \
                 ${extra[@]+"${extra[@]}"} --quiet)

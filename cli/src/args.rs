@@ -98,7 +98,7 @@ pub struct EncodeArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Residual coder: tdct is the smallest at equal error; jpeg decodes any frame on its own;
-    /// mpeg4 and hevc (10/12-bit pictures) suit hardware video decoders.
+    /// mpeg4, hevc and av1 (10/12-bit pictures) suit hardware video decoders.
     #[arg(long, value_enum, default_value_t = CodecChoice::Tdct)]
     pub codec: CodecChoice,
     /// Rate knob for every codec, 1..100 (higher = better quality, more bits; default 50).
@@ -107,16 +107,20 @@ pub struct EncodeArgs {
     /// MPEG-4 quantiser 1..31 (lower = better); overrides the one --quality sets for mpeg4.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=31))]
     pub qscale: Option<u8>,
-    /// HEVC quantiser (QP) 0..51 (lower = better); overrides the one --quality sets for hevc.
-    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=51))]
+    /// hevc, av1: the codec's own quantiser (lower = better), overriding the one --quality sets:
+    /// HEVC's QP 0..51, or libaom's constant-quality level (crf) 0..63 for av1.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=63))]
     pub qp: Option<u8>,
-    /// hevc: bits a sample of the residual pictures, 10 or 12 [default: 10].
-    #[arg(long, value_parser = clap::value_parser!(u8).range(10..=12))]
-    pub bit_depth: Option<u8>,
+    /// hevc, av1: bits a sample of the residual pictures, 10, 12 or auto: 10 below --quality 90,
+    /// 12 from 90 (measured at equal error: below 90, 12 bits cost as much as 10 or up to 20 %
+    /// more; from 90 as much or less, and they reach errors 10 bits cannot on sequences with large
+    /// residuals; docs/results.md).
+    #[arg(long, default_value = "auto", value_parser = parse_bit_depth)]
+    pub bit_depth: BitDepth,
     /// JPEG's own quality 1..100 for the residual pictures; overrides the one --quality sets.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
     pub jpeg_quality: Option<u8>,
-    /// Quantiser step (tdct) or pixel step (one grey level of the residual images, jpeg, mpeg4, hevc)
+    /// Quantiser step (tdct) or pixel step (one grey level of the residual images, image codecs)
     /// as a fraction of the first frame's bounding-box diagonal (e.g. 0.001); overrides the one
     /// --quality sets.
     #[arg(long)]
@@ -146,12 +150,12 @@ pub struct EncodeArgs {
     /// Grown until the charts fit.
     #[arg(long, default_value = "auto")]
     pub lattice: String,
-    /// jpeg, mpeg4, hevc: how free pixels of the geometry images are filled [default: snap for
-    /// jpeg, biharmonic for mpeg4 and hevc].
+    /// jpeg, mpeg4, hevc, av1: how free pixels of the geometry images are filled [default: snap
+    /// for jpeg, biharmonic for the video codecs].
     #[arg(long, value_parser = padding_methods())]
     pub padding: Option<String>,
-    /// mpeg4, hevc: group of pictures, an I-frame every N frames [default: 50]; 1 makes hevc
-    /// all-intra (every frame decodes alone).
+    /// mpeg4, hevc, av1: group of pictures, an I-frame every N frames [default: 50]; 1 makes hevc
+    /// and av1 all-intra (every frame decodes alone).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub gop: Option<u64>,
     /// Let the first-frame coder reorder vertices for fewer bits (default keeps the input order).
@@ -179,6 +183,24 @@ pub struct EncodeArgs {
     /// How to read the input.
     #[command(flatten)]
     pub input_args: InputArgs,
+}
+
+/// `--bit-depth`: a number of bits, or chosen from the quality.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BitDepth {
+    /// The measured rule: 10 bits below quality 90, 12 from 90.
+    Auto,
+    /// 10 or 12 bits.
+    Bits(u8),
+}
+
+fn parse_bit_depth(value: &str) -> Result<BitDepth, String> {
+    match value {
+        "auto" => Ok(BitDepth::Auto),
+        "10" => Ok(BitDepth::Bits(10)),
+        "12" => Ok(BitDepth::Bits(12)),
+        _ => Err("expected 10, 12 or auto".into()),
+    }
 }
 
 /// The padding methods `--padding` takes (the padding crate's names).
@@ -218,6 +240,8 @@ pub enum CodecChoice {
     Tdct,
     /// HEVC (libx265) at 10 or 12 bits a sample: an IDR frame, then P-frames (--gop 1: all-intra).
     Hevc,
+    /// AV1 (libaom) at 10 or 12 bits a sample: a key frame, then P-frames (--gop 1: all-intra).
+    Av1,
 }
 
 /// The motion predictors.

@@ -7,14 +7,18 @@
 //! - [`jpeg`] and [`mpeg4`] are the paper's geometry video: the residuals are splatted onto a
 //!   multi-chart atlas ([`geometry_video`]), padded, and coded as pictures — one JPEG per frame
 //!   (any frame decodes alone) or MPEG-4 Part 2 I- and P-frames through FFmpeg (cargo feature
-//!   `mpeg4`). [`hevc`] codes the same pictures at 10 or 12 bits a sample with libx265 (same
-//!   feature: it needs FFmpeg too).
+//!   `mpeg4`). [`hevc`] and [`av1`] code the same pictures at 10 or 12 bits a sample with libx265
+//!   and libaom (same feature: they need FFmpeg too; their shared part is [`deep`]).
 //! - [`tdct`] is the follow-up paper's temporal DCT: each vertex's residual trajectory transformed
 //!   over all frames and coded band by band, no images.
 //!
 //! [`quality`] maps the one `quality` knob onto each codec's quantiser.
 
 pub mod abbreviated;
+#[cfg(feature = "mpeg4")]
+pub mod av1;
+#[cfg(feature = "mpeg4")]
+pub mod deep;
 pub mod geometry_video;
 #[cfg(feature = "mpeg4")]
 pub mod hevc;
@@ -28,7 +32,9 @@ pub mod quality;
 pub mod tdct;
 
 pub use plane::Plane;
-pub use quality::{hevc_law, ijg_scale_percent, jpeg_law, mpeg4_law, target_step, PictureLaw};
+pub use quality::{
+    av1_law, hevc_law, ijg_scale_percent, jpeg_law, mpeg4_law, target_step, PictureLaw,
+};
 
 use crate::encoder::EncodeOptions;
 use crate::error::{Error, Result};
@@ -56,11 +62,20 @@ pub enum Codec {
     /// HEVC at 10 or 12 bits a sample (libx265): IDR frames every `gop` frames, P-frames between
     /// (`gop` 1: all-intra, every frame decodes alone).
     Hevc,
+    /// AV1 at 10 or 12 bits a sample (libaom): key frames every `gop` frames, P-frames between
+    /// (`gop` 1: all-intra, every frame decodes alone).
+    Av1,
 }
 
 impl Codec {
     /// Every codec, in the order of their stream ids.
-    pub const ALL: [Codec; 4] = [Codec::Jpeg, Codec::Mpeg4, Codec::Tdct, Codec::Hevc];
+    pub const ALL: [Codec; 5] = [
+        Codec::Jpeg,
+        Codec::Mpeg4,
+        Codec::Tdct,
+        Codec::Hevc,
+        Codec::Av1,
+    ];
 
     /// The codec's id in the stream header. The temporal DCT's is 3 since its bands are coded with
     /// spatial prediction (issue 18): id 2 was the format before, which this build refuses.
@@ -70,6 +85,7 @@ impl Codec {
             Codec::Mpeg4 => 1,
             Codec::Tdct => 3,
             Codec::Hevc => 4,
+            Codec::Av1 => 5,
         }
     }
 
@@ -95,6 +111,7 @@ impl Codec {
             Codec::Mpeg4 => "mpeg4",
             Codec::Tdct => "tdct",
             Codec::Hevc => "hevc",
+            Codec::Av1 => "av1",
         }
     }
 
@@ -103,9 +120,10 @@ impl Codec {
         !matches!(self, Codec::Tdct)
     }
 
-    /// Whether this build can code the codec (MPEG-4 and HEVC need the `mpeg4` feature, i.e. FFmpeg).
+    /// Whether this build can code the codec (MPEG-4, HEVC and AV1 need the `mpeg4` feature, i.e.
+    /// FFmpeg).
     pub fn available(self) -> bool {
-        !matches!(self, Codec::Mpeg4 | Codec::Hevc) || cfg!(feature = "mpeg4")
+        !matches!(self, Codec::Mpeg4 | Codec::Hevc | Codec::Av1) || cfg!(feature = "mpeg4")
     }
 
     /// The codec's encoder.
@@ -115,9 +133,11 @@ impl Codec {
             #[cfg(feature = "mpeg4")]
             Codec::Mpeg4 => Box::new(geometry_video::Encoder::new(mpeg4::Pictures)),
             #[cfg(feature = "mpeg4")]
-            Codec::Hevc => Box::new(geometry_video::Encoder::new(hevc::Pictures)),
+            Codec::Hevc => Box::new(geometry_video::Encoder::new(hevc::PICTURES)),
+            #[cfg(feature = "mpeg4")]
+            Codec::Av1 => Box::new(geometry_video::Encoder::new(av1::PICTURES)),
             #[cfg(not(feature = "mpeg4"))]
-            Codec::Mpeg4 | Codec::Hevc => return Err(unavailable()),
+            Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
             Codec::Tdct => Box::new(tdct::Encoder),
         })
     }
@@ -129,9 +149,11 @@ impl Codec {
             #[cfg(feature = "mpeg4")]
             Codec::Mpeg4 => Some(Box::new(mpeg4::Pictures)),
             #[cfg(feature = "mpeg4")]
-            Codec::Hevc => Some(Box::new(hevc::Pictures)),
+            Codec::Hevc => Some(Box::new(hevc::PICTURES)),
+            #[cfg(feature = "mpeg4")]
+            Codec::Av1 => Some(Box::new(av1::PICTURES)),
             #[cfg(not(feature = "mpeg4"))]
-            Codec::Mpeg4 | Codec::Hevc => return Err(unavailable()),
+            Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
             Codec::Tdct => None,
         })
     }
@@ -158,12 +180,18 @@ impl Codec {
             )?),
             #[cfg(feature = "mpeg4")]
             Codec::Hevc => Box::new(geometry_video::Decoder::open(
-                hevc::Pictures,
+                hevc::PICTURES,
+                stream,
+                reader,
+            )?),
+            #[cfg(feature = "mpeg4")]
+            Codec::Av1 => Box::new(geometry_video::Decoder::open(
+                av1::PICTURES,
                 stream,
                 reader,
             )?),
             #[cfg(not(feature = "mpeg4"))]
-            Codec::Mpeg4 | Codec::Hevc => return Err(unavailable()),
+            Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
             Codec::Tdct => Box::new(tdct::Decoder::open(stream, reader, max_bands)?),
         })
     }
@@ -172,7 +200,8 @@ impl Codec {
 #[cfg(not(feature = "mpeg4"))]
 fn unavailable() -> Error {
     Error::Codec(
-        "this build has no MPEG-4 or HEVC codec (built without the `mpeg4` feature, FFmpeg)".into(),
+        "this build has no MPEG-4, HEVC or AV1 codec (built without the `mpeg4` feature, FFmpeg)"
+            .into(),
     )
 }
 
@@ -201,8 +230,8 @@ pub struct ResidualInput<'a> {
 pub struct CodecParams {
     /// Geometry-image lattice, (0, 0) without images.
     pub lattice: (u16, u16),
-    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality, HEVC QP (0 without
-    /// pictures).
+    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality, HEVC QP, AV1 `crf`
+    /// (0 without pictures).
     pub qscale: u8,
     /// Frames per group of pictures (1 for intra codecs).
     pub gop: u32,
@@ -286,6 +315,6 @@ mod tests {
         }
         let old = Codec::from_id(RETIRED_TDCT_ID).unwrap_err().to_string();
         assert!(old.contains("re-encode"), "{old}");
-        assert!(Codec::from_id(5).is_err());
+        assert!(Codec::from_id(6).is_err());
     }
 }

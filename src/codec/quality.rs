@@ -129,6 +129,99 @@ pub fn hevc_law(quality: u8, depth: u8) -> PictureLaw {
     }
 }
 
+/// AV1's law at 10 bits a sample, made as HEVC's: a pixel step of [`AV1_STEP_FACTOR`] × the target
+/// step and the quantiser (libaom's `crf` 0..63, AV1's quantiser index over 4) whose quantiser step
+/// follows the target step ([`AV1_QP_AT_50`] at quality 50), between [`AV1_MIN_QP`] and
+/// [`AV1_MAX_QP`]; beyond them the pixel step takes the rest. Unlike HEVC's QP, AV1's quantiser
+/// index does not double its step at a fixed pace (about linear up to index 96, then about 9.5
+/// `crf` per doubling), so the law reads the step off [`AV1_AC_STEPS`]. Measured on CesiumMan
+/// (docs/results.md, "AV1"): quality 50 lands on HEVC's error at quality 50 (RMSE 3.80e-4 at
+/// 2.72 bpvf, HEVC 3.81e-4 at 2.79); at equal error the rate hardly depends on how pixel step
+/// and `crf` share it (pixel step 5e-5 `crf` 32, 1e-4 `crf` 20, 2e-4 `crf` 8: 3.82, 3.71, 4.36
+/// bpvf at RMSE 2.45, 2.54, 2.20e-4) up to `crf` 32, above which libaom's constant-quality mode
+/// keeps its key frames' quantiser and the error stops growing (5e-5: `crf` 32–56 all 2.45e-4).
+pub const AV1_STEP_FACTOR: f64 = 0.1;
+/// libaom's `crf` at quality 50 at 10 bits a sample.
+pub const AV1_QP_AT_50: u8 = 32;
+/// The highest `crf` the law uses (the error stops following `crf` above it).
+pub const AV1_MAX_QP: u8 = 32;
+/// The lowest `crf` the law uses at 10 bits a sample.
+pub const AV1_MIN_QP: u8 = 8;
+/// AV1's AC quantiser step at 10 bits a sample (the specification's `ac_qlookup_10` table,
+/// libaom's `ac_qlookup_10_QTX`) at quantiser index 4 × `crf` for `crf` 0, 4, …, 60, and at index
+/// 255 (`crf` 63): the law interpolates log-linearly between these. At 12 bits the table is about
+/// 4 × this one: the step is relative to the sample range, as HEVC's QP.
+pub const AV1_AC_STEPS: [(u8, u16); 17] = [
+    (0, 4),
+    (4, 55),
+    (8, 122),
+    (12, 195),
+    (16, 267),
+    (20, 337),
+    (24, 409),
+    (28, 539),
+    (32, 700),
+    (36, 922),
+    (40, 1218),
+    (44, 1631),
+    (48, 2199),
+    (52, 2971),
+    (56, 4028),
+    (60, 5476),
+    (63, 7312),
+];
+
+/// log2 of AV1's AC step at 10 bits at a (fractional) `crf` 0..=63, from [`AV1_AC_STEPS`].
+fn av1_log2_step(crf: f64) -> f64 {
+    let i = AV1_AC_STEPS
+        .iter()
+        .rposition(|&(c, _)| f64::from(c) <= crf)
+        .unwrap_or(0)
+        .min(AV1_AC_STEPS.len() - 2);
+    let ((c0, s0), (c1, s1)) = (AV1_AC_STEPS[i], AV1_AC_STEPS[i + 1]);
+    let t = (crf - f64::from(c0)) / f64::from(c1 - c0);
+    let (l0, l1) = (f64::from(s0).log2(), f64::from(s1).log2());
+    l0 + t * (l1 - l0)
+}
+
+/// The (fractional) `crf` whose AC step has log2 `log2_step`, clamped to 0..=63.
+fn av1_crf_of(log2_step: f64) -> f64 {
+    let logs = AV1_AC_STEPS.map(|(c, s)| (f64::from(c), f64::from(s).log2()));
+    if log2_step <= logs[0].1 {
+        return 0.0;
+    }
+    match logs.windows(2).find(|w| log2_step <= w[1].1) {
+        Some(w) => w[0].0 + (log2_step - w[0].1) / (w[1].1 - w[0].1) * (w[1].0 - w[0].0),
+        None => 63.0,
+    }
+}
+
+/// AV1's pixel step factor and `crf` for a user quality 1..100 at `depth` bits a sample: the `crf`
+/// whose quantiser step is the one of [`AV1_QP_AT_50`] scaled as the target step; a deeper sample
+/// wants a step a quarter as large per 2 bits (the same step in model units, finer rounding), down
+/// to [`AV1_MIN_QP`], below which the pixel step takes the rest.
+pub fn av1_law(quality: u8, depth: u8) -> PictureLaw {
+    let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
+    let deeper = f64::from(depth) - 10.0;
+    let want = av1_log2_step(f64::from(AV1_QP_AT_50)) + scale.log2() - deeper;
+    // The floor is a `crf`, not a step, at either depth: AV1's 12-bit table is 4 × the 10-bit one
+    // only from about index 32 up (measured: quality 90 at 12 bits with the floor lowered by two
+    // bits went to `crf` 3 and 159 bpvf on CesiumMan).
+    let floor = av1_log2_step(f64::from(AV1_MIN_QP));
+    let ceiling = av1_log2_step(f64::from(AV1_MAX_QP));
+    let crf = av1_crf_of(want.clamp(floor, ceiling)).round();
+    // Beyond the floor or the ceiling the pixel step takes what the quantiser cannot.
+    let beyond = if (floor..=ceiling).contains(&want) {
+        0.0
+    } else {
+        want - av1_log2_step(crf)
+    };
+    PictureLaw {
+        step_factor: AV1_STEP_FACTOR * 2f64.powf(beyond),
+        quantiser: crf as u8,
+    }
+}
+
 /// MPEG-4's pixel step factor and qscale for a user quality 1..100.
 pub fn mpeg4_law(quality: u8) -> PictureLaw {
     read_law(&MPEG4_LAW, quality)
@@ -169,7 +262,9 @@ mod tests {
     fn pixel_steps_fall_and_quantisers_do_not_coarsen_with_quality() {
         let hevc10 = |q| hevc_law(q, 10);
         let hevc12 = |q| hevc_law(q, 12);
-        for law in [jpeg_law, mpeg4_law, hevc10, hevc12] {
+        let av1_10 = |q| av1_law(q, 10);
+        let av1_12 = |q| av1_law(q, 12);
+        for law in [jpeg_law, mpeg4_law, hevc10, hevc12, av1_10, av1_12] {
             for q in 1..100u8 {
                 let (a, b) = (law(q), law(q + 1));
                 let step = |l: PictureLaw, q| l.step_factor * target_step(q, 1.0);
@@ -182,8 +277,19 @@ mod tests {
             assert!((1..=31).contains(&mpeg4_law(q).quantiser));
             assert!(hevc_law(q + 1, 10).quantiser <= hevc_law(q, 10).quantiser);
             assert!(hevc_law(q, 12).quantiser <= 51);
+            assert!(av1_law(q + 1, 10).quantiser <= av1_law(q, 10).quantiser);
+            assert!(av1_law(q, 10).quantiser <= 63);
         }
         assert_eq!(hevc_law(50, 10).quantiser, HEVC_QP_AT_50 as u8);
         assert_eq!(hevc_law(50, 12).quantiser, HEVC_QP_AT_50 as u8 - 12);
+        assert_eq!(av1_law(50, 10).quantiser, AV1_QP_AT_50);
+        // The 12-bit crf of quality 50 has a quarter of the 10-bit step (700 / 4 = 175: crf 11).
+        assert_eq!(av1_law(50, 12).quantiser, 11);
+        assert_eq!(av1_law(10, 10).quantiser, AV1_MAX_QP);
+        assert!(av1_law(10, 10).step_factor > AV1_STEP_FACTOR);
+        for crf in 0..=63 {
+            let c = f64::from(crf);
+            assert!((av1_crf_of(av1_log2_step(c)) - c).abs() < 1e-9, "{crf}");
+        }
     }
 }

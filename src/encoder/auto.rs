@@ -283,11 +283,14 @@ struct Sample {
 impl Sample {
     /// `None` when every candidate is coded whole: tdct (cheap), MPEG-4 (its P-frames predict
     /// from the frame before, so spread frames misrank the candidates: Fox q50 kept a stream 20 %
-    /// larger than the smallest), HEVC (P-frames too; its sampled trials were not measured), or a
+    /// larger than the smallest), HEVC and AV1 (P-frames too; their sampled trials were not measured), or a
     /// short animation.
     fn of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Option<Self>> {
         let count = mesh.frame_count();
-        let whole = matches!(opts.codec, Codec::Tdct | Codec::Mpeg4 | Codec::Hevc);
+        let whole = matches!(
+            opts.codec,
+            Codec::Tdct | Codec::Mpeg4 | Codec::Hevc | Codec::Av1
+        );
         if whole || count <= 2 * TRIAL_FRAMES {
             return Ok(None);
         }

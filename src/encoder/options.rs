@@ -19,11 +19,12 @@ pub struct EncodeOptions {
     pub codec: Codec,
     /// Rate knob 1..100 (higher = better).
     pub quality: u8,
-    /// The video codec's own quantiser, MPEG-4 qscale (1..=31) or HEVC QP (0..=51); `None` derives
-    /// it from `quality`.
+    /// The video codec's own quantiser, MPEG-4 qscale (1..=31), HEVC QP (0..=51) or AV1 `crf`
+    /// (libaom's constant-quality level, 0..=63); `None` derives it from `quality`.
     pub qscale: Option<u8>,
-    /// Bits a sample of the HEVC pictures, 10 or 12; `None` picks the measured default
-    /// ([`crate::codec::hevc::DEFAULT_DEPTH`]). JPEG and MPEG-4 code 8.
+    /// Bits a sample of the HEVC and AV1 pictures, 10 or 12; `None` picks it from `quality` by the
+    /// measured rule of [`crate::codec::deep::auto_depth`] (12 from quality 90). JPEG and MPEG-4
+    /// code 8.
     pub bit_depth: Option<u8>,
     /// JPEG's own quality 1..100 for the residual pictures; `None` derives it from `quality`.
     pub jpeg_quality: Option<u8>,
@@ -43,8 +44,8 @@ pub struct EncodeOptions {
     pub lattice: Lattice,
     /// Padding of the free pixels; `None` picks the codec's measured best.
     pub padding: Option<padding::Method>,
-    /// Frames per group of pictures of MPEG-4 and HEVC: an intra frame, then `gop − 1` P-frames.
-    /// 1 makes HEVC all-intra (every frame decodes alone, as JPEG's).
+    /// Frames per group of pictures of MPEG-4, HEVC and AV1: an intra frame, then `gop − 1`
+    /// P-frames. 1 makes HEVC and AV1 all-intra (every frame decodes alone, as JPEG's).
     pub gop: usize,
     /// Let the first-frame coder permute vertices.
     pub reorder: bool,
@@ -97,7 +98,8 @@ pub fn default_affine_precision(codec: Codec) -> f64 {
     match codec {
         // HEVC's P-frames as MPEG-4's: CesiumMan q50 measured 3.045 bpvf at 1/16, 3.055 at 1/4, at
         // equal RMSE (3.9e-4).
-        Codec::Mpeg4 | Codec::Hevc => 1.0 / 16.0,
+        // AV1 as HEVC (not measured apart).
+        Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => 1.0 / 16.0,
         _ => motion::DEFAULT_AFFINE_PRECISION,
     }
 }
@@ -239,7 +241,7 @@ impl EncodeOptions {
             quality: header.quality,
             qscale: match header.codec {
                 Codec::Mpeg4 => Some(header.qscale).filter(|&q| q > 0),
-                Codec::Hevc => Some(header.qscale),
+                Codec::Hevc | Codec::Av1 => Some(header.qscale),
                 _ => None,
             },
             // In the codec's set-up part, not the header: the pictures' decoder reads it.
@@ -331,13 +333,20 @@ impl EncodeOptions {
                 return Err(Error::option("bit_depth", "must be 10 or 12"));
             }
         }
-        if let (Codec::Hevc, Some(q)) = (self.codec, self.qscale) {
-            if q > 51 {
+        match (self.codec, self.qscale) {
+            (Codec::Hevc, Some(q)) if q > 51 => {
                 return Err(Error::option(
                     "qscale",
                     "must be between 0 and 51 for hevc (its QP)",
                 ));
             }
+            (Codec::Av1, Some(q)) if q > 63 => {
+                return Err(Error::option(
+                    "qscale",
+                    "must be between 0 and 63 for av1 (libaom's crf)",
+                ));
+            }
+            _ => {}
         }
         if !(1..=24).contains(&self.uv_bits) {
             return Err(Error::option("uv_bits", "must be between 1 and 24"));

@@ -85,7 +85,7 @@ fn stream_error(bytes: Vec<u8>) -> String {
 
 #[test]
 fn the_forgery_helper_keeps_an_honest_stream_valid() {
-    for codec in [Codec::Jpeg, Codec::Mpeg4, Codec::Hevc] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4, Codec::Hevc, Codec::Av1] {
         let mut bytes = tiny_stream(codec);
         harness::fix_checksums(&mut bytes);
         assert_eq!(
@@ -153,7 +153,7 @@ fn a_step_that_overflows_the_coefficients_is_refused() {
 
 #[test]
 fn a_billion_vertices_or_frames_is_refused_before_allocating() {
-    for codec in [Codec::Jpeg, Codec::Mpeg4, Codec::Hevc] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4, Codec::Hevc, Codec::Av1] {
         // Header layout: vertices, frames, triangles, clusters (u32 each), then the lattice.
         for (offset, what) in [
             (0, "vertices"),
@@ -174,7 +174,7 @@ fn a_billion_vertices_or_frames_is_refused_before_allocating() {
 fn counts_under_the_header_limit_are_checked_against_the_bytes() {
     // 2^27 passes the header's own limit; the parts' real sizes must refuse it, quickly.
     let start = std::time::Instant::now();
-    for codec in [Codec::Jpeg, Codec::Mpeg4, Codec::Hevc] {
+    for codec in [Codec::Jpeg, Codec::Mpeg4, Codec::Hevc, Codec::Av1] {
         for offset in [4, 8] {
             let msg = stream_error(forged(codec, offset, 1 << 27));
             assert!(!msg.is_empty());

@@ -149,63 +149,74 @@ fn assert_cuts_fail_and_flips_never_mislead(
     }
 }
 
-/// HEVC: the round trip stays within the error its quality promises, a frame decoded alone (from
-/// its group's IDR frame) equals the same frame of the full decode, and the same input and options
-/// give the same bytes.
+/// HEVC and AV1: the round trip stays within the error its quality promises, a frame decoded alone
+/// (from its group's key frame) equals the same frame of the full decode, and the same input and
+/// options give the same bytes.
 #[test]
-fn hevc_round_trip_random_access_and_determinism() {
+fn deep_codecs_round_trip_random_access_and_determinism() {
     let mesh = read_media("RiggedFigure.glb");
-    for depth in [10u8, 12] {
-        let options = EncodeOptions {
-            bit_depth: Some(depth),
-            ..opts(Codec::Hevc, 75)
-        };
-        let bytes = encode_bytes(&mesh, &options);
-        assert_eq!(bytes, encode_bytes(&mesh, &options), "{depth} bits");
-        let decoded = decode_all(bytes.clone()).unwrap();
-        assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
-        let m = compare(&mesh, &decoded).unwrap();
-        // Quality 75's target step is 5e-4 of the diagonal; MPEG-4 at the same quality measures
-        // under 1e-4 here (the test above).
-        assert!(m.rmse < 2e-4, "{depth} bits: RMSE {}", m.rmse);
-        let f = 15;
-        let alone = decoder(bytes).unwrap().decode_frame(f).unwrap();
-        assert_eq!(alone, decoded.frame(f), "{depth} bits");
+    for codec in [Codec::Hevc, Codec::Av1] {
+        for depth in [10u8, 12] {
+            let options = EncodeOptions {
+                bit_depth: Some(depth),
+                ..opts(codec, 75)
+            };
+            let bytes = encode_bytes(&mesh, &options);
+            let what = format!("{} at {depth} bits", codec.name());
+            assert_eq!(bytes, encode_bytes(&mesh, &options), "{what}");
+            let decoded = decode_all(bytes.clone()).unwrap();
+            assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
+            let m = compare(&mesh, &decoded).unwrap();
+            // Quality 75's target step is 5e-4 of the diagonal; MPEG-4 at the same quality
+            // measures under 1e-4 here (the test above).
+            assert!(m.rmse < 2e-4, "{what}: RMSE {}", m.rmse);
+            let f = 15;
+            let alone = decoder(bytes).unwrap().decode_frame(f).unwrap();
+            assert_eq!(alone, decoded.frame(f), "{what}");
+        }
     }
 }
 
-/// All-intra HEVC (`gop` 1): a frame decodes when every other frame's chunk is destroyed.
+/// All-intra HEVC and AV1 (`gop` 1): a frame decodes when every other frame's chunk is destroyed.
 #[test]
-fn all_intra_hevc_frame_decodes_alone() {
+fn all_intra_deep_codec_frame_decodes_alone() {
     let mesh = read_media("RiggedSimple.glb");
-    let bytes = encode_bytes(
-        &mesh,
-        &EncodeOptions {
-            gop: 1,
-            ..opts(Codec::Hevc, 75)
-        },
-    );
-    let n = 7;
-    let want = decoder(bytes.clone()).unwrap().decode_frame(n).unwrap();
-    let reader = ContainerReader::new(Cursor::new(bytes.clone())).unwrap();
-    let images = reader.entry(Tag::FRAMES).unwrap();
-    let dec = decoder(bytes.clone()).unwrap();
-    let mut damaged = bytes;
-    for f in (0..dec.header().frames as usize).filter(|&f| f != n) {
-        let e = dec.frame_entry(f).unwrap();
-        assert!(e.key, "frame {f} of an all-intra stream is not a key frame");
-        let start = (images.offset + e.offset) as usize;
-        damaged[start..start + e.len as usize]
-            .iter_mut()
-            .for_each(|b| *b ^= 0xA5);
+    for codec in [Codec::Hevc, Codec::Av1] {
+        let bytes = encode_bytes(
+            &mesh,
+            &EncodeOptions {
+                gop: 1,
+                ..opts(codec, 75)
+            },
+        );
+        let n = 7;
+        let want = decoder(bytes.clone()).unwrap().decode_frame(n).unwrap();
+        let reader = ContainerReader::new(Cursor::new(bytes.clone())).unwrap();
+        let images = reader.entry(Tag::FRAMES).unwrap();
+        let dec = decoder(bytes.clone()).unwrap();
+        let mut damaged = bytes;
+        for f in (0..dec.header().frames as usize).filter(|&f| f != n) {
+            let e = dec.frame_entry(f).unwrap();
+            assert!(
+                e.key,
+                "frame {f} of an all-intra {} stream is not a key frame",
+                codec.name()
+            );
+            let start = (images.offset + e.offset) as usize;
+            damaged[start..start + e.len as usize]
+                .iter_mut()
+                .for_each(|b| *b ^= 0xA5);
+        }
+        assert_eq!(decoder(damaged).unwrap().decode_frame(n).unwrap(), want);
     }
-    assert_eq!(decoder(damaged).unwrap().decode_frame(n).unwrap(), want);
 }
 
 #[test]
-fn truncated_and_bit_flipped_hevc_streams_are_errors_not_panics() {
+fn truncated_and_bit_flipped_deep_codec_streams_are_errors_not_panics() {
     let mesh = read_media("RiggedSimple.glb");
-    let bytes = encode_bytes(&mesh, &opts(Codec::Hevc, 50));
-    let step = (bytes.len() / 200).max(1);
-    assert_cuts_fail_and_flips_never_mislead(&bytes, (0..bytes.len()).step_by(step), step);
+    for codec in [Codec::Hevc, Codec::Av1] {
+        let bytes = encode_bytes(&mesh, &opts(codec, 50));
+        let step = (bytes.len() / 200).max(1);
+        assert_cuts_fail_and_flips_never_mislead(&bytes, (0..bytes.len()).step_by(step), step);
+    }
 }

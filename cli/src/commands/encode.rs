@@ -1,6 +1,6 @@
 //! `mcgv-video encode`.
 
-use crate::args::{CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
+use crate::args::{BitDepth, CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
@@ -21,6 +21,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         CodecChoice::Mpeg4 => Codec::Mpeg4,
         CodecChoice::Tdct => Codec::Tdct,
         CodecChoice::Hevc => Codec::Hevc,
+        CodecChoice::Av1 => Codec::Av1,
     };
     check_codec_options(args, codec, lattice)?;
     if args.affine_bits.is_some() {
@@ -65,7 +66,10 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
         // One field for the video codecs' quantisers; check_codec_options lets one through.
         qscale: args.qscale.or(args.qp),
-        bit_depth: args.bit_depth,
+        bit_depth: match args.bit_depth {
+            BitDepth::Auto => None,
+            BitDepth::Bits(bits) => Some(bits),
+        },
         jpeg_quality: args.jpeg_quality,
         clusters: args.clusters.unwrap_or(defaults.clusters),
         segmentation,
@@ -97,13 +101,18 @@ fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Res
              with small residuals already cost few bits; leave it out",
         ));
     }
-    let images: &[Codec] = &[Codec::Jpeg, Codec::Mpeg4, Codec::Hevc];
+    let images: &[Codec] = &[Codec::Jpeg, Codec::Mpeg4, Codec::Hevc, Codec::Av1];
+    let deep: &[Codec] = &[Codec::Hevc, Codec::Av1];
     let given: [(&'static str, bool, &[Codec]); 7] = [
         ("qscale", args.qscale.is_some(), &[Codec::Mpeg4]),
-        ("qp", args.qp.is_some(), &[Codec::Hevc]),
-        ("bit_depth", args.bit_depth.is_some(), &[Codec::Hevc]),
+        ("qp", args.qp.is_some(), deep),
+        ("bit_depth", args.bit_depth != BitDepth::Auto, deep),
         ("jpeg_quality", args.jpeg_quality.is_some(), &[Codec::Jpeg]),
-        ("gop", args.gop.is_some(), &[Codec::Mpeg4, Codec::Hevc]),
+        (
+            "gop",
+            args.gop.is_some(),
+            &[Codec::Mpeg4, Codec::Hevc, Codec::Av1],
+        ),
         ("padding", args.padding.is_some(), images),
         ("lattice", lattice != Lattice::Auto, images),
     ];

@@ -146,6 +146,7 @@ fn summary(h: &Header, path: &Path) -> String {
             h.quality, h.qscale, h.gop
         ),
         Codec::Hevc => format!("hevc quality {} qp {} gop {}", h.quality, h.qscale, h.gop),
+        Codec::Av1 => format!("av1 quality {} crf {} gop {}", h.quality, h.qscale, h.gop),
         Codec::Tdct => {
             return format!(
                 "{}: {} vertices x {} frames, {} faces; tdct quality {}; {} clusters, {} predictor, no atlas",

@@ -347,48 +347,50 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--bands applies to tdct"));
 }
 
-/// `--codec hevc` with its own flags: --qp, --bit-depth, --gop 1 (all-intra); the header and the
-/// set-up carry what decode needs, random access gives the full decode's frame, and the flags are
-/// refused for other codecs.
+/// `--codec hevc` and `--codec av1` with their own flags: --qp, --bit-depth, --gop 1 (all-intra);
+/// the header and the set-up carry what decode needs, random access gives the full decode's frame,
+/// and the flags are refused for other codecs and out of each codec's range.
 #[test]
-fn hevc_flags_encode_decode_and_random_access() {
+fn deep_codec_flags_encode_decode_and_random_access() {
     let dir = tempfile::tempdir().unwrap();
     let sample = media_path("RiggedFigure.glb");
-    for (name, extra) in [
-        ("p.mcgv", vec!["--bit-depth", "12", "--gop", "8"]),
-        ("i.mcgv", vec!["--qp", "20", "--gop", "1"]),
-    ] {
-        let stream = dir.path().join(name);
-        let s = stream.to_str().unwrap();
-        let mut args = vec!["encode", &sample, "-o", s, "--codec", "hevc", "--quiet"];
-        args.extend(extra.iter().copied());
-        ok(&run(&args));
-        let info = json(&run(&["inspect", s, "--json"]));
-        assert_eq!(info["codec"], "hevc");
-        let depth = if name == "p.mcgv" { 12 } else { 10 };
-        assert_eq!(info["bit_depth"], depth);
-        if name == "i.mcgv" {
-            assert_eq!(info["qscale"], 20);
-            assert_eq!(info["gop"], 1);
+    for codec in ["hevc", "av1"] {
+        for (name, extra) in [
+            ("p.mcgv", vec!["--bit-depth", "12", "--gop", "8"]),
+            ("i.mcgv", vec!["--qp", "20", "--gop", "1"]),
+        ] {
+            let stream = dir.path().join(format!("{codec}-{name}"));
+            let s = stream.to_str().unwrap();
+            let mut args = vec!["encode", &sample, "-o", s, "--codec", codec, "--quiet"];
+            args.extend(extra.iter().copied());
+            ok(&run(&args));
+            let info = json(&run(&["inspect", s, "--json"]));
+            assert_eq!(info["codec"], codec);
+            let depth = if name == "p.mcgv" { 12 } else { 10 };
+            assert_eq!(info["bit_depth"], depth);
+            if name == "i.mcgv" {
+                assert_eq!(info["qscale"], 20);
+                assert_eq!(info["gop"], 1);
+            }
+            let all = dir.path().join(format!("{codec}-{depth}-all/"));
+            let one = dir.path().join(format!("{codec}-{depth}-one/"));
+            ok(&run(&["decode", s, "-o", all.to_str().unwrap(), "--quiet"]));
+            ok(&run(&[
+                "decode",
+                s,
+                "-o",
+                one.to_str().unwrap(),
+                "--frame",
+                "11",
+                "--quiet",
+            ]));
+            assert_eq!(
+                std::fs::read(one.join("frame_0011.obj")).unwrap(),
+                std::fs::read(all.join("frame_0011.obj")).unwrap(),
+            );
+            let m = json(&run(&["eval", &sample, s, "--json", "--quiet"]));
+            assert!(m["rmse"].as_f64().unwrap() < 1e-3, "{codec}: {m}");
         }
-        let all = dir.path().join(format!("{depth}-all/"));
-        let one = dir.path().join(format!("{depth}-one/"));
-        ok(&run(&["decode", s, "-o", all.to_str().unwrap(), "--quiet"]));
-        ok(&run(&[
-            "decode",
-            s,
-            "-o",
-            one.to_str().unwrap(),
-            "--frame",
-            "11",
-            "--quiet",
-        ]));
-        assert_eq!(
-            std::fs::read(one.join("frame_0011.obj")).unwrap(),
-            std::fs::read(all.join("frame_0011.obj")).unwrap(),
-        );
-        let m = json(&run(&["eval", &sample, s, "--json", "--quiet"]));
-        assert!(m["rmse"].as_f64().unwrap() < 1e-3, "{m}");
     }
     let o = dir.path().join("x.mcgv");
     let o = o.to_str().unwrap();
@@ -397,6 +399,9 @@ fn hevc_flags_encode_decode_and_random_access() {
         vec!["--codec", "jpeg", "--qp", "20"],
         vec!["--codec", "hevc", "--qscale", "3"],
         vec!["--codec", "hevc", "--bit-depth", "11"],
+        vec!["--codec", "hevc", "--qp", "52"],
+        vec!["--codec", "av1", "--qp", "64"],
+        vec!["--codec", "av1", "--qscale", "3"],
     ] {
         let mut args = vec!["encode", sample.as_str(), "-o", o];
         args.extend(extra.iter().copied());

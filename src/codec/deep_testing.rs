@@ -1,0 +1,108 @@
+//! What hevc's and av1's unit tests share: a smooth moving test pattern, a coder of planes and
+//! the checks both codecs pass.
+
+use super::*;
+
+/// A smooth pattern moving with `t`, spanning most of the `depth`-bit range.
+pub fn ramp(width: u32, height: u32, t: u32, depth: u8) -> Plane<u16> {
+    let top = f64::from(quantise::max_level(depth));
+    let data = (0..width * height)
+        .map(|i| {
+            let (x, y) = (f64::from(i % width), f64::from(i / width));
+            let v = 0.5 + 0.3 * ((x + 2.0 * f64::from(t)) / 9.0).sin() * (y / 7.0).cos();
+            (v * top).round() as u16
+        })
+        .collect();
+    Plane::new(width, height, data).unwrap()
+}
+
+/// The packets of `planes` coded by `flavour` with `options`.
+pub fn code(flavour: &dyn Flavour, planes: &[Plane<u16>], options: &Options) -> Vec<Packet> {
+    let (w, h) = (planes[0].width, planes[0].height);
+    let mut encoder = Encoder::new(flavour, w, h, options, 0).unwrap();
+    let mut packets = Vec::new();
+    for p in planes {
+        packets.extend(encoder.encode(p).unwrap());
+    }
+    packets.extend(encoder.finish().unwrap());
+    packets
+}
+
+/// Codes five frames of each depth and layout with key frames every 2, checks the key flags,
+/// that a second coding gives the same bytes, that every decoded sample is within `tolerance`
+/// levels of an 8-bit picture (scaled to the depth) and that a P-frame without its key frame
+/// gives no picture.
+pub fn round_trip(flavour: &dyn Flavour, qp: u8, tolerance: u16) {
+    for (depth, layout) in [(10, Planes::Mono), (12, Planes::Mono), (10, Planes::Yuv444)] {
+        let (w, h) = (96, 48);
+        let planes: Vec<_> = (0..5).map(|t| ramp(w, h, t, depth)).collect();
+        let options = Options {
+            qp,
+            gop: 2,
+            depth,
+            planes: layout,
+        };
+        let packets = code(flavour, &planes, &options);
+        let keys: Vec<bool> = packets.iter().map(|p| p.key).collect();
+        assert_eq!(keys, [true, false, true, false, true], "{depth} bits");
+        assert_eq!(
+            packets,
+            code(flavour, &planes, &options),
+            "not deterministic"
+        );
+        let mut decoder = Decoder::new(flavour, w, h, depth, layout).unwrap();
+        for (plane, packet) in planes.iter().zip(&packets) {
+            let back = decoder.decode(&packet.data).unwrap();
+            let worst = back[0]
+                .data
+                .iter()
+                .zip(&plane.data)
+                .map(|(a, b)| a.abs_diff(*b))
+                .max()
+                .unwrap();
+            let limit = tolerance << (depth - 8);
+            assert!(worst <= limit, "{depth} bits {layout:?}: {worst}");
+        }
+        let mut cold = Decoder::new(flavour, w, h, depth, layout).unwrap();
+        let first = cold.decode(&packets[1].data);
+        assert!(first.map_or(true, |p| p.is_empty()));
+    }
+}
+
+/// Sizes, quantisers, depths, samples and set-up parts out of range are errors.
+pub fn bad_settings_are_errors<F: Flavour>(flavour: F, qp: u8) {
+    let options = Options {
+        qp,
+        gop: 50,
+        depth: 10,
+        planes: Planes::Mono,
+    };
+    let too_fine = flavour.max_qp() + 1;
+    assert!(Encoder::new(&flavour, 15, 32, &options, 0).is_err());
+    let coarse = Options {
+        qp: too_fine,
+        ..options
+    };
+    assert!(Encoder::new(&flavour, 32, 32, &coarse, 0).is_err());
+    let shallow = Options {
+        depth: 8,
+        ..options
+    };
+    assert!(Encoder::new(&flavour, 32, 32, &shallow, 0).is_err());
+    let yuv = Options {
+        planes: Planes::Yuv444,
+        ..options
+    };
+    let error = Encoder::new(&flavour, 64, 32, &yuv, 0).err();
+    assert!(error.is_some(), "not three images wide");
+    let mut encoder = Encoder::new(&flavour, 96, 32, &options, 0).unwrap();
+    assert!(encoder.encode(&Plane::filled(96, 32, 1024)).is_err());
+    assert!(encoder.encode(&Plane::filled(48, 32, 0)).is_err());
+    let name = flavour.name();
+    let pictures = Pictures(flavour);
+    assert!(pictures.depth_of_setup(&[]).is_err());
+    assert!(pictures.depth_of_setup(&[10]).is_err());
+    assert!(pictures.depth_of_setup(&[9, 0]).is_err());
+    assert!(pictures.depth_of_setup(&[10, 2]).is_err());
+    assert_eq!(read_setup(name, &[12, 1]).unwrap(), (12, Planes::Yuv444));
+}
