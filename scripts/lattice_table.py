@@ -30,12 +30,11 @@ IMAGE_CODECS = ("jpeg", "mpeg4", "hevc")
 def series(codec):
     """(image codec, lattice) of a row's codec label; lattice "auto" when none is named."""
     base = codec.partition("+")[0]
-    name, _, lattice = base.partition("@")
     # hevc@12@128x128: the depth stays with the codec, the last WxH part is the lattice
     parts = base.split("@")
     if len(parts) > 1 and "x" in parts[-1]:
         return "@".join(parts[:-1]), parts[-1]
-    return base, "auto" if not lattice else "auto"
+    return base, "auto"
 
 
 def reference_lattice(vertices):
