@@ -26,8 +26,8 @@
 #              other than the default is labelled hevc@12, hevc-intra@12.
 #   LATTICES   --lattice values of the jpeg, mpeg4 and hevc runs (WxH or auto; default: auto only);
 #              a fixed lattice is labelled with the size the stream really holds (`inspect --json`),
-#              jpeg@128x128, hevc@12@128x128; tdct has no lattice and runs once. A lattice the charts
-#              do not fit is reported on stderr and skipped.
+#              jpeg@128x128, hevc@12@128x128; tdct has no lattice and runs once. A failed encoding on
+#              a fixed lattice (one the charts do not fit) is reported on stderr and skipped.
 set -euo pipefail
 bin=${MCGV_BIN:-target/release/mcgv-video}
 out=$1; shift
@@ -105,6 +105,8 @@ for input in "$@"; do
             [ "$lattice" = auto ] || codec_flags+=(--lattice "$lattice")
             if ! read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" "${codec_flags[@]}" "$flag" "$value" \
                 ${extra[@]+"${extra[@]}"} --quiet) || [ -z "${em:-}" ]; then
+                # Only a fixed lattice may be too small for the charts; any other failure stops the sweep.
+                [ "$lattice" = auto ] && exit 1
                 echo "sweep.sh: $name $codec $flag $value --lattice $lattice failed, skipped" >&2
                 continue
             fi
