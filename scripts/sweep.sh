@@ -7,9 +7,10 @@
 #   scripts/sweep.sh OUT.csv INPUT...
 # env: JPEG_QUALITIES, MPEG4_QUALITIES, QSCALES, TDCT_QUALITIES, HEVC_QUALITIES,
 #      HEVC_INTRA_QUALITIES, HEVC_DEPTHS, AV1_QUALITIES, AV1_INTRA_QUALITIES, AV1_DEPTHS,
-#      VARIANTS, EXTRA, MCGV_BIN
+#      LATTICES, VARIANTS, EXTRA, MCGV_BIN
 #   VARIANTS   space-separated encoder variants, each a '+'-joined list of
-#              skinning (--predictor skinning) and decimation (--segmentation decimation), or
+#              skinning (--predictor skinning), affine (--predictor affine), decimation
+#              (--segmentation decimation) and kmeans (--segmentation kmeans), or
 #              `default` (no extra flag). Unset: the default encoder only. A variant's rows are
 #              labelled in the codec column as CODEC+VARIANT (mpeg4+skinning, jpeg+skinning+decimation),
 #              so plots and tables treat each as its own series; the CSV columns stay the same.
@@ -28,6 +29,10 @@
 #              codes one motion model instead of the automatic choice's candidates).
 #   AV1_QUALITIES, AV1_INTRA_QUALITIES, AV1_DEPTHS  the same for `--codec av1` (codec columns av1,
 #              av1-intra, av1@12, av1-intra@12), made only when `encode --help` mentions av1.
+#   LATTICES   --lattice values of the jpeg, mpeg4, hevc and av1 runs (WxH or auto; default: auto only);
+#              a fixed lattice is labelled with the size the stream really holds (`inspect --json`),
+#              jpeg@128x128, hevc@12@128x128; tdct has no lattice and runs once. A failed encoding on
+#              a fixed lattice (one the charts do not fit) is reported on stderr and skipped.
 set -euo pipefail
 bin=${MCGV_BIN:-target/release/mcgv-video}
 out=$1; shift
@@ -37,6 +42,7 @@ qscales=${QSCALES-}
 hevc_qualities=${HEVC_QUALITIES-}
 hevc_intra_qualities=${HEVC_INTRA_QUALITIES-}
 hevc_depths=${HEVC_DEPTHS:-default}
+lattices=${LATTICES:-auto}
 if [ -n "$hevc_qualities$hevc_intra_qualities" ] && ! "$bin" encode --help | grep -qw hevc; then
     echo "sweep.sh: $bin has no hevc codec; HEVC_QUALITIES ignored" >&2
     hevc_qualities=""; hevc_intra_qualities=""
@@ -59,8 +65,10 @@ variant_flags() {
     for part in "${parts[@]}"; do
         case $part in
             skinning) flags+=(--predictor skinning) ;;
+            affine) flags+=(--predictor affine) ;;
             decimation) flags+=(--segmentation decimation) ;;
-            *) echo "sweep.sh: unknown variant part '$part' in '$1' (skinning, decimation, default)" >&2
+            kmeans) flags+=(--segmentation kmeans) ;;
+            *) echo "sweep.sh: unknown variant part '$part' in '$1' (skinning, affine, decimation, kmeans, default)" >&2
                return 1 ;;
         esac
     done
@@ -75,9 +83,9 @@ elif [ -n "${TDCT_QUALITIES:-}" ]; then
 fi
 [ -s "$out" ] || echo "sequence,codec,setting,bytes,bpvf,rmse,vertex_rmse,kg_error,hausdorff,encode_s,decode_s,encode_cpu_s,decode_cpu_s,encode_rss_kb,decode_rss_kb,frames,vertices" > "$out"
 field() { sed -E "s/.*\"$1\":([0-9.eE+-]+).*/\1/" <<<"$2"; }
-# Runs a command under GNU time; prints "wall cpu max_rss_kb".
+# Runs a command under GNU time; prints "wall cpu max_rss_kb", nothing if the command fails.
 measure() {
-    /usr/bin/time -f "%e %U %S %M" -o "$tmp/time" "$@"
+    /usr/bin/time -f "%e %U %S %M" -o "$tmp/time" "$@" || return 1
     awk '{ printf "%s %.2f %s\n", $1, $2 + $3, $4 }' "$tmp/time"
 }
 for input in "$@"; do
@@ -103,21 +111,35 @@ for input in "$@"; do
         read -ra extra <<<"$(variant_flags "$variant") ${EXTRA:-}"
         suffix=""; [ "$variant" = default ] || suffix="+$variant"
         for run in "${runs[@]}"; do
-            read -r codec flag value <<<"$run"
+          read -r codec flag value <<<"$run"
+          run_lattices=$lattices; [ "$codec" = tdct ] && run_lattices=auto
+          for lattice in $run_lattices; do
             stream="$tmp/$name.mcgv"
             # hevc-intra@12 is `--codec hevc --gop 1 --bit-depth 12` (av1 alike).
             codec_flags=(--codec "${codec%%[-@]*}")
             case $codec in hevc-intra* | av1-intra*) codec_flags+=(--gop 1) ;; esac
             case $codec in *@*) codec_flags+=(--bit-depth "${codec#*@}") ;; esac
-            read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" "${codec_flags[@]}" "$flag" "$value" \
-                ${extra[@]+"${extra[@]}"} --quiet)
+            [ "$lattice" = auto ] || codec_flags+=(--lattice "$lattice")
+            if ! read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" "${codec_flags[@]}" "$flag" "$value" \
+                ${extra[@]+"${extra[@]}"} --quiet) || [ -z "${em:-}" ]; then
+                # Only a fixed lattice may be too small for the charts; any other failure stops the sweep.
+                [ "$lattice" = auto ] && exit 1
+                echo "sweep.sh: $name $codec $flag $value --lattice $lattice failed, skipped" >&2
+                continue
+            fi
+            label=$codec
+            if [ "$lattice" != auto ]; then
+                used=$("$bin" inspect "$stream" --json | sed -E 's/.*"lattice":\[([0-9]+),([0-9]+)\].*/\1x\2/')
+                label="$codec@$used"
+            fi
             read -r dw dc dm < <(measure "$bin" decode "$stream" -o "$tmp/dec.pc2" --quiet)
             m=$("$bin" eval "$input" "$stream" --json --quiet)
             printf '%s,%s,%s,%d,%.4f,%.6e,%.6e,%.5f,%.6e,%s,%s,%s,%s,%s,%s,%d,%d\n' \
-                "$name" "$codec$suffix" "${flag#--} $value" "$(stat -c %s "$stream")" "$(field bpvf "$m")" \
+                "$name" "$label$suffix" "${flag#--} $value" "$(stat -c %s "$stream")" "$(field bpvf "$m")" \
                 "$(field rmse "$m")" "$(field vertex_rmse "$m")" "$(field kg_error "$m")" \
                 "$(field hausdorff "$m")" "$ew" "$dw" "$ec" "$dc" "$em" "$dm" \
                 "$(field frames "$m")" "$(field vertices "$m")" | tee -a "$out"
+          done
         done
     done
 done

@@ -145,9 +145,9 @@ pub struct EncodeArgs {
     /// Retired: the affine coefficients now follow the quality's step (see --affine-precision).
     #[arg(long, hide = true)]
     pub affine_bits: Option<u8>,
-    /// Geometry-image lattice: WIDTHxHEIGHT (multiples of 16), or `auto` to size it from the
-    /// vertex count (about 28 pixels per vertex; 256x256 for 2341..8738 vertices, more above).
-    /// Grown until the charts fit.
+    /// Geometry-image lattice: WIDTHxHEIGHT (multiples of 16), or `auto` for the smallest square
+    /// the charts fit, tried from about 2 pixels per vertex upwards (the fewest bits at equal
+    /// error on the media sequences).
     #[arg(long, default_value = "auto")]
     pub lattice: String,
     /// jpeg, mpeg4, hevc, av1: how free pixels of the geometry images are filled [default: snap

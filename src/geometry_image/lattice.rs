@@ -14,27 +14,25 @@ pub enum Lattice {
     Fixed(u16, u16),
 }
 
-/// Lattice pixels per vertex for `Lattice::Auto`. The papers' sequences (2900–8400 vertices) use
-/// 256×256; a small mesh in that lattice pays for pixels it does not need: RiggedFigure (370
-/// vertices) costs 96 bpvf at 256×256 and 37 bpvf at 96×96 at about the same RMSE, Fox (1728) is
-/// best near 224×224 (encode --lattice WxH, eval; JPEG q30/q75).
-const AUTO_PIXELS_PER_VERTEX: f64 = 28.0;
-
-/// Lattice pixels per vertex below which `Lattice::Auto` grows past 256×256: BrainStem (34 159
-/// vertices) at 336×336 had 70 % of its vertices moved off colliding pixels, at 512×512 28 %. At
-/// 7.5 the papers' largest meshes (8431-vertex horses) stay at 256×256 and BrainStem gets 512×512.
-const MIN_PIXELS_PER_VERTEX: f64 = 7.5;
+/// Lattice pixels per vertex `Lattice::Auto` starts from; it then grows until the charts fit, so
+/// in practice the lattice is the smallest one the atlas packs. Every pixel is coded, and pixels
+/// without a vertex (interpolated chart interiors, padding between charts) only cost bits: on the
+/// media sequences the smallest lattice that fits needs the fewest bits at equal surface RMSE, for
+/// JPEG and MPEG-4 alike, although more vertices then move off a shared rounded pixel (issue 15,
+/// docs/results.md "Lattice density": `scripts/sweep.sh` with LATTICES, affine + k-means, qualities
+/// 10..90; bits at the former rule's error over its bits, JPEG / MPEG-4): walking_cat (1297
+/// vertices) 64×64 0.46 / 0.47 against 192×192, 48×48 does not fit; CesiumMan (3273) 160×160
+/// 0.66 / 0.76 against 256×256, 144×144 does not fit; pcow (2904) 80×80 0.52 / 0.56, 96×96
+/// 0.49 / 0.53; pdance (7061) 128×128 0.54 / 0.72; horse-gallop and horse-collapse (8431) 128×128
+/// 0.78 / 0.79 and 0.71 / 0.69, 96×96 does not fit. No lattice between the smallest that fits and
+/// the former one did better. The former rule (28 pixels per vertex, 256×256 for 2341..8738
+/// vertices) had been measured on RiggedFigure and Fox only.
+const AUTO_PIXELS_PER_VERTEX: f64 = 1.9;
 
 /// The first lattice side `Lattice::Auto` tries for `vertices`: about
-/// [`AUTO_PIXELS_PER_VERTEX`] pixels per vertex, at least 32, at most the papers' 256 unless that
-/// leaves fewer than [`MIN_PIXELS_PER_VERTEX`] (meshes over 8738 vertices).
+/// [`AUTO_PIXELS_PER_VERTEX`] pixels per vertex, at least 32, in multiples of 16.
 pub fn auto_side(vertices: usize) -> u16 {
-    let v = vertices as f64;
-    let side = (v * AUTO_PIXELS_PER_VERTEX)
-        .sqrt()
-        .min(256.0)
-        .max((v * MIN_PIXELS_PER_VERTEX).sqrt());
-    round_up_16(side).max(32)
+    round_up_16((vertices as f64 * AUTO_PIXELS_PER_VERTEX).sqrt()).max(32)
 }
 
 fn round_up_16(x: f64) -> u16 {
@@ -102,13 +100,14 @@ pub fn build_atlas(
     loop {
         let next = match build(side, side) {
             Ok(a) => return Ok(((side, side), a)),
+            // The smallest square with as many blocks as the charts need, then 16 more at a time:
+            // the greedy packer may need a little more than the bound, and each step of 16 costs a
+            // build but a larger lattice than needed costs bits in every frame.
             Err(atlas::AtlasError::ChartsDoNotFit { blocks, block, .. }) => {
-                // Room for the blocks with some slack, and at least a quarter more each time.
-                let needed = f64::from(block) * (blocks as f64 * 1.3).sqrt();
-                round_up_16(needed.max(f64::from(side) * 1.25))
+                round_up_16(f64::from(block) * (blocks as f64).sqrt()).max(side + 16)
             }
             Err(atlas::AtlasError::TooManyVertices { vertices, .. }) => {
-                round_up_16((vertices as f64 * 2.0).sqrt().max(f64::from(side) * 1.25))
+                round_up_16((vertices as f64).sqrt()).max(side + 16)
             }
             Err(e) => return Err(e.into()),
         };
@@ -126,13 +125,13 @@ mod tests {
     use super::auto_side;
 
     #[test]
-    fn auto_lattice_scales_with_vertices_up_to_the_papers_size() {
+    fn auto_lattice_starts_near_two_pixels_per_vertex() {
         assert_eq!(auto_side(3), 32);
-        assert_eq!(auto_side(160), 80);
-        assert_eq!(auto_side(1728), 224);
-        assert_eq!(auto_side(3030), 256);
-        assert_eq!(auto_side(8431), 256);
-        assert_eq!(auto_side(34_159), 512);
-        assert_eq!(auto_side(160) % 16, 0);
+        assert_eq!(auto_side(160), 32);
+        assert_eq!(auto_side(1297), 64);
+        assert_eq!(auto_side(3273), 80);
+        assert_eq!(auto_side(8431), 128);
+        assert_eq!(auto_side(34_159), 256);
+        assert_eq!(auto_side(1728) % 16, 0);
     }
 }

@@ -26,14 +26,16 @@ fn opts(codec: Codec, quality: u8) -> EncodeOptions {
 }
 
 /// Bounds per quality, as fractions of the bounding-box diagonal (the papers' RMSE): twice what this
-/// build measures (7.7e-5 at quality 30, 3.1e-5 at 90, `mcgv-video eval` on the same encodings), so a
-/// regression in any stage — prediction, quantisation, padding, codec — breaks them.
+/// build measures (1.7e-4 at quality 30, 3.5e-5 at 90, `mcgv-video eval` on the same encodings, on
+/// the automatic lattice: 64×64 since issue 15's lattice density, 8 % more error and 14 % fewer
+/// bytes at quality 30 than on the former 80×80), so a regression in any stage — prediction,
+/// quantisation, padding, codec — breaks them.
 #[test]
 fn jpeg_round_trip_keeps_connectivity_and_bounds_error() {
     let mesh = read_media("RiggedSimple.glb");
     let mut last_rmse = f64::INFINITY;
     let mut last_size = 0;
-    for (quality, bound) in [(30u8, 1.6e-4), (90, 6.4e-5)] {
+    for (quality, bound) in [(30u8, 3.4e-4), (90, 7.0e-5)] {
         let bytes = encode_bytes(&mesh, &opts(Codec::Jpeg, quality));
         let size = bytes.len();
         let decoded = decode_all(bytes).unwrap();
