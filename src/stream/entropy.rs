@@ -228,12 +228,41 @@ impl UIntModel {
 impl IntModel {
     /// Bits that coding `value` would cost now, without coding it.
     pub fn cost(&self, value: i64) -> f64 {
-        let sign = match value {
-            0 => 0.0,
-            _ => self.sign.cost(value < 0),
-        };
-        self.magnitude.cost(value.unsigned_abs()) + sign
+        signed_cost(value, &self.magnitude, &self.sign)
     }
+
+    /// Its two models, lent.
+    pub fn parts(&mut self) -> SignedModels<'_> {
+        SignedModels {
+            magnitude: &mut self.magnitude,
+            sign: &mut self.sign,
+        }
+    }
+}
+
+/// The two models a signed integer is coded with, borrowed: its magnitude's and, when non-zero,
+/// its sign's. [`IntModel`] owns one such pair; a coder that picks the sign's model by a context
+/// of its own lends a pair it assembles.
+pub struct SignedModels<'a> {
+    /// The magnitude's model.
+    pub magnitude: &'a mut UIntModel,
+    /// The sign's model (`true`: negative).
+    pub sign: &'a mut BitModel,
+}
+
+impl SignedModels<'_> {
+    /// Bits that coding `value` would cost now, without coding it.
+    pub fn cost(&self, value: i64) -> f64 {
+        signed_cost(value, self.magnitude, self.sign)
+    }
+}
+
+fn signed_cost(value: i64, magnitude: &UIntModel, sign: &BitModel) -> f64 {
+    let sign = match value {
+        0 => 0.0,
+        _ => sign.cost(value < 0),
+    };
+    magnitude.cost(value.unsigned_abs()) + sign
 }
 
 /// Writes adaptive-coded symbols into a byte buffer.
@@ -327,9 +356,14 @@ impl Encoder {
 
     /// Codes a signed integer.
     pub fn signed(&mut self, value: i64, model: &mut IntModel) {
-        self.unsigned(value.unsigned_abs(), &mut model.magnitude);
+        self.signed_with(value, model.parts());
+    }
+
+    /// Codes a signed integer with lent models.
+    pub fn signed_with(&mut self, value: i64, models: SignedModels) {
+        self.unsigned(value.unsigned_abs(), models.magnitude);
         if value != 0 {
-            self.bit(value < 0, &mut model.sign);
+            self.bit(value < 0, models.sign);
         }
     }
 
@@ -458,13 +492,18 @@ impl Decoder {
 
     /// Decodes a signed integer.
     pub fn signed(&mut self, model: &mut IntModel) -> Result<i64> {
-        let magnitude = self.unsigned(&mut model.magnitude)?;
+        self.signed_with(model.parts())
+    }
+
+    /// Decodes a signed integer with lent models.
+    pub fn signed_with(&mut self, models: SignedModels) -> Result<i64> {
+        let magnitude = self.unsigned(models.magnitude)?;
         if magnitude == 0 {
             return Ok(0);
         }
         // The sign is read before the range check: i64::MIN has magnitude 2^63, which the encoder
         // writes and only a negative sign makes representable.
-        let value = if self.bit(&mut model.sign)? {
+        let value = if self.bit(models.sign)? {
             0i64.checked_sub_unsigned(magnitude)
         } else {
             i64::try_from(magnitude).ok()
@@ -482,8 +521,12 @@ pub trait SymbolCoder {
     fn symbol(&mut self, value: usize, model: &mut SymbolModel) -> Result<usize>;
     /// Codes an unsigned integer.
     fn unsigned(&mut self, value: u64, model: &mut UIntModel) -> Result<u64>;
+    /// Codes a signed integer with lent models.
+    fn signed_with(&mut self, value: i64, models: SignedModels) -> Result<i64>;
     /// Codes a signed integer.
-    fn signed(&mut self, value: i64, model: &mut IntModel) -> Result<i64>;
+    fn signed(&mut self, value: i64, model: &mut IntModel) -> Result<i64> {
+        self.signed_with(value, model.parts())
+    }
     /// Codes `n` raw bits.
     fn raw_bits(&mut self, value: u64, n: u32) -> Result<u64>;
 }
@@ -501,8 +544,8 @@ impl SymbolCoder for Encoder {
         Encoder::unsigned(self, value, model);
         Ok(value)
     }
-    fn signed(&mut self, value: i64, model: &mut IntModel) -> Result<i64> {
-        Encoder::signed(self, value, model);
+    fn signed_with(&mut self, value: i64, models: SignedModels) -> Result<i64> {
+        Encoder::signed_with(self, value, models);
         Ok(value)
     }
     fn raw_bits(&mut self, value: u64, n: u32) -> Result<u64> {
@@ -525,8 +568,8 @@ impl SymbolCoder for Decoder {
     fn unsigned(&mut self, _: u64, model: &mut UIntModel) -> Result<u64> {
         Decoder::unsigned(self, model)
     }
-    fn signed(&mut self, _: i64, model: &mut IntModel) -> Result<i64> {
-        Decoder::signed(self, model)
+    fn signed_with(&mut self, _: i64, models: SignedModels) -> Result<i64> {
+        Decoder::signed_with(self, models)
     }
     fn raw_bits(&mut self, _: u64, n: u32) -> Result<u64> {
         Decoder::raw_bits(self, n)

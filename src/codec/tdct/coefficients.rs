@@ -13,7 +13,7 @@
 
 use super::spatial::{self, Neighbourhood, Spatial};
 use crate::error::{Error, Result};
-use crate::stream::entropy::{self, BitModel, SymbolCoder, UIntModel};
+use crate::stream::entropy::{self, BitModel, SignedModels, SymbolCoder, UIntModel};
 use std::sync::Arc;
 
 pub use super::transform::{basis, forward, quantise, Inverse, DEAD_ZONE};
@@ -56,7 +56,7 @@ pub struct Rounding<'a> {
 }
 
 impl Rounding<'_> {
-    fn choose(&self, i: usize, prediction: i64, model: &ValueModel) -> i64 {
+    fn choose(&self, i: usize, prediction: i64, model: &SignedModels) -> i64 {
         let x = self.scaled[i];
         let below = x.floor() as i64;
         let price = |l: i64| {
@@ -81,36 +81,6 @@ fn magnitude_class(magnitude: u64) -> usize {
         3..=4 => 3,
         5..=8 => 4,
         _ => MAGNITUDES - 1,
-    }
-}
-
-/// The two models one coded value goes through: its magnitude's and, when non-zero, its sign's.
-struct ValueModel<'a> {
-    magnitude: &'a mut UIntModel,
-    sign: &'a mut BitModel,
-}
-
-impl ValueModel<'_> {
-    /// Bits that coding `value` would cost now.
-    fn cost(&self, value: i64) -> f64 {
-        let sign = if value == 0 {
-            0.0
-        } else {
-            self.sign.cost(value < 0)
-        };
-        self.magnitude.cost(value.unsigned_abs()) + sign
-    }
-
-    /// Codes `value` (an encoder reads it, a decoder returns what it decodes).
-    fn code<C: SymbolCoder>(&mut self, coder: &mut C, value: i64) -> Result<i64> {
-        let magnitude = coder.unsigned(value.unsigned_abs(), self.magnitude)?;
-        let magnitude = i64::try_from(magnitude)
-            .map_err(|_| Error::Stream(format!("a level of magnitude {magnitude}")))?;
-        if magnitude != 0 && coder.bit(value < 0, self.sign)? {
-            Ok(-magnitude)
-        } else {
-            Ok(magnitude)
-        }
     }
 }
 
@@ -208,14 +178,14 @@ impl BandCoder {
                     .saturating_add(spatial::largest(&self.coded, earlier, a))
                     .div_ceil(2);
                 let near = magnitude_class(near);
-                let mut model = ValueModel {
+                let model = SignedModels {
                     magnitude: &mut magnitudes[(prev * 2 + sibling) * MAGNITUDES + near],
                     sign: &mut signs[spatial::sign_class(&self.coded, earlier, a)],
                 };
                 if let Some(r) = rounding {
                     levels[i] = r.choose(i, prediction, &model);
                 }
-                let value = model.code(coder, levels[i].wrapping_sub(prediction))?;
+                let value = coder.signed_with(levels[i].wrapping_sub(prediction), model)?;
                 self.coded[i] = value;
                 levels[i] = value.wrapping_add(prediction);
                 self.previous[i] = levels[i].unsigned_abs().min(255) as u8;
