@@ -77,11 +77,8 @@ pub(crate) fn next_packet(
     inner: &mut encoder::Video,
 ) -> Result<Option<ffmpeg::Packet>> {
     let mut packet = ffmpeg::Packet::empty();
-    match inner.receive_packet(&mut packet) {
-        Ok(()) => Ok(Some(packet)),
-        Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => Ok(None),
-        Err(e) => Err(error(codec, "receive packet", e)),
-    }
+    let status = inner.receive_packet(&mut packet);
+    received(codec, "receive packet", status, packet)
 }
 
 /// The decoder's next picture, or `None` when it needs more input or has ended.
@@ -90,9 +87,20 @@ pub(crate) fn next_picture(
     inner: &mut decoder::Video,
 ) -> Result<Option<frame::Video>> {
     let mut picture = frame::Video::empty();
-    match inner.receive_frame(&mut picture) {
-        Ok(()) => Ok(Some(picture)),
+    let status = inner.receive_frame(&mut picture);
+    received(codec, "receive picture", status, picture)
+}
+
+/// `out` when FFmpeg's receive call filled it, `None` when it needs more input or has ended.
+fn received<T>(
+    codec: &str,
+    context: &str,
+    status: std::result::Result<(), ffmpeg::Error>,
+    out: T,
+) -> Result<Option<T>> {
+    match status {
+        Ok(()) => Ok(Some(out)),
         Err(ffmpeg::Error::Other { errno: EAGAIN }) | Err(ffmpeg::Error::Eof) => Ok(None),
-        Err(e) => Err(error(codec, "receive picture", e)),
+        Err(e) => Err(error(codec, context, e)),
     }
 }
