@@ -126,7 +126,7 @@ pub struct EncodeArgs {
     #[arg(long)]
     pub step: Option<f64>,
     /// Number of motion clusters K for k-means (default 20; with --segmentation auto, for its
-    /// k-means candidate).
+    /// k-means candidate; tdct's auto also tries 1.5 K and 2 K).
     #[arg(long)]
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or

@@ -102,7 +102,7 @@ pub fn encode_with_progress(
     };
     progress.total(mesh.frame_count() as u64);
     progress.stage("segmentation");
-    let (partition, segmentation) = analysis::segment(mesh, model.segmentation, opts.clusters)?;
+    let (partition, segmentation) = analysis::segment(mesh, model.segmentation, model.clusters)?;
     clock.lap("segmentation");
     progress.stage("motion");
     let reference = &ff.decoded_positions;
@@ -238,7 +238,7 @@ fn header(
         padding: params.padding.clone(),
         // Decimation asks for no K: the header then records the K it found.
         requested_clusters: match model.segmentation {
-            Segmentation::KMeans => opts.clusters as u32,
+            Segmentation::KMeans => model.clusters as u32,
             Segmentation::Decimation { .. } => partition.clusters() as u32,
         },
         reorder: opts.reorder,
