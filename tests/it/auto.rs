@@ -40,6 +40,8 @@ fn rigid_pair() -> AnimatedMesh {
     })
 }
 
+/// Options with K = 2 and the first frame at the default 12 bits (tdct would otherwise try other
+/// precisions too, see `first_frame_bits.rs`).
 fn opts(
     codec: Codec,
     predictor: PredictorChoice,
@@ -48,6 +50,7 @@ fn opts(
     EncodeOptions {
         codec,
         clusters: 2,
+        first_frame_bits: Some(12),
         predictor,
         segmentation,
         padding: (codec != Codec::Tdct).then_some(padding::Method::Cg),

@@ -80,6 +80,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             .gop
             .map_or(defaults.gop, |g| usize::try_from(g).unwrap_or(usize::MAX)),
         reorder: args.reorder,
+        first_frame_bits: args.first_frame_bits,
         predictor: match args.predictor {
             PredictorChoice::Affine => Predictor::Fixed(PredictorKind::Affine),
             PredictorChoice::Skinning => Predictor::Fixed(PredictorKind::Skinning),
