@@ -89,7 +89,6 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         weight_bits: args.weight_bits,
         step: args.step,
         uv_bits: args.uv_bits,
-        ..defaults
     })
 }
 
