@@ -1,5 +1,6 @@
 //! tdct's choice of first-frame precision, when the caller leaves `first_frame_bits` open: the
-//! animation is coded at each of [`FIRST_FRAME_BITS_TRIED`] and the smallest stream is kept.
+//! animation is coded at the precisions of [`FIRST_FRAME_BITS_TRIED`], finer to coarser while the
+//! stream shrinks, and the smallest stream is kept.
 //!
 //! The temporal DCT codes frame 0's residual like any other frame's, so a coarser first frame is
 //! corrected down to the quality's step: the bits move from the first-frame coder into the
@@ -13,7 +14,7 @@ use super::{encode_once, EncodeOptions, Encoded, PredictorChoice, Segmentation};
 use crate::error::Result;
 use crate::mesh::AnimatedMesh;
 use crate::progress::Progress;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 pub use super::options::FIRST_FRAME_BITS_TRIED;
 
@@ -26,17 +27,20 @@ pub struct FirstFrameTrial {
     pub bytes: u64,
 }
 
-/// Codes `mesh` at every precision of [`FIRST_FRAME_BITS_TRIED`] and keeps the smallest stream
-/// (the default on a tie); its report lists the trials.
+/// Codes `mesh` at the precisions of [`FIRST_FRAME_BITS_TRIED`], finer to coarser until one does
+/// not shrink the stream, and keeps the smallest (the default on a tie); its report lists the
+/// trials.
 pub(super) fn choose(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
     progress: &dyn Progress,
 ) -> Result<Encoded> {
     let [default, others @ ..] = FIRST_FRAME_BITS_TRIED;
+    let frames = mesh.frame_count() as u64;
     let progress = Ahead {
         inner: progress,
-        extra: (others.len() * mesh.frame_count()) as u64,
+        extra: others.len() as u64 * frames,
+        first: AtomicU64::new(0),
         told: AtomicBool::new(false),
     };
     let at = |bits: u8, base: &EncodeOptions| EncodeOptions {
@@ -56,11 +60,14 @@ pub(super) fn choose(
             bits,
             bytes: encoded.report.bytes,
         });
-        if encoded.report.bytes < best.report.bytes {
-            let choice = best.report.choice.take();
-            best = encoded;
-            best.report.choice = choice;
+        if encoded.report.bytes >= best.report.bytes {
+            // Coarser still has not helped where this did not (the media samples and the cloth).
+            progress.retell(trials.len() as u64 - 1, frames);
+            break;
         }
+        let choice = best.report.choice.take();
+        best = encoded;
+        best.report.choice = choice;
     }
     best.report.first_frame_trials = trials;
     Ok(best)
@@ -87,7 +94,17 @@ fn chosen_model(encoded: &Encoded, opts: &EncodeOptions) -> EncodeOptions {
 struct Ahead<'a> {
     inner: &'a dyn Progress,
     extra: u64,
+    /// The first encoding's own total.
+    first: AtomicU64,
     told: AtomicBool,
+}
+
+impl Ahead<'_> {
+    /// Tells the total again when the trials stop after `run` of them, `frames` frames each.
+    fn retell(&self, run: u64, frames: u64) {
+        self.inner
+            .total(self.first.load(Ordering::Relaxed) + run * frames);
+    }
 }
 
 impl Progress for Ahead<'_> {
@@ -97,6 +114,7 @@ impl Progress for Ahead<'_> {
 
     fn total(&self, frames: u64) {
         if !self.told.swap(true, Ordering::Relaxed) {
+            self.first.store(frames, Ordering::Relaxed);
             self.inner.total(frames + self.extra);
         }
     }

@@ -37,8 +37,14 @@ fn tdct_keeps_the_smallest_precision_and_its_stream_is_the_fixed_ones() {
         assert_eq!(open.first_frame_bits, None, "open by default");
         let encoded = encode(&mesh, &open).expect("encodes");
         let trials = &encoded.report.first_frame_trials;
+        // Finer to coarser, stopping after the first precision that did not shrink the stream.
         let bits: Vec<u8> = trials.iter().map(|t| t.bits).collect();
-        assert_eq!(bits, FIRST_FRAME_BITS_TRIED);
+        assert_eq!(bits, FIRST_FRAME_BITS_TRIED[..bits.len()], "{trials:?}");
+        let shrinking = trials
+            .windows(2)
+            .take_while(|w| w[1].bytes < w[0].bytes)
+            .count();
+        assert!(shrinking + 2 >= bits.len(), "{trials:?}");
         let smallest = trials.iter().min_by_key(|t| t.bytes).expect("trials");
         assert_eq!(encoded.report.bytes, smallest.bytes, "{trials:?}");
         let header = &encoded.report.header;
@@ -119,8 +125,8 @@ fn the_trials_are_announced_once_and_picture_codecs_do_not_try() {
     let (total, done) = (counter.total.into_inner(), counter.done.into_inner());
     assert_eq!(total, done);
     let frames = mesh.frame_count() as u64;
-    // 8 model candidates at 12 bits, then the kept model at 10 and 8 bits.
-    assert_eq!(total, 8 * frames + 2 * frames);
+    // 8 model candidates at 12 bits, then the kept model at 10 (and 8) bits.
+    assert!([9, 10].contains(&(total / frames)), "{total}");
     let jpeg = EncodeOptions {
         codec: Codec::Jpeg,
         ..tdct(50)
