@@ -296,6 +296,21 @@ fn encode_one(
         ),
         None => line,
     };
+    let line = match r.first_frame_trials.as_slice() {
+        [] => line,
+        trials => {
+            let tried: Vec<String> = trials
+                .iter()
+                .map(|t| format!("{} bits {} bytes", t.bits, t.bytes))
+                .collect();
+            format!(
+                "{line}
+first frame: kept {} bits of {}",
+                r.header.first_frame_bits,
+                tried.join(", ")
+            )
+        }
+    };
     // With `-o -` stdout carries the stream: the report goes to stderr.
     if to_stdout {
         eprintln!("{line}");
