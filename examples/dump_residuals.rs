@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mesh.frame(0),
         mesh.triangles(),
         &first_frame::FirstFrameOptions {
-            bits: opts.first_frame_bits,
+            bits: opts.first_frame_bits_or_default(),
             reorder: false,
         },
     )?;

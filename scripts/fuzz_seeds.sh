@@ -37,6 +37,9 @@ tdct=(--codec tdct --clusters 4 --fps 6 --quality 10 --quiet)
 # CesiumMan's do; a few frames keep the seed small.
 "$bin" encode "$media/CesiumMan.glb" -o "$out/decode_stream/tdct-spatial.mcgv" --codec tdct --clusters 4 \
 	--fps 2 --quality 90 --quiet
+# A coarse first frame the residuals correct (tdct's first-frame trials keep 8-12 bits).
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/tdct-ff8.mcgv" --first-frame-bits 8 \
+	"${tdct[@]}"
 # Decimation finds K itself, so it takes no --clusters.
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-decimation.mcgv" --codec jpeg \
 	--segmentation decimation --lattice 64x64 --fps 6 --quiet

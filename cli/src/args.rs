@@ -126,7 +126,7 @@ pub struct EncodeArgs {
     #[arg(long)]
     pub step: Option<f64>,
     /// Number of motion clusters K for k-means (default 20; with --segmentation auto, for its
-    /// k-means candidate).
+    /// k-means candidate; tdct's auto also tries 1.5 K and 2 K).
     #[arg(long)]
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or
@@ -161,6 +161,10 @@ pub struct EncodeArgs {
     /// Let the first-frame coder reorder vertices for fewer bits (default keeps the input order).
     #[arg(long)]
     pub reorder: bool,
+    /// Bits per coordinate of the first frame, 1..=24 [default: 12; tdct tries 12, 10 and 8 and
+    /// keeps the smallest stream, see --json's first_frame_trials].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=24))]
+    pub first_frame_bits: Option<u8>,
     /// Motion predictor: one affine map per cluster, per-vertex skinning weights over
     /// neighbouring clusters' maps (coded in the stream; the decoder follows the stream's choice),
     /// or auto: both are tried at the quality's step and the smaller stream is kept.

@@ -48,7 +48,7 @@ pub fn first_frame(
         mesh.frame(0),
         mesh.triangles(),
         &FirstFrameOptions {
-            bits: opts.first_frame_bits,
+            bits: opts.first_frame_bits_or_default(),
             reorder: opts.reorder,
         },
     )?;

@@ -109,12 +109,17 @@ pub(super) fn choose(
         .iter()
         .map(|_| AtlasCache::default())
         .collect();
-    for (&segmentation, atlas) in segmentations.iter().zip(&atlases) {
-        progress.stage(&format!("segmentation ({})", segmentation.name()));
-        let (partition, segmented) = analysis::segment(mesh, segmentation, opts.clusters)?;
+    for (&(segmentation, k), atlas) in segmentations.iter().zip(&atlases) {
+        let stage = match segmentation {
+            Segmentation::KMeans => format!("segmentation (kmeans, K = {k})"),
+            Segmentation::Decimation { .. } => "segmentation (decimation)".to_string(),
+        };
+        progress.stage(&stage);
+        let (partition, segmented) = analysis::segment(mesh, segmentation, k)?;
         let track = analysis::fit_track(mesh, reference, &partition, opts)?;
-        clock.lap(&format!("segmentation ({})", segmentation.name()));
-        for &model in models.iter().filter(|m| m.segmentation == segmentation) {
+        clock.lap(&stage);
+        let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);
+        for &model in models.iter().filter(same) {
             let start = Instant::now();
             let progress = Labelled {
                 inner: progress,
@@ -234,12 +239,13 @@ fn keep(
     }
 }
 
-/// The distinct segmentations of `models`, in order.
-fn segmentations(models: &[MotionModel]) -> Vec<Segmentation> {
-    let mut distinct: Vec<Segmentation> = Vec::new();
+/// The distinct segmentations of `models` (with k-means's K), in order.
+fn segmentations(models: &[MotionModel]) -> Vec<(Segmentation, usize)> {
+    let mut distinct: Vec<(Segmentation, usize)> = Vec::new();
     for model in models {
-        if !distinct.contains(&model.segmentation) {
-            distinct.push(model.segmentation);
+        let partition = (model.segmentation, model.clusters);
+        if !distinct.contains(&partition) {
+            distinct.push(partition);
         }
     }
     distinct
@@ -247,7 +253,10 @@ fn segmentations(models: &[MotionModel]) -> Vec<Segmentation> {
 
 /// Why candidate `chosen` was kept, in words: its margin over the runner-up.
 fn reason(candidates: &[Candidate], chosen: usize, trial_frames: usize, frames: usize) -> String {
-    let name = |c: &Candidate| format!("{}+{}", c.predictor.name(), c.segmentation);
+    let name = |c: &Candidate| {
+        let model = format!("{}+{}", c.predictor.name(), c.segmentation);
+        format!("{model} ({} clusters)", c.clusters)
+    };
     let winner = &candidates[chosen];
     let runner_up = candidates
         .iter()

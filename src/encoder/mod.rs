@@ -5,13 +5,16 @@
 pub mod analysis;
 mod attributes;
 pub mod auto;
+pub mod first_frame_bits;
 mod options;
 
 pub use analysis::{Prediction, SegmentationReport};
 pub use auto::{Candidate, ChoiceReport};
+pub use first_frame_bits::FirstFrameTrial;
 pub use options::{
-    default_affine_precision, EncodeOptions, MotionModel, PredictorChoice, Segmentation,
-    SegmentationChoice, DEFAULT_QUALITY,
+    default_affine_precision, kmeans_ladder, EncodeOptions, MotionModel, PredictorChoice,
+    Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS, DEFAULT_QUALITY,
+    FIRST_FRAME_BITS_TRIED,
 };
 
 use crate::codec::{CodecParams, ResidualInput};
@@ -52,6 +55,9 @@ pub struct EncodeReport {
     pub segmentation: SegmentationReport,
     /// With an automatic predictor or segmentation: the candidates measured and the one kept.
     pub choice: Option<ChoiceReport>,
+    /// tdct with the first frame's precision left open: each precision tried and its stream's
+    /// bytes (empty otherwise); the header says which was kept.
+    pub first_frame_trials: Vec<FirstFrameTrial>,
     /// If the first-frame coder reordered vertices: new index → input index.
     #[serde(skip)]
     pub permutation: Option<Vec<u32>>,
@@ -83,13 +89,26 @@ pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Encoded> {
 }
 
 /// Encodes an animation, telling `progress` each stage and each frame coded. With an automatic
-/// predictor or segmentation, every candidate is tried ([`auto`]) and the smallest stream kept.
+/// predictor or segmentation, every candidate is tried ([`auto`]) and the smallest stream kept;
+/// so are tdct's first-frame precisions when `first_frame_bits` is open ([`first_frame_bits`]).
 pub fn encode_with_progress(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
     progress: &dyn Progress,
 ) -> Result<Encoded> {
     opts.check(mesh)?;
+    match (opts.first_frame_bits, opts.codec) {
+        (None, crate::codec::Codec::Tdct) => first_frame_bits::choose(mesh, opts, progress),
+        _ => encode_once(mesh, opts, progress),
+    }
+}
+
+/// Encodes an animation at one first-frame precision (the default if `opts` leaves it open).
+fn encode_once(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    progress: &dyn Progress,
+) -> Result<Encoded> {
     let mut clock = Stopwatch::new();
     progress.stage("first frame");
     let (ff, permuted) = analysis::first_frame(mesh, opts)?;
@@ -102,7 +121,7 @@ pub fn encode_with_progress(
     };
     progress.total(mesh.frame_count() as u64);
     progress.stage("segmentation");
-    let (partition, segmentation) = analysis::segment(mesh, model.segmentation, opts.clusters)?;
+    let (partition, segmentation) = analysis::segment(mesh, model.segmentation, model.clusters)?;
     clock.lap("segmentation");
     progress.stage("motion");
     let reference = &ff.decoded_positions;
@@ -183,6 +202,7 @@ fn code(
         stage_seconds: clock.stages,
         segmentation: analysed.segmentation.clone(),
         choice: None,
+        first_frame_trials: Vec::new(),
         permutation: ff.permutation.clone(),
     };
     Ok(Encoded { container, report })
@@ -234,11 +254,11 @@ fn header(
         qscale: params.qscale,
         gop: params.gop,
         affine_precision: opts.affine_precision_code(),
-        first_frame_bits: opts.first_frame_bits,
+        first_frame_bits: opts.first_frame_bits_or_default(),
         padding: params.padding.clone(),
         // Decimation asks for no K: the header then records the K it found.
         requested_clusters: match model.segmentation {
-            Segmentation::KMeans => opts.clusters as u32,
+            Segmentation::KMeans => model.clusters as u32,
             Segmentation::Decimation { .. } => partition.clusters() as u32,
         },
         reorder: opts.reorder,

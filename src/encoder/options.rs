@@ -8,6 +8,17 @@ use crate::mesh::AnimatedMesh;
 use crate::motion::{self, PredictorKind};
 use crate::stream::header::Header;
 
+/// Bits per coordinate of the first frame unless the caller or tdct's trials pick others.
+pub const DEFAULT_FIRST_FRAME_BITS: u8 = 12;
+
+/// The first-frame bits tdct tries when the caller leaves them open, the default first (it wins
+/// ties). The temporal DCT corrects frame 0 too, so a coarser first frame moves bits from the
+/// first-frame coder into the residuals' lowest band: which side codes them cheaper depends on the
+/// mesh and the step (walking_cat: 8 bits −11 % at quality 10, 10 bits −1.2 % at 90; the cloth
+/// fixture, a flat grid the first-frame coder predicts almost exactly: 12 at every quality;
+/// docs/results.md, "First-frame bits").
+pub const FIRST_FRAME_BITS_TRIED: [u8; 3] = [DEFAULT_FIRST_FRAME_BITS, 10, 8];
+
 /// Default `quality`: the middle of the useful range, a target step of 1/1000 of the first frame's
 /// bounding-box diagonal (see [`crate::codec::quality`]).
 pub const DEFAULT_QUALITY: u8 = 50;
@@ -38,8 +49,10 @@ pub struct EncodeOptions {
     /// stored in sixteenths, 1/16..=255/16. `None` picks the codec's measured best
     /// ([`default_affine_precision`]).
     pub affine_precision: Option<f64>,
-    /// Bits per coordinate of the first frame.
-    pub first_frame_bits: u8,
+    /// Bits per coordinate of the first frame (1..=24); `None` lets the encoder choose: the
+    /// picture codecs take [`DEFAULT_FIRST_FRAME_BITS`], tdct tries each of
+    /// [`FIRST_FRAME_BITS_TRIED`] and keeps the smallest stream (`encoder::first_frame_bits`).
+    pub first_frame_bits: Option<u8>,
     /// Lattice width and height, or chosen from the mesh.
     pub lattice: Lattice,
     /// Padding of the free pixels; `None` picks the codec's measured best.
@@ -75,7 +88,7 @@ impl Default for EncodeOptions {
             // media samples at equal error too (docs/results.md), for 15–70 % more encoding time.
             segmentation: SegmentationChoice::auto(),
             affine_precision: None,
-            first_frame_bits: 12,
+            first_frame_bits: None,
             lattice: Lattice::Auto,
             padding: None,
             gop: 50,
@@ -157,8 +170,9 @@ impl From<PredictorKind> for PredictorChoice {
 pub enum SegmentationChoice {
     /// This segmentation.
     Fixed(Segmentation),
-    /// k-means (K = `EncodeOptions::clusters`) and decimation down to `e0` are tried at the
-    /// encoding's step; the smallest stream is kept.
+    /// k-means (K = `EncodeOptions::clusters`; with tdct also the larger K of
+    /// [`kmeans_ladder`]) and decimation down to `e0` are tried at the encoding's step; the
+    /// smallest stream is kept.
     Auto {
         /// Decimation's error threshold E0.
         e0: f64,
@@ -207,6 +221,20 @@ pub struct MotionModel {
     pub predictor: PredictorKind,
     /// The segmentation.
     pub segmentation: Segmentation,
+    /// k-means's K (decimation finds its own; there it is `EncodeOptions::clusters`, unused).
+    pub clusters: usize,
+}
+
+/// The k-means cluster counts an automatic segmentation tries with tdct, from the caller's `k`:
+/// k, 1.5 k and 2 k. More clusters fit the motion more closely (smaller residuals) for more side
+/// information, and which wins depends on the animation and the step: at equal vertex RMSE the
+/// walking cat kept 30 of 20/30/40 at every quality, the cloth fixture 40 from quality 30, Fox
+/// 40 at quality 90 (docs/results.md, "k-means ladder"). tdct's trials are cheap next to the
+/// segmentations; the picture codecs', coded whole (MPEG-4, HEVC, AV1), are not, so they try k.
+pub fn kmeans_ladder(k: usize) -> Vec<usize> {
+    let mut ladder = vec![k, k + k.div_ceil(2), 2 * k];
+    ladder.dedup();
+    ladder
 }
 
 impl MotionModel {
@@ -221,13 +249,23 @@ impl EncodeOptions {
     /// segmentation (each partition serves every predictor), the defaults first.
     pub fn motion_models(&self) -> Vec<MotionModel> {
         let predictors = self.predictor.candidates();
-        self.segmentation
-            .candidates()
-            .into_iter()
-            .flat_map(|segmentation| {
+        let ladder = match (self.segmentation, self.codec) {
+            (SegmentationChoice::Auto { .. }, Codec::Tdct) => kmeans_ladder(self.clusters),
+            _ => vec![self.clusters],
+        };
+        let partitions = self.segmentation.candidates().into_iter().flat_map(|s| {
+            let ks = match s {
+                Segmentation::KMeans => ladder.clone(),
+                Segmentation::Decimation { .. } => vec![self.clusters],
+            };
+            ks.into_iter().map(move |k| (s, k))
+        });
+        partitions
+            .flat_map(|(segmentation, clusters)| {
                 predictors.iter().map(move |&predictor| MotionModel {
                     predictor,
                     segmentation,
+                    clusters,
                 })
             })
             .collect()
@@ -251,7 +289,7 @@ impl EncodeOptions {
             // The segmentation is not redone: the stream carries its partition.
             segmentation: SegmentationChoice::Fixed(Segmentation::KMeans),
             affine_precision: Some(f64::from(header.affine_precision) / 16.0),
-            first_frame_bits: header.first_frame_bits,
+            first_frame_bits: Some(header.first_frame_bits),
             lattice: Lattice::Fixed(header.lattice_width, header.lattice_height),
             padding: match header.codec.has_images() {
                 true => Some(
@@ -317,6 +355,12 @@ impl EncodeOptions {
         if let Lattice::Fixed(w, h) = self.lattice {
             lattice::check(w, h)?;
         }
+        if let Some(bits) = self.first_frame_bits.filter(|b| !(1..=24).contains(b)) {
+            return Err(Error::option(
+                "first_frame_bits",
+                format!("must be between 1 and 24 bits per coordinate, not {bits}"),
+            ));
+        }
         if !(2..=31).contains(&self.weight_bits) {
             return Err(Error::option("weight_bits", "must be between 2 and 31"));
         }
@@ -352,6 +396,11 @@ impl EncodeOptions {
             return Err(Error::option("uv_bits", "must be between 1 and 24"));
         }
         Ok(())
+    }
+
+    /// The first frame's bits per coordinate of one encoding: the caller's, else the default.
+    pub fn first_frame_bits_or_default(&self) -> u8 {
+        self.first_frame_bits.unwrap_or(DEFAULT_FIRST_FRAME_BITS)
     }
 
     /// `affine_precision` as the header stores it: in sixteenths, 1..=255.

@@ -4,7 +4,8 @@
 use crate::common::{animate, decoder, tube};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{
-    encode, encode_with_progress, EncodeOptions, PredictorChoice, Segmentation, SegmentationChoice,
+    encode, encode_with_progress, Candidate, EncodeOptions, PredictorChoice, Segmentation,
+    SegmentationChoice,
 };
 use mcgv_video::mesh::{AnimatedMesh, Point};
 use mcgv_video::motion::PredictorKind;
@@ -39,6 +40,8 @@ fn rigid_pair() -> AnimatedMesh {
     })
 }
 
+/// Options with K = 2 and the first frame at the default 12 bits (tdct would otherwise try other
+/// precisions too, see `first_frame_bits.rs`).
 fn opts(
     codec: Codec,
     predictor: PredictorChoice,
@@ -47,6 +50,7 @@ fn opts(
     EncodeOptions {
         codec,
         clusters: 2,
+        first_frame_bits: Some(12),
         predictor,
         segmentation,
         padding: (codec != Codec::Tdct).then_some(padding::Method::Cg),
@@ -114,6 +118,8 @@ fn auto_keeps_skinning_on_a_skinned_bend_and_its_stream_is_the_fixed_ones() {
 #[test]
 fn auto_keeps_affine_on_rigid_parts_and_the_default_on_a_tie() {
     // Both segmentations find the two tubes, so they tie; skinning adds its weights (31 bytes).
+    // tdct also tries k-means at 1.5 K and 2 K (3 and 4): more clusters than parts only add
+    // side information.
     let mesh = rigid_pair();
     let options = opts(
         Codec::Tdct,
@@ -127,21 +133,62 @@ fn auto_keeps_affine_on_rigid_parts_and_the_default_on_a_tie() {
         .iter()
         .map(|c| format!("{}+{}", c.predictor.name(), c.segmentation))
         .collect();
-    assert_eq!(
-        names,
-        [
-            "affine+kmeans",
-            "skinning+kmeans",
-            "affine+decimation",
-            "skinning+decimation"
-        ]
-    );
+    let pair = ["affine+kmeans", "skinning+kmeans"];
+    let expected: Vec<&str> = [
+        pair,
+        pair,
+        pair,
+        ["affine+decimation", "skinning+decimation"],
+    ]
+    .concat();
+    assert_eq!(names, expected);
     let bytes: Vec<u64> = choice.candidates.iter().map(|c| c.bytes).collect();
-    assert_eq!(bytes[0], bytes[2], "{bytes:?}");
+    assert_eq!(bytes[0], bytes[6], "{bytes:?}");
     assert!(bytes[1] > bytes[0], "{bytes:?}");
+    assert!(bytes[2..6].iter().all(|&b| b >= bytes[0]), "{bytes:?}");
     assert_eq!(choice.chosen, "affine+kmeans");
+    assert_eq!(choice.candidates[0].clusters, 2);
     assert_eq!(encoded.report.segmentation.method, "kmeans");
     assert_eq!(encoded.report.header.predictor, PredictorKind::Affine);
+    assert_eq!(encoded.report.header.requested_clusters, 2);
+}
+
+#[test]
+fn tdct_tries_a_ladder_of_cluster_counts_and_keeps_the_smallest() {
+    let mesh = skinned_bend();
+    let options = opts(
+        Codec::Tdct,
+        PredictorKind::Affine.into(),
+        SegmentationChoice::auto(),
+    );
+    let encoded = encode(&mesh, &options).expect("encodes");
+    let choice = encoded.report.choice.expect("a choice");
+    let kmeans: Vec<&Candidate> = (choice.candidates.iter())
+        .filter(|c| c.segmentation == "kmeans")
+        .collect();
+    assert_eq!(kmeans.len(), 3, "{choice:?}");
+    let smallest = choice.candidates.iter().map(|c| c.bytes).min();
+    assert_eq!(Some(encoded.report.bytes), smallest, "{choice:?}");
+    // Each rung is the fixed encoding at that K, and the header records the K asked for.
+    for (c, k) in kmeans.iter().zip([2, 3, 4]) {
+        let fixed = EncodeOptions {
+            clusters: k,
+            ..opts(
+                Codec::Tdct,
+                PredictorKind::Affine.into(),
+                Segmentation::KMeans.into(),
+            )
+        };
+        let bytes = encode(&mesh, &fixed).expect("encodes").to_bytes();
+        assert_eq!(bytes.len() as u64, c.bytes, "K = {k}");
+    }
+    // The picture codecs, whose trials are whole encodings, try the caller's K only.
+    let jpeg = opts(
+        Codec::Jpeg,
+        PredictorKind::Affine.into(),
+        SegmentationChoice::auto(),
+    );
+    assert_eq!(jpeg.motion_models().len(), 2);
 }
 
 #[test]
@@ -208,9 +255,10 @@ impl Progress for Counter {
 fn progress_announces_the_trials_frames_and_reports_them_all() {
     let mesh = skinned_bend();
     let frames = mesh.frame_count() as u64;
-    // tdct and MPEG-4 code every candidate whole; JPEG 12 frames each, then the winner whole.
+    // tdct and MPEG-4 code every candidate whole (tdct's k-means at three K); JPEG 12 frames each,
+    // then the winner whole.
     let codecs = [
-        (Codec::Tdct, 4 * frames),
+        (Codec::Tdct, 8 * frames),
         (Codec::Mpeg4, 4 * frames),
         (Codec::Jpeg, 4 * 12 + frames),
     ];

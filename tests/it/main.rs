@@ -12,6 +12,7 @@ mod codec;
 mod decimate;
 mod error_law;
 mod first_frame;
+mod first_frame_bits;
 mod fuzz_regressions;
 mod gltf_write;
 mod hostile_meshes;

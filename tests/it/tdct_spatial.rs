@@ -22,7 +22,7 @@ pub fn coefficients_of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<Vec<f64
         mesh.frame(0),
         mesh.triangles(),
         &FirstFrameOptions {
-            bits: opts.first_frame_bits,
+            bits: opts.first_frame_bits_or_default(),
             reorder: false,
         },
     )

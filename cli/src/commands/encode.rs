@@ -80,6 +80,7 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             .gop
             .map_or(defaults.gop, |g| usize::try_from(g).unwrap_or(usize::MAX)),
         reorder: args.reorder,
+        first_frame_bits: args.first_frame_bits,
         predictor: match args.predictor {
             PredictorChoice::Affine => Predictor::Fixed(PredictorKind::Affine),
             PredictorChoice::Skinning => Predictor::Fixed(PredictorKind::Skinning),
@@ -88,7 +89,6 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         weight_bits: args.weight_bits,
         step: args.step,
         uv_bits: args.uv_bits,
-        ..defaults
     })
 }
 
@@ -295,6 +295,21 @@ fn encode_one(
             choice.reason
         ),
         None => line,
+    };
+    let line = match r.first_frame_trials.as_slice() {
+        [] => line,
+        trials => {
+            let tried: Vec<String> = trials
+                .iter()
+                .map(|t| format!("{} bits {} bytes", t.bits, t.bytes))
+                .collect();
+            format!(
+                "{line}
+first frame: kept {} bits of {}",
+                r.header.first_frame_bits,
+                tried.join(", ")
+            )
+        }
     };
     // With `-o -` stdout carries the stream: the report goes to stderr.
     if to_stdout {

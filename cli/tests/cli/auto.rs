@@ -10,13 +10,22 @@ fn auto_reports_its_candidates_and_keeps_the_smallest() {
     let s = stream.to_str().expect("utf-8 path");
     let sample = media_path("RiggedSimple.glb");
     let base = ["encode", sample.as_str(), "-o", s, "--quiet"];
-    let auto = ["--predictor", "auto", "--segmentation", "auto"];
+    // The first frame at 12 bits: the size of the kept model's stream is then a candidate's.
+    let auto = [
+        "--predictor",
+        "auto",
+        "--segmentation",
+        "auto",
+        "--first-frame-bits",
+        "12",
+    ];
     let enc = json(&run(
         &[&base[..], &auto, &["--json", "--e0", "0.004"]].concat()
     ));
     let choice = &enc["choice"];
     let candidates = choice["candidates"].as_array().expect("candidates");
-    assert_eq!(candidates.len(), 4, "{enc}");
+    // tdct's k-means at K, 1.5 K and 2 K, decimation, each with both predictors.
+    assert_eq!(candidates.len(), 8, "{enc}");
     let smallest = candidates
         .iter()
         .min_by_key(|c| c["bytes"].as_u64().expect("bytes"))
@@ -38,9 +47,16 @@ fn auto_reports_its_candidates_and_keeps_the_smallest() {
     // auto is the default; the text report says what was kept; fixed flags choose nothing.
     let default = json(&run(&[&base[..], &["--json", "--e0", "0.004"]].concat()));
     assert_eq!(default["choice"]["chosen"], choice["chosen"], "{default}");
-    assert_eq!(default["bytes"], enc["bytes"]);
-    let text = ok(&run(&[&base[..4], &auto, &["--clusters", "5"]].concat()));
+    // With the first frame's precision open too, the stream is the smallest of its trials.
+    let trials = default["first_frame_trials"].as_array().expect("trials");
+    assert_eq!(trials[0]["bytes"], enc["bytes"], "{default}");
+    let least = trials.iter().filter_map(|t| t["bytes"].as_u64()).min();
+    assert_eq!(default["bytes"].as_u64(), least, "{default}");
+    let text = ok(&run(
+        &[&base[..4], &auto[..4], &["--clusters", "5"]].concat()
+    ));
     assert!(text.contains("auto: kept"), "{text}");
+    assert!(text.contains("first frame: kept"), "{text}");
     let fixed = [
         "--predictor",
         "affine",

@@ -1,0 +1,143 @@
+//! tdct's choice of first-frame precision (`EncodeOptions::first_frame_bits: None`): every
+//! precision of `FIRST_FRAME_BITS_TRIED` is coded with the motion model chosen at the default, the
+//! smallest stream is kept, and the temporal DCT corrects a coarser first frame down to the step.
+
+use crate::common::{animate, decoder, tube};
+use mcgv_video::codec::Codec;
+use mcgv_video::encoder::{encode, encode_with_progress, EncodeOptions, FIRST_FRAME_BITS_TRIED};
+use mcgv_video::mesh::{AnimatedMesh, Point};
+use mcgv_video::metrics;
+use mcgv_video::Progress;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// A bulging tube that waves: a shape the first-frame coder cannot predict exactly.
+fn waving_tube() -> AnimatedMesh {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, -2.0, 2.0, 30, 16);
+    animate(&points, tris, 24, |t, _, p: Point| {
+        let wave = 0.3 * (1.7 * p[0] + 4.0 * t).sin();
+        [p[0], p[1] + wave, p[2] + 0.5 * wave * p[1]]
+    })
+}
+
+fn tdct(quality: u8) -> EncodeOptions {
+    EncodeOptions {
+        quality,
+        clusters: 4,
+        ..EncodeOptions::default()
+    }
+}
+
+#[test]
+fn tdct_keeps_the_smallest_precision_and_its_stream_is_the_fixed_ones() {
+    let mesh = waving_tube();
+    let mut kept_bits = Vec::new();
+    for quality in [10, 90] {
+        let open = tdct(quality);
+        assert_eq!(open.first_frame_bits, None, "open by default");
+        let encoded = encode(&mesh, &open).expect("encodes");
+        let trials = &encoded.report.first_frame_trials;
+        // Finer to coarser, stopping after the first precision that did not shrink the stream.
+        let bits: Vec<u8> = trials.iter().map(|t| t.bits).collect();
+        assert_eq!(bits, FIRST_FRAME_BITS_TRIED[..bits.len()], "{trials:?}");
+        let shrinking = trials
+            .windows(2)
+            .take_while(|w| w[1].bytes < w[0].bytes)
+            .count();
+        assert!(shrinking + 2 >= bits.len(), "{trials:?}");
+        let smallest = trials.iter().min_by_key(|t| t.bytes).expect("trials");
+        assert_eq!(encoded.report.bytes, smallest.bytes, "{trials:?}");
+        let header = &encoded.report.header;
+        assert_eq!(header.first_frame_bits, smallest.bits, "{trials:?}");
+        // The kept stream is what the chosen model at the chosen precision codes when fixed.
+        let choice = encoded.report.choice.as_ref().expect("auto model");
+        let chosen = choice
+            .candidates
+            .iter()
+            .min_by_key(|c| c.bytes)
+            .expect("one");
+        let fixed = EncodeOptions {
+            first_frame_bits: Some(smallest.bits),
+            predictor: header.predictor.into(),
+            segmentation: match chosen.segmentation {
+                "kmeans" => mcgv_video::encoder::Segmentation::KMeans.into(),
+                _ => mcgv_video::encoder::SegmentationChoice::Fixed(
+                    mcgv_video::encoder::Segmentation::Decimation {
+                        e0: encoded.report.segmentation.e0.expect("decimation's e0"),
+                    },
+                ),
+            },
+            clusters: header.requested_clusters as usize,
+            ..open.clone()
+        };
+        let again = encode(&mesh, &fixed).expect("encodes");
+        assert!(again.report.first_frame_trials.is_empty());
+        assert_eq!(again.to_bytes(), encoded.to_bytes(), "quality {quality}");
+        kept_bits.push(smallest.bits);
+    }
+    // The coarse step keeps a coarser first frame than the fine one.
+    assert!(kept_bits[0] < kept_bits[1], "{kept_bits:?}");
+}
+
+#[test]
+fn a_coarse_first_frame_is_corrected_down_to_the_step() {
+    let mesh = waving_tube();
+    let error = |bits: u8| {
+        let opts = EncodeOptions {
+            first_frame_bits: Some(bits),
+            ..tdct(70)
+        };
+        let bytes = encode(&mesh, &opts).expect("encodes").to_bytes();
+        let decoded = decoder(bytes)
+            .expect("opens")
+            .decode_all()
+            .expect("decodes");
+        metrics::vertex_errors(&mesh, &decoded)
+            .expect("comparable")
+            .rmse
+    };
+    let (fine, coarse) = (error(12), error(8));
+    // 8 bits alone would leave 1/512 of the box on frame 0; the residuals take it to the step.
+    assert!(coarse < 1.15 * fine, "8 bits {coarse}, 12 bits {fine}");
+}
+
+#[derive(Default)]
+struct Counter {
+    total: AtomicU64,
+    done: AtomicU64,
+}
+
+impl Progress for Counter {
+    fn total(&self, frames: u64) {
+        self.total.store(frames, Ordering::Relaxed);
+    }
+
+    fn frames(&self, count: u64) {
+        self.done.fetch_add(count, Ordering::Relaxed);
+    }
+}
+
+#[test]
+fn the_trials_are_announced_once_and_picture_codecs_do_not_try() {
+    let mesh = waving_tube();
+    let counter = Counter::default();
+    encode_with_progress(&mesh, &tdct(50), &counter).expect("encodes");
+    let (total, done) = (counter.total.into_inner(), counter.done.into_inner());
+    assert_eq!(total, done);
+    let frames = mesh.frame_count() as u64;
+    // 8 model candidates at 12 bits, then the kept model at 10 (and 8) bits.
+    assert!([9, 10].contains(&(total / frames)), "{total}");
+    let jpeg = EncodeOptions {
+        codec: Codec::Jpeg,
+        ..tdct(50)
+    };
+    let encoded = encode(&mesh, &jpeg).expect("encodes");
+    assert!(encoded.report.first_frame_trials.is_empty());
+    assert_eq!(encoded.report.header.first_frame_bits, 12);
+    let refused = EncodeOptions {
+        first_frame_bits: Some(30),
+        ..tdct(50)
+    };
+    let err = encode(&mesh, &refused).err().expect("refused").to_string();
+    assert!(err.contains("first_frame_bits"), "{err}");
+}
