@@ -74,7 +74,8 @@ struct Anchor {
 /// `eval`, surface RMSE; docs/results.md, "Quality laws on the smallest lattice"):
 /// - quality 50, 0.8 → 0.25: the hardest sequence, horse-collapse, reaches 3.8e-4 at pixel step
 ///   3e-4 and 5.3e-4 at 5e-4; the walking cat 3.9e-4 at 4e-4 (6.6 bpvf) and 2.3e-4 at 2e-4
-///   (9.6 bpvf); so quality 50 lands at about 2–3.5e-4 and under 10 bpvf on the media sequences.
+///   (9.6 bpvf); quality 50 now lands at 1.8–3.3e-4 (Fox 0.67e-4) for 2.3–8.0 bpvf on the eight
+///   media sequences of at least 1000 vertices.
 /// - quality 75, 0.6 → 0.4 with JPEG quality 90 (pixel step 2e-4: 1.1e-4 on the cat, 9e-5 on
 ///   CesiumMan, about tdct's error at 75). Scaled as quality 50's (0.19) it reached the cat's
 ///   8-bit floor (5.4e-5, the range of its residuals over 255 levels) already at 75, leaving
@@ -94,8 +95,9 @@ const JPEG_LAW: [Anchor; 4] = [
 /// - quality 50, 0.8 → 0.21 (quality 1, 3.0 → 0.8, scaled alike): at qscale 2, surface RMSE 4e-4
 ///   needs pixel step 2.3e-4 on horse-collapse (3.4 bpvf), the hardest for error per step; the
 ///   walking cat and Cow need 5.5 and 5.2 bpvf for it (pixel step 4e-4 and 2.9e-4) and have
-///   1.0e-3 and 5.2e-4 at 4 bpvf, so quality 50 spends more than 4 bpvf there to keep the error
-///   under 4e-4.
+///   1.0e-3 and 5.3e-4 at 4 bpvf, so quality 50 spends more than 4 bpvf there to keep the error
+///   under 4e-4 (6.5 and 6.2 bpvf at 2.9 and 3.2e-4; 1.7–3.6 bpvf at 1.8–3.6e-4 elsewhere, Fox
+///   0.36e-4).
 /// - quality 75, 0.45 → 0.27, and 90, 0.6 → 0.16: qualities 90 and 97 end at about the same
 ///   error where the 8-bit range widens the step (walking cat 8.1e-5, Cow 9.9e-5: there the
 ///   automatic choice keeps the smaller stream at the step, affine maps on the cat, though
