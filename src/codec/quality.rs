@@ -78,8 +78,8 @@ struct Anchor {
 ///   media sequences of at least 1000 vertices.
 /// - quality 75, 0.6 → 0.4 with JPEG quality 90 (pixel step 2e-4: 1.1e-4 on the cat, 9e-5 on
 ///   CesiumMan, about tdct's error at 75). Scaled as quality 50's (0.19) it reached the cat's
-///   8-bit floor (5.4e-5, the range of its residuals over 255 levels) already at 75, leaving
-///   quality 90 no lower error.
+///   floor (5.4e-5, where the 8-bit range widens the step) already at 75, leaving quality 90 no
+///   lower error (5.5e-5).
 /// - quality 90, 0.3 → 0.2 (pixel step 4e-5, at or near that floor on the cat and Cow).
 const JPEG_LAW: [Anchor; 4] = [
     anchor(1, 1.25, 75),
@@ -94,8 +94,8 @@ const JPEG_LAW: [Anchor; 4] = [
 /// the smallest lattice as JPEG's:
 /// - quality 50, 0.8 → 0.21 (quality 1, 3.0 → 0.8, scaled alike): at qscale 2, surface RMSE 4e-4
 ///   needs pixel step 2.3e-4 on horse-collapse (3.4 bpvf), the hardest for error per step; the
-///   walking cat and Cow need 5.5 and 5.2 bpvf for it (pixel step 4e-4 and 2.9e-4) and have
-///   1.0e-3 and 5.3e-4 at 4 bpvf, so quality 50 spends more than 4 bpvf there to keep the error
+///   walking cat and Cow need about 5.8 and 5.3 bpvf for it (any qscale) and have about 9.7e-4
+///   and 5.3e-4 at 4 bpvf, so quality 50 spends more than 4 bpvf there to keep the error
 ///   under 4e-4 (6.5 and 6.2 bpvf at 2.9 and 3.2e-4; 1.7–3.6 bpvf at 1.8–3.6e-4 elsewhere, Fox
 ///   0.36e-4).
 /// - quality 75, 0.45 → 0.27, and 90, 0.6 → 0.16: qualities 90 and 97 end at about the same
