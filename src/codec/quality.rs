@@ -67,23 +67,48 @@ struct Anchor {
 /// JPEG's law, read off the lower hull of (bpvf, vertex RMSE) over pixel step × JPEG quality
 /// (`examples/error_law_sweep.rs` on CesiumMan, the walking cat and Cow): the error follows
 /// about the square root of the pixel step, so the factor falls as the quality rises; JPEG quality
-/// 75 is on the hull up to a vertex RMSE of about 4e-4 of the diagonal, 90 below. Quality 50 lands
-/// at about 9e-4 (vertex RMSE; the papers' surface RMSE about 4e-4) on CesiumMan.
+/// 75 is on the hull up to a vertex RMSE of about 4e-4 of the diagonal, 90 below. The shape was
+/// read on the former automatic lattice (about 28 pixels a vertex); on the smallest lattice the
+/// charts fit (`Lattice::Auto` since then) one pixel step gives more error for fewer bits, and
+/// the anchors were re-measured there (`mcgv-video encode SEQ --step S --jpeg-quality J` and
+/// `eval`, surface RMSE; docs/results.md, "Quality laws on the smallest lattice"):
+/// - quality 50, 0.8 → 0.25: the hardest sequence, horse-collapse, reaches 3.8e-4 at pixel step
+///   3e-4 and 5.3e-4 at 5e-4; the walking cat 3.9e-4 at 4e-4 (6.6 bpvf) and 2.3e-4 at 2e-4
+///   (9.6 bpvf); quality 50 now lands at 1.8–3.3e-4 (Fox 0.67e-4) for 2.3–8.0 bpvf on the eight
+///   media sequences of at least 1000 vertices.
+/// - quality 75, 0.6 → 0.4 with JPEG quality 90 (pixel step 2e-4: 1.1e-4 on the cat, 9e-5 on
+///   CesiumMan, about tdct's error at 75). Scaled as quality 50's (0.19) it reached the cat's
+///   floor (5.4e-5, where the 8-bit range widens the step) already at 75, leaving quality 90 no
+///   lower error (5.5e-5).
+/// - quality 90, 0.3 → 0.2 (pixel step 4e-5, at or near that floor on the cat and Cow).
 const JPEG_LAW: [Anchor; 4] = [
-    anchor(1, 4.0, 75),
-    anchor(50, 0.8, 75),
-    anchor(75, 0.6, 90),
-    anchor(90, 0.3, 90),
+    anchor(1, 1.25, 75),
+    anchor(50, 0.25, 75),
+    anchor(75, 0.4, 90),
+    anchor(90, 0.2, 90),
 ];
 
 /// MPEG-4's law, made as [`JPEG_LAW`] over pixel step × qscale: qscales 1, 2 and 4 lie on one
 /// curve (error about pixel step^0.6) where the 8-bit range allows; 2 is kept, and 1 from quality
-/// 90, where finer steps meet the 8-bit floor on sequences with large residuals.
+/// 90, where finer steps meet the 8-bit floor on sequences with large residuals. Re-measured on
+/// the smallest lattice as JPEG's:
+/// - quality 50, 0.8 → 0.21 (quality 1, 3.0 → 0.8, scaled alike): at qscale 2, surface RMSE 4e-4
+///   needs pixel step 2.3e-4 on horse-collapse (3.4 bpvf), the hardest for error per step; the
+///   walking cat and Cow need about 5.8 and 5.3 bpvf for it (any qscale) and have about 9.7e-4
+///   and 5.3e-4 at 4 bpvf, so quality 50 spends more than 4 bpvf there to keep the error
+///   under 4e-4 (6.5 and 6.2 bpvf at 2.9 and 3.2e-4; 1.7–3.6 bpvf at 1.8–3.6e-4 elsewhere, Fox
+///   0.36e-4).
+/// - quality 75, 0.45 → 0.27, and 90, 0.6 → 0.16: qualities 90 and 97 end at about the same
+///   error where the 8-bit range widens the step (walking cat 8.1e-5, Cow 9.9e-5: there the
+///   automatic choice keeps the smaller stream at the step, affine maps on the cat, though
+///   skinning reaches 4.2e-5 at 97 for 30 % more bytes), so quality 75 stays at least twice above
+///   that: 0.24 gave the cat 1.8e-4 but Cow 1.92e-4 (1.94×); 0.16 and 0.12 gave the cat 1.3e-4
+///   and, with affine maps, 1.6e-4.
 const MPEG4_LAW: [Anchor; 4] = [
-    anchor(1, 3.0, 2),
-    anchor(50, 0.8, 2),
-    anchor(75, 0.45, 2),
-    anchor(90, 0.6, 1),
+    anchor(1, 0.8, 2),
+    anchor(50, 0.21, 2),
+    anchor(75, 0.27, 2),
+    anchor(90, 0.16, 1),
 ];
 
 const fn anchor(quality: u8, step_factor: f64, quantiser: u8) -> Anchor {
@@ -105,8 +130,10 @@ pub fn jpeg_law(quality: u8) -> PictureLaw {
 /// step × QP on CesiumMan (docs/results.md): the error follows step × 2^(QP/6) and, at equal error,
 /// the rate hardly depends on how the two share it (within 3 % from QP 10 to 40), except that QPs
 /// under 10 cost more than a finer pixel step at equal error, hence the floor. Quality 50 lands on
-/// MPEG-4's error at quality 50.
-pub const HEVC_STEP_FACTOR: f64 = 0.05;
+/// MPEG-4's error at quality 50: the factor was 0.05 on the former automatic lattice; on the
+/// smallest lattice that fits, where MPEG-4's quality 50 was re-anchored 2.4× lower in error
+/// ([`MPEG4_LAW`]), it is 0.02 (docs/results.md, "Quality laws on the smallest lattice").
+pub const HEVC_STEP_FACTOR: f64 = 0.02;
 /// The QP of quality 50 at 10 bits a sample.
 pub const HEVC_QP_AT_50: f64 = 28.0;
 /// The lowest QP the law uses at 10 bits a sample.
@@ -140,7 +167,10 @@ pub fn hevc_law(quality: u8, depth: u8) -> PictureLaw {
 /// and `crf` share it (pixel step 5e-5 `crf` 32, 1e-4 `crf` 20, 2e-4 `crf` 8: 3.82, 3.71, 4.36
 /// bpvf at RMSE 2.45, 2.54, 2.20e-4) up to `crf` 32, above which libaom's constant-quality mode
 /// keeps its key frames' quantiser and the error stops growing (5e-5: `crf` 32–56 all 2.45e-4).
-pub const AV1_STEP_FACTOR: f64 = 0.1;
+/// Those figures are on the former automatic lattice, where the factor was 0.1; on the smallest
+/// lattice that fits it is 0.04, scaled as [`HEVC_STEP_FACTOR`] (docs/results.md, "Quality laws
+/// on the smallest lattice").
+pub const AV1_STEP_FACTOR: f64 = 0.04;
 /// libaom's `crf` at quality 50 at 10 bits a sample.
 pub const AV1_QP_AT_50: u8 = 32;
 /// The highest `crf` the law uses (the error stops following `crf` above it).
