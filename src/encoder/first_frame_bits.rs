@@ -47,15 +47,18 @@ pub(super) fn choose(
         first_frame_bits: Some(bits),
         ..base.clone()
     };
-    let mut best = encode_once(mesh, &at(default, opts), &progress)?;
+    let mut best = encode_once(mesh, &at(default, opts), &progress, None)?;
     let model = chosen_model(&best, opts);
+    // The segmentation runs on the animation alone, so the trials keep the first one's, unless
+    // the first-frame coder reorders the vertices (its order may change with the precision).
+    let known = (!opts.reorder).then(|| (best.partition.clone(), best.report.segmentation.clone()));
     let mut trials = vec![FirstFrameTrial {
         bits: default,
         bytes: best.report.bytes,
     }];
     for bits in others {
         progress.stage(&format!("first frame at {bits} bits"));
-        let encoded = encode_once(mesh, &at(bits, &model), &progress)?;
+        let encoded = encode_once(mesh, &at(bits, &model), &progress, known.clone())?;
         trials.push(FirstFrameTrial {
             bits,
             bytes: encoded.report.bytes,

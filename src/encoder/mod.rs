@@ -69,6 +69,8 @@ pub struct Encoded {
     pub container: ContainerWriter,
     /// The figures of the encoding.
     pub report: EncodeReport,
+    /// The motion clusters it was coded with, for trials that keep them.
+    pub(crate) partition: Partition,
 }
 
 impl Encoded {
@@ -99,15 +101,17 @@ pub fn encode_with_progress(
     opts.check(mesh)?;
     match (opts.first_frame_bits, opts.codec) {
         (None, crate::codec::Codec::Tdct) => first_frame_bits::choose(mesh, opts, progress),
-        _ => encode_once(mesh, opts, progress),
+        _ => encode_once(mesh, opts, progress, None),
     }
 }
 
-/// Encodes an animation at one first-frame precision (the default if `opts` leaves it open).
+/// Encodes an animation at one first-frame precision (the default if `opts` leaves it open); a
+/// single motion model's segmentation is `known` when a trial before found it.
 fn encode_once(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
     progress: &dyn Progress,
+    known: Option<(Partition, SegmentationReport)>,
 ) -> Result<Encoded> {
     let mut clock = Stopwatch::new();
     progress.stage("first frame");
@@ -121,7 +125,10 @@ fn encode_once(
     };
     progress.total(mesh.frame_count() as u64);
     progress.stage("segmentation");
-    let (partition, segmentation) = analysis::segment(mesh, model.segmentation, model.clusters)?;
+    let (partition, segmentation) = match known {
+        Some(known) => known,
+        None => analysis::segment(mesh, model.segmentation, model.clusters)?,
+    };
     clock.lap("segmentation");
     progress.stage("motion");
     let reference = &ff.decoded_positions;
@@ -205,7 +212,11 @@ fn code(
         first_frame_trials: Vec::new(),
         permutation: ff.permutation.clone(),
     };
-    Ok(Encoded { container, report })
+    Ok(Encoded {
+        container,
+        report,
+        partition: partition.clone(),
+    })
 }
 
 /// Seconds per stage.
