@@ -385,9 +385,9 @@ impl Decoder {
 /// P-frame groups: `biharmonic`, smooth across chart borders, what a transform codec codes cheaply
 /// (measured against the other methods at HEVC's QPs in docs/results.md). All-intra (`gop` 1):
 /// `pushpull`, measured at equal RMSE on the smallest-fitting lattice (docs/results.md, "AV1 and
-/// HEVC padding"): all-intra AV1 takes 10 % fewer bits than with `biharmonic` on walking_cat and
-/// 1–3 % on horse-gallop, all-intra HEVC 9–10 % on walking_cat; in P-frame groups it saved only
-/// 1–3 % (AV1, both sequences), so those keep `biharmonic`.
+/// HEVC padding"): all-intra AV1 takes 10 % fewer bits than with `biharmonic` on walking_cat, 3–8 %
+/// on pcow and 1–3 % on horse-gallop, all-intra HEVC 9–11 % on walking_cat; in P-frame groups the
+/// other methods saved 1–3 % or lost up to 9 % (`laplace` on pcow), so those keep `biharmonic`.
 pub fn deep_padding(gop: usize) -> padding::Method {
     if gop <= 1 {
         padding::Method::PushPull
