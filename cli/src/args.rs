@@ -151,7 +151,8 @@ pub struct EncodeArgs {
     #[arg(long, default_value = "auto")]
     pub lattice: String,
     /// jpeg, mpeg4, hevc, av1: how free pixels of the geometry images are filled [default: snap
-    /// for jpeg, biharmonic for the video codecs].
+    /// for jpeg, pushpull for all-intra hevc and av1 (--gop 1), biharmonic for the other video
+    /// codecs].
     #[arg(long, value_parser = padding_methods())]
     pub padding: Option<String>,
     /// mpeg4, hevc, av1: group of pictures, an I-frame every N frames [default: 50]; 1 makes hevc

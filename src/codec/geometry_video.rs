@@ -31,8 +31,8 @@ pub trait PictureCodec: Sync {
     fn codec(&self) -> Codec;
     /// How residual ranges are shared between frames.
     fn range_mode(&self, opts: &EncodeOptions) -> RangeMode;
-    /// The padding this codec measured best with.
-    fn default_padding(&self) -> padding::Method;
+    /// The padding this codec measured best with for an encoding with `opts` (its GOP).
+    fn default_padding(&self, opts: &EncodeOptions) -> padding::Method;
     /// The pixel step as a multiple of the target step of `opts.quality`.
     fn step_factor(&self, opts: &EncodeOptions) -> f64;
     /// The picture codec's own quantiser (MPEG-4 qscale, JPEG quality, HEVC QP), recorded in the header.
@@ -77,7 +77,7 @@ pub trait PictureDecoder {
 
 /// The padding an encoding uses: the option's, else the picture codec's measured best.
 pub fn padding_method(codec: &dyn PictureCodec, opts: &EncodeOptions) -> padding::Method {
-    opts.padding.unwrap_or(codec.default_padding())
+    opts.padding.unwrap_or(codec.default_padding(opts))
 }
 
 /// The residual images an encoding with `codec` makes of `input`'s residuals.

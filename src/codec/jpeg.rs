@@ -121,7 +121,7 @@ impl PictureCodec for Pictures {
     }
 
     /// `snap`, tuned to JPEG's quantiser at the stream's quality (padding/README.md).
-    fn default_padding(&self) -> padding::Method {
+    fn default_padding(&self, _opts: &EncodeOptions) -> padding::Method {
         padding::Method::Snap
     }
 

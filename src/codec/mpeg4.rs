@@ -323,7 +323,7 @@ impl PictureCodec for Pictures {
     }
 
     /// `biharmonic`: quality-independent, measured best with MPEG-4's quantiser (padding/README.md).
-    fn default_padding(&self) -> padding::Method {
+    fn default_padding(&self, _opts: &EncodeOptions) -> padding::Method {
         padding::Method::Biharmonic
     }
 

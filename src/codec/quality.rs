@@ -177,48 +177,66 @@ pub const AV1_STEP_FACTOR: f64 = 0.028;
 pub const AV1_QP_AT_50: u8 = 32;
 /// The highest `crf` the law uses (the error stops following `crf` above it).
 pub const AV1_MAX_QP: u8 = 32;
-/// The lowest `crf` the law uses at 10 bits a sample.
-pub const AV1_MIN_QP: u8 = 8;
-/// AV1's AC quantiser step at 10 bits a sample (the specification's `ac_qlookup_10` table,
-/// libaom's `ac_qlookup_10_QTX`) at quantiser index 4 × `crf` for `crf` 0, 4, …, 60, and at index
-/// 255 (`crf` 63): the law interpolates log-linearly between these. At 12 bits the table is about
-/// 4 × this one: the step is relative to the sample range, as HEVC's QP.
-pub const AV1_AC_STEPS: [(u8, u16); 17] = [
-    (0, 4),
-    (4, 55),
-    (8, 122),
-    (12, 195),
-    (16, 267),
-    (20, 337),
-    (24, 409),
-    (28, 539),
-    (32, 700),
-    (36, 922),
-    (40, 1218),
-    (44, 1631),
-    (48, 2199),
-    (52, 2971),
-    (56, 4028),
-    (60, 5476),
-    (63, 7312),
+/// The lowest `crf` the law uses. Not 0: with no quantiser deltas `crf` 0 is lossless coding.
+/// It was 8, which capped P-frame groups at the top (horse-collapse: quality 90 and 97 both at
+/// RMSE 1.27e-4, 5.6 bpvf, as there the pixel step cannot go finer than the group's residual range
+/// allows at 12 bits); `crf` 1 lets the error keep falling up to quality 97 (horse-collapse: 3.8e-5
+/// at 11.8 bpvf, 1.06e-5 at 21.7; docs/results.md, "AV1 and HEVC padding").
+pub const AV1_MIN_QP: u8 = 1;
+/// AV1's AC quantiser step at 10 and 12 bits a sample (the specification's `ac_qlookup_10` and
+/// `ac_qlookup_12` tables, libaom's `ac_qlookup_10_QTX` and `ac_qlookup_12_QTX`) at quantiser
+/// index 4 × `crf` for `crf` 0, 1, 2, 3, 4, 8, …, 60, and at index 255 (`crf` 63): the law
+/// interpolates log-linearly between these. From `crf` 8 up the 12-bit step is about 4 × the
+/// 10-bit one (the step is relative to the sample range, as HEVC's QP); below it the 12-bit step
+/// is finer (0.55 × at `crf` 1), hence both columns.
+pub const AV1_AC_STEPS: [(u8, u16, u16); 20] = [
+    (0, 4, 4),
+    (1, 16, 35),
+    (2, 27, 75),
+    (3, 40, 126),
+    (4, 55, 183),
+    (8, 122, 456),
+    (12, 195, 753),
+    (16, 267, 1049),
+    (20, 337, 1335),
+    (24, 409, 1627),
+    (28, 539, 2150),
+    (32, 700, 2798),
+    (36, 922, 3684),
+    (40, 1218, 4871),
+    (44, 1631, 6522),
+    (48, 2199, 8795),
+    (52, 2971, 11885),
+    (56, 4028, 16110),
+    (60, 5476, 21902),
+    (63, 7312, 29247),
 ];
 
-/// log2 of AV1's AC step at 10 bits at a (fractional) `crf` 0..=63, from [`AV1_AC_STEPS`].
-fn av1_log2_step(crf: f64) -> f64 {
+/// log2 of AV1's AC step at a (fractional) `crf` 0..=63 at `depth` bits, from [`AV1_AC_STEPS`], in
+/// 10-bit units (the 12-bit step over 4).
+fn av1_log2_step(crf: f64, depth: u8) -> f64 {
+    let log2_at = |&(_, s10, s12): &(u8, u16, u16)| {
+        if depth >= 12 {
+            f64::from(s12).log2() - 2.0
+        } else {
+            f64::from(s10).log2()
+        }
+    };
     let i = AV1_AC_STEPS
         .iter()
-        .rposition(|&(c, _)| f64::from(c) <= crf)
+        .rposition(|&(c, _, _)| f64::from(c) <= crf)
         .unwrap_or(0)
         .min(AV1_AC_STEPS.len() - 2);
-    let ((c0, s0), (c1, s1)) = (AV1_AC_STEPS[i], AV1_AC_STEPS[i + 1]);
-    let t = (crf - f64::from(c0)) / f64::from(c1 - c0);
-    let (l0, l1) = (f64::from(s0).log2(), f64::from(s1).log2());
+    let (a, b) = (&AV1_AC_STEPS[i], &AV1_AC_STEPS[i + 1]);
+    let t = (crf - f64::from(a.0)) / f64::from(b.0 - a.0);
+    let (l0, l1) = (log2_at(a), log2_at(b));
     l0 + t * (l1 - l0)
 }
 
-/// The (fractional) `crf` whose AC step has log2 `log2_step`, clamped to 0..=63.
-fn av1_crf_of(log2_step: f64) -> f64 {
-    let logs = AV1_AC_STEPS.map(|(c, s)| (f64::from(c), f64::from(s).log2()));
+/// The (fractional) `crf` whose AC step at `depth` bits has log2 `log2_step` (in 10-bit units, as
+/// [`av1_log2_step`]), clamped to 0..=63.
+fn av1_crf_of(log2_step: f64, depth: u8) -> f64 {
+    let logs = AV1_AC_STEPS.map(|(c, _, _)| (f64::from(c), av1_log2_step(f64::from(c), depth)));
     if log2_step <= logs[0].1 {
         return 0.0;
     }
@@ -235,18 +253,17 @@ fn av1_crf_of(log2_step: f64) -> f64 {
 pub fn av1_law(quality: u8, depth: u8) -> PictureLaw {
     let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
     let deeper = f64::from(depth) - 10.0;
-    let want = av1_log2_step(f64::from(AV1_QP_AT_50)) + scale.log2() - deeper;
-    // The floor is a `crf`, not a step, at either depth: AV1's 12-bit table is 4 × the 10-bit one
-    // only from about index 32 up (measured: quality 90 at 12 bits with the floor lowered by two
-    // bits went to `crf` 3 and 159 bpvf on CesiumMan).
-    let floor = av1_log2_step(f64::from(AV1_MIN_QP));
-    let ceiling = av1_log2_step(f64::from(AV1_MAX_QP));
-    let crf = av1_crf_of(want.clamp(floor, ceiling)).round();
+    let want = av1_log2_step(f64::from(AV1_QP_AT_50), 10) + scale.log2() - deeper;
+    // The floor is a `crf`, not a step, at either depth (measured: quality 90 at 12 bits with a
+    // floor two bits lower than 10 bits' went to `crf` 3 and 159 bpvf on CesiumMan).
+    let floor = av1_log2_step(f64::from(AV1_MIN_QP), depth);
+    let ceiling = av1_log2_step(f64::from(AV1_MAX_QP), depth);
+    let crf = av1_crf_of(want.clamp(floor, ceiling), depth).round();
     // Beyond the floor or the ceiling the pixel step takes what the quantiser cannot.
     let beyond = if (floor..=ceiling).contains(&want) {
         0.0
     } else {
-        want - av1_log2_step(crf)
+        want - av1_log2_step(crf, depth)
     };
     PictureLaw {
         step_factor: AV1_STEP_FACTOR * 2f64.powf(beyond),
@@ -319,9 +336,21 @@ mod tests {
         assert_eq!(av1_law(50, 12).quantiser, 11);
         assert_eq!(av1_law(10, 10).quantiser, AV1_MAX_QP);
         assert!(av1_law(10, 10).step_factor > AV1_STEP_FACTOR);
-        for crf in 0..=63 {
-            let c = f64::from(crf);
-            assert!((av1_crf_of(av1_log2_step(c)) - c).abs() < 1e-9, "{crf}");
+        for depth in [10, 12] {
+            for crf in 0..=63 {
+                let c = f64::from(crf);
+                let back = av1_crf_of(av1_log2_step(c, depth), depth);
+                assert!((back - c).abs() < 1e-9, "{crf} at {depth} bits");
+            }
         }
+    }
+
+    #[test]
+    fn av1_quantiser_keeps_falling_up_to_quality_97_at_12_bits() {
+        // The former floor (`crf` 8) held every quality from 90 up at one `crf`.
+        let crfs: Vec<u8> = (90..=97).map(|q| av1_law(q, 12).quantiser).collect();
+        assert!(crfs[0] < 8, "{crfs:?}");
+        assert!(crfs[7] < crfs[0], "{crfs:?}");
+        assert!(crfs.iter().all(|&c| c >= AV1_MIN_QP), "{crfs:?}");
     }
 }
