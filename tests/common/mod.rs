@@ -189,3 +189,22 @@ pub fn base64(bytes: &[u8]) -> String {
     }
     out
 }
+
+/// Counts the frames an encoding announces (its latest total) and reports done.
+#[derive(Default)]
+pub struct Counter {
+    pub total: std::sync::atomic::AtomicU64,
+    pub done: std::sync::atomic::AtomicU64,
+}
+
+impl mcgv_video::Progress for Counter {
+    fn total(&self, frames: u64) {
+        self.total
+            .store(frames, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    fn frames(&self, count: u64) {
+        self.done
+            .fetch_add(count, std::sync::atomic::Ordering::Relaxed);
+    }
+}

@@ -1,7 +1,7 @@
 //! `--predictor auto` and `--segmentation auto` (issue 18): the encoder codes every candidate at
 //! the quality's step and keeps the smallest stream, saying so in its report.
 
-use crate::common::{animate, decoder, tube};
+use crate::common::{animate, decoder, tube, Counter};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{
     encode, encode_with_progress, Candidate, EncodeOptions, PredictorChoice, Segmentation,
@@ -9,8 +9,7 @@ use mcgv_video::encoder::{
 };
 use mcgv_video::mesh::{AnimatedMesh, Point};
 use mcgv_video::motion::PredictorKind;
-use mcgv_video::Progress;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::Ordering;
 
 /// A tube bent at its middle by linear-blend skinning over two bones, the blend spread over half
 /// its length: what the skinning predictor models exactly and piecewise affine maps do not.
@@ -232,23 +231,6 @@ fn picture_codecs_try_a_sample_of_frames_then_code_the_winner_whole() {
         best.bytes,
         fixed.len()
     );
-}
-
-/// Counts the frames the encoder announces and reports.
-#[derive(Default)]
-struct Counter {
-    total: AtomicU64,
-    done: AtomicU64,
-}
-
-impl Progress for Counter {
-    fn total(&self, frames: u64) {
-        self.total.store(frames, Ordering::Relaxed);
-    }
-
-    fn frames(&self, count: u64) {
-        self.done.fetch_add(count, Ordering::Relaxed);
-    }
 }
 
 #[test]

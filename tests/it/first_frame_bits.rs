@@ -2,13 +2,11 @@
 //! precision of `FIRST_FRAME_BITS_TRIED` is coded with the motion model chosen at the default, the
 //! smallest stream is kept, and the temporal DCT corrects a coarser first frame down to the step.
 
-use crate::common::{animate, decoder, tube};
+use crate::common::{animate, decoder, tube, Counter};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{encode, encode_with_progress, EncodeOptions, FIRST_FRAME_BITS_TRIED};
 use mcgv_video::mesh::{AnimatedMesh, Point};
 use mcgv_video::metrics;
-use mcgv_video::Progress;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A bulging tube that waves: a shape the first-frame coder cannot predict exactly.
 fn waving_tube() -> AnimatedMesh {
@@ -99,22 +97,6 @@ fn a_coarse_first_frame_is_corrected_down_to_the_step() {
     let (fine, coarse) = (error(12), error(8));
     // 8 bits alone would leave 1/512 of the box on frame 0; the residuals take it to the step.
     assert!(coarse < 1.15 * fine, "8 bits {coarse}, 12 bits {fine}");
-}
-
-#[derive(Default)]
-struct Counter {
-    total: AtomicU64,
-    done: AtomicU64,
-}
-
-impl Progress for Counter {
-    fn total(&self, frames: u64) {
-        self.total.store(frames, Ordering::Relaxed);
-    }
-
-    fn frames(&self, count: u64) {
-        self.done.fetch_add(count, Ordering::Relaxed);
-    }
 }
 
 #[test]
