@@ -10,7 +10,7 @@
 //! the other precisions are coded with it fixed: the model follows the motion, the precision the
 //! first frame's shape.
 
-use super::{encode_once, EncodeOptions, Encoded, PredictorChoice, Segmentation};
+use super::{encode_once, EncodeOptions, Encoded, PredictorChoice};
 use crate::error::Result;
 use crate::mesh::AnimatedMesh;
 use crate::progress::Progress;
@@ -48,7 +48,12 @@ pub(super) fn choose(
         ..base.clone()
     };
     let mut best = encode_once(mesh, &at(default, opts), &progress, None)?;
-    let model = chosen_model(&best, opts);
+    let model = EncodeOptions {
+        predictor: PredictorChoice::Fixed(best.model.predictor),
+        segmentation: best.model.segmentation.into(),
+        clusters: best.model.clusters,
+        ..opts.clone()
+    };
     // The segmentation runs on the animation alone, so the trials keep the first one's, unless
     // the first-frame coder reorders the vertices (its order may change with the precision).
     let known = (!opts.reorder).then(|| (best.partition.clone(), best.report.segmentation.clone()));
@@ -74,22 +79,6 @@ pub(super) fn choose(
     }
     best.report.first_frame_trials = trials;
     Ok(best)
-}
-
-/// `opts` with the motion model `encoded` was coded with fixed: its predictor, its segmentation
-/// and (k-means) the K it asked for.
-fn chosen_model(encoded: &Encoded, opts: &EncodeOptions) -> EncodeOptions {
-    let report = &encoded.report;
-    let segmentation = match report.segmentation.e0 {
-        Some(e0) => Segmentation::Decimation { e0 },
-        None => Segmentation::KMeans,
-    };
-    EncodeOptions {
-        predictor: PredictorChoice::Fixed(report.header.predictor),
-        segmentation: segmentation.into(),
-        clusters: report.header.requested_clusters as usize,
-        ..opts.clone()
-    }
 }
 
 /// Passes progress on, telling the whole work ahead once: the first encoding's total plus the

@@ -69,7 +69,8 @@ pub struct Encoded {
     pub container: ContainerWriter,
     /// The figures of the encoding.
     pub report: EncodeReport,
-    /// The motion clusters it was coded with, for trials that keep them.
+    /// The motion model and clusters it was coded with, for trials that keep them.
+    pub(crate) model: MotionModel,
     pub(crate) partition: Partition,
 }
 
@@ -215,6 +216,7 @@ fn code(
     Ok(Encoded {
         container,
         report,
+        model,
         partition: partition.clone(),
     })
 }
