@@ -54,7 +54,8 @@ MCGV_PYTHON=$py bash scripts/peers_page.sh bench-out/peers.md bench-out/peers.sk
     echo "# Rate-distortion tables"
     echo
     echo "Written by \`make bench\` (\`scripts/rd_table.py\` over ${csvs[*]#bench-out/}, copied beside this"
-    echo "page); the narrative and older measurements are in [../results.md](../results.md)."
+    echo "page); the narrative and older measurements are in [../results.md](../results.md). The other CSVs"
+    echo "in this folder are older measurements that results.md cites; they do not feed these tables."
     echo
     cat bench-out/table.md
 } > docs/bench/tables.md
