@@ -130,7 +130,8 @@ pub struct EncodeArgs {
     #[arg(long)]
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or
-    /// auto: both are tried at the quality's step and the smaller stream is kept (see --json).
+    /// auto: both are tried at the quality's step and the smaller stream is kept (picture codecs:
+    /// the fewer bits at equal error; see --json).
     #[arg(long, value_enum, default_value_t = SegmentationChoice::Auto)]
     pub segmentation: SegmentationChoice,
     /// Decimation's error threshold E0: RMS affine-fit error per vertex and frame, as a fraction of
@@ -139,7 +140,8 @@ pub struct EncodeArgs {
     pub e0: Option<f64>,
     /// The affine coefficients' quantiser step as a multiple of the residual step (whose size
     /// --quality or --step sets): smaller = finer maps, more side information (1/16..15.9;
-    /// default 0.25; 1/16 for mpeg4, whose P-frames suffer from coarser maps).
+    /// default 0.25; 1/16 for mpeg4 and for hevc and av1 with --gop above 1, whose P-frames suffer
+    /// from coarser maps).
     #[arg(long)]
     pub affine_precision: Option<f64>,
     /// Retired: the affine coefficients now follow the quality's step (see --affine-precision).
@@ -168,7 +170,8 @@ pub struct EncodeArgs {
     pub first_frame_bits: Option<u8>,
     /// Motion predictor: one affine map per cluster, per-vertex skinning weights over
     /// neighbouring clusters' maps (coded in the stream; the decoder follows the stream's choice),
-    /// or auto: both are tried at the quality's step and the smaller stream is kept.
+    /// or auto: both are tried at the quality's step and the smaller stream is kept (picture
+    /// codecs: the fewer bits at equal error).
     #[arg(long, value_enum, default_value_t = PredictorChoice::Auto)]
     pub predictor: PredictorChoice,
     /// Bits per quantised skinning weight, sign included (the paper's 16; the motion bench saw

@@ -1,8 +1,11 @@
 //! The encoder's automatic choice of motion model (`PredictorChoice::Auto`,
 //! `SegmentationChoice::Auto`): every candidate predictor × segmentation is coded at the encoding's
-//! quality, hence at one step, and the smallest stream is kept. Which one wins depends on the
-//! animation (skinning on rigid bones, the affine maps on soft bodies), so it is measured, not
-//! guessed.
+//! quality, hence at one step, and the one with the fewest bits at equal error is kept: the
+//! smallest stream for tdct, whose step is the same for every candidate; the picture codecs'
+//! candidates are decoded and their bits charged for their error ([`super::distortion`]), since a
+//! step widened where residuals outgrow the samples buys fewer bits with more error. Which one
+//! wins depends on the animation (skinning on rigid bones, the affine maps on soft bodies), so it
+//! is measured, not guessed.
 //!
 //! Shared between the candidates: the first frame, each segmentation (used by every predictor)
 //! and its affine track (skinning blends its maps). tdct codes every candidate whole (its
@@ -11,7 +14,7 @@
 //! sample of frames per candidate, scales the sample's per-frame parts to the whole and then codes
 //! the winner once in full.
 
-use super::{analysis, assemble, code, header, Analysed, Encoded, Stopwatch};
+use super::{analysis, assemble, code, distortion, header, Analysed, Encoded, Stopwatch};
 use crate::codec::{Codec, ResidualInput};
 use crate::encoder::{EncodeOptions, MotionModel, Segmentation};
 use crate::error::{Error, Result};
@@ -52,6 +55,9 @@ pub struct Candidate {
     pub clusters: usize,
     /// Its stream's bytes (estimated when the trial coded a sample of frames).
     pub bytes: u64,
+    /// Its decoded stream's RMS vertex error over the first frame's bounding-box diagonal, when
+    /// the choice weighed errors (picture codecs coding every candidate whole).
+    pub vertex_rmse: Option<f64>,
     /// Seconds of its trial: prediction and residual coding (the segmentations are in the
     /// report's stages).
     pub seconds: f64,
@@ -60,7 +66,7 @@ pub struct Candidate {
 /// The best candidate so far: its whole stream, or (sampled trials) what coding it in full needs.
 struct Best<'a> {
     index: usize,
-    bytes: u64,
+    cost: f64,
     kept: Kept<'a>,
 }
 
@@ -103,6 +109,9 @@ pub(super) fn choose(
     };
     let reference = &ff.decoded_positions;
     let mut candidates = Vec::with_capacity(models.len());
+    let mut costs = Vec::with_capacity(models.len());
+    let vertex_frames = (mesh.vertex_count() * frames) as f64;
+    let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
     let mut best: Option<Best> = None;
     let segmentations = segmentations(models);
     let atlases: Vec<AtlasCache> = segmentations
@@ -136,6 +145,13 @@ pub(super) fn choose(
                 atlas: Some(atlas),
             };
             let (bytes, encoded) = trial(&shared, &analysed, &progress)?;
+            let error = match &encoded {
+                Some(encoded) if opts.codec.has_images() => {
+                    Some(distortion::squared_error(mesh, encoded)?)
+                }
+                _ => None,
+            };
+            let cost = distortion::cost(8.0 * bytes as f64, error);
             let kept = match encoded {
                 Some(encoded) => Kept::Stream(Box::new(encoded)),
                 None => {
@@ -149,11 +165,13 @@ pub(super) fn choose(
                 segmentation: segmentation.name(),
                 clusters: partition.clusters(),
                 bytes,
+                vertex_rmse: error.map(|e| (e / vertex_frames).sqrt() / diagonal),
                 seconds: start.elapsed().as_secs_f64(),
             });
-            if best.as_ref().is_none_or(|b| bytes < b.bytes) {
+            costs.push(cost);
+            if best.as_ref().is_none_or(|b| cost < b.cost) {
                 let index = candidates.len() - 1;
-                best = Some(Best { index, bytes, kept });
+                best = Some(Best { index, cost, kept });
             }
         }
     }
@@ -163,7 +181,7 @@ pub(super) fn choose(
     encoded.report.choice = Some(ChoiceReport {
         chosen: model.name(),
         trial_frames,
-        reason: reason(&candidates, best.index, trial_frames, frames),
+        reason: reason(&candidates, &costs, best.index, (trial_frames, frames)),
         candidates,
     });
     Ok(encoded)
@@ -251,28 +269,44 @@ fn segmentations(models: &[MotionModel]) -> Vec<(Segmentation, usize)> {
     distinct
 }
 
-/// Why candidate `chosen` was kept, in words: its margin over the runner-up.
-fn reason(candidates: &[Candidate], chosen: usize, trial_frames: usize, frames: usize) -> String {
+/// Why candidate `chosen` was kept, in words: its margin over the runner-up (the next lowest
+/// cost), in bytes or, when errors were weighed, in bits at equal error.
+fn reason(
+    candidates: &[Candidate],
+    costs: &[f64],
+    chosen: usize,
+    (trial_frames, frames): (usize, usize),
+) -> String {
     let name = |c: &Candidate| {
         let model = format!("{}+{}", c.predictor.name(), c.segmentation);
         format!("{model} ({} clusters)", c.clusters)
     };
     let winner = &candidates[chosen];
-    let runner_up = candidates
-        .iter()
-        .enumerate()
-        .filter(|&(i, _)| i != chosen)
-        .map(|(_, c)| c)
-        .min_by_key(|c| c.bytes);
-    let mut reason = match runner_up {
-        Some(next) => format!(
-            "smallest stream at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
+    let runner_up = (0..candidates.len())
+        .filter(|&i| i != chosen)
+        .min_by(|&a, &b| costs[a].total_cmp(&costs[b]));
+    let mut reason = match (runner_up, winner.vertex_rmse) {
+        (Some(next), Some(rmse)) => format!(
+            "fewest bits at equal error (RMSE ∝ rate^-{}): {} bytes at vertex RMSE {rmse:.3e}; \
+             {} ({} bytes at {:.3e}) would need {:.1} % more bits at that error",
+            distortion::RMSE_EXPONENT,
             winner.bytes,
-            100.0 * (1.0 - winner.bytes as f64 / next.bytes.max(1) as f64),
-            name(next),
-            next.bytes
+            name(&candidates[next]),
+            candidates[next].bytes,
+            candidates[next].vertex_rmse.unwrap_or(f64::NAN),
+            100.0 * ((costs[next] - costs[chosen]).exp2() - 1.0),
         ),
-        None => "the only candidate".to_string(),
+        (Some(next), None) => {
+            let next = &candidates[next];
+            format!(
+                "smallest stream at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
+                winner.bytes,
+                100.0 * (1.0 - winner.bytes as f64 / next.bytes.max(1) as f64),
+                name(next),
+                next.bytes
+            )
+        }
+        (None, _) => "the only candidate".to_string(),
     };
     if trial_frames < frames {
         reason.push_str(&format!(

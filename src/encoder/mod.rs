@@ -5,6 +5,7 @@
 pub mod analysis;
 mod attributes;
 pub mod auto;
+pub mod distortion;
 pub mod first_frame_bits;
 mod options;
 

@@ -101,14 +101,19 @@ impl Default for EncodeOptions {
     }
 }
 
-/// The affine precision `k` (step = k·Δ) a codec gets unless asked otherwise, measured by total
-/// bytes at equal vertex RMSE: 1/4 for tdct (CesiumMan, RiggedFigure, walking_cat; 1/8 and 1/2
-/// within a few per cent) and JPEG (q50: CesiumMan 389 856 bytes at 1/4, 398 653 at 1/16, 413 960
-/// with 17-bit maps, equal RMSE). MPEG-4 needs finer maps: their quantisation noise is white in
-/// time and spoils its P-frame prediction (CesiumMan q30: 91 418 bytes with 17-bit maps, 111 733
-/// at 1/4, 80 564 at 1/16, all at RMSE 7.9e-4).
-pub fn default_affine_precision(codec: Codec) -> f64 {
+/// The affine precision `k` (step = k·Δ) a codec with groups of `gop` pictures gets unless asked
+/// otherwise, measured by total bytes at equal vertex RMSE: 1/4 for tdct (CesiumMan, RiggedFigure,
+/// walking_cat; 1/8 and 1/2 within a few per cent) and JPEG (q50: CesiumMan 389 856 bytes at 1/4,
+/// 398 653 at 1/16, 413 960 with 17-bit maps, equal RMSE). MPEG-4 needs finer maps: their
+/// quantisation noise is white in time and spoils its P-frame prediction (CesiumMan q30: 91 418
+/// bytes with 17-bit maps, 111 733 at 1/4, 80 564 at 1/16, all at RMSE 7.9e-4).
+pub fn default_affine_precision(codec: Codec, gop: usize) -> f64 {
     match codec {
+        // All-intra HEVC and AV1 (`gop` 1) have no P-frame to spoil, so they take JPEG's 1/4: at
+        // equal surface RMSE, qualities 40/65, AV1 1–12 % and HEVC 0–5 % fewer bits than at 1/16
+        // (walking_cat, horse-gallop, pcow; docs/results.md, "Affine precision of the HEVC and AV1
+        // groups").
+        Codec::Hevc | Codec::Av1 if gop == 1 => motion::DEFAULT_AFFINE_PRECISION,
         // HEVC's P-frames as MPEG-4's: CesiumMan q50 measured 3.045 bpvf at 1/16, 3.055 at 1/4, at
         // equal RMSE (3.9e-4).
         // AV1 as HEVC (not measured apart).
@@ -407,7 +412,7 @@ impl EncodeOptions {
     pub fn affine_precision_code(&self) -> u8 {
         let k = self
             .affine_precision
-            .unwrap_or_else(|| default_affine_precision(self.codec));
+            .unwrap_or_else(|| default_affine_precision(self.codec, self.gop));
         (k * 16.0).round().clamp(1.0, 255.0) as u8
     }
 
