@@ -289,7 +289,7 @@ fn reason(
         (Some(next), Some(rmse)) => format!(
             "fewest bits at equal error (RMSE ∝ rate^-{}): {} bytes at vertex RMSE {rmse:.3e}; \
              {} ({} bytes at {:.3e}) would need {:.1} % more bits at that error",
-            distortion::RMSE_EXPONENT,
+            distortion::RD_SLOPE,
             winner.bytes,
             name(&candidates[next]),
             candidates[next].bytes,

@@ -109,15 +109,16 @@ impl Default for EncodeOptions {
 /// bytes with 17-bit maps, 111 733 at 1/4, 80 564 at 1/16, all at RMSE 7.9e-4).
 pub fn default_affine_precision(codec: Codec, gop: usize) -> f64 {
     match codec {
-        // All-intra HEVC and AV1 (`gop` 1) have no P-frame to spoil, so they take JPEG's 1/4: at
-        // equal surface RMSE, qualities 40/65, AV1 1–12 % and HEVC 0–5 % fewer bits than at 1/16
-        // (walking_cat, horse-gallop, pcow; docs/results.md, "Affine precision of the HEVC and AV1
-        // groups").
-        Codec::Hevc | Codec::Av1 if gop == 1 => motion::DEFAULT_AFFINE_PRECISION,
-        // HEVC's P-frames as MPEG-4's: CesiumMan q50 measured 3.045 bpvf at 1/16, 3.055 at 1/4, at
-        // equal RMSE (3.9e-4).
-        // AV1 as HEVC (not measured apart).
-        Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => 1.0 / 16.0,
+        // All-intra AV1 (`gop` 1) has no P-frame to spoil, so it takes JPEG's 1/4: at equal
+        // surface RMSE, qualities 40/65, 1–12 % fewer bits than at 1/16 (walking_cat,
+        // horse-gallop, pcow; docs/results.md, "Bits at equal error in the automatic choice").
+        // HEVC takes 1/4 with P-frames too: 0–11 % fewer bits at qualities 30/50 (ibid.; CesiumMan
+        // q50 had measured 3.045 bpvf at 1/16, 3.055 at 1/4, at equal RMSE).
+        Codec::Av1 if gop == 1 => motion::DEFAULT_AFFINE_PRECISION,
+        Codec::Hevc => motion::DEFAULT_AFFINE_PRECISION,
+        // AV1's P-frames as MPEG-4's: 1/4 saved 8–13 % on pcow at qualities 30/50 but cost 16 %
+        // more bits at 9 % more error on horse-gallop at quality 70.
+        Codec::Mpeg4 | Codec::Av1 => 1.0 / 16.0,
         _ => motion::DEFAULT_AFFINE_PRECISION,
     }
 }
@@ -456,5 +457,40 @@ impl EncodeOptions {
             return no_images("padding");
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn affine_precision_is_fine_only_for_p_frames_that_suffer_from_coarse_maps() {
+        let code = |codec, gop| {
+            let opts = EncodeOptions {
+                codec,
+                gop,
+                ..EncodeOptions::default()
+            };
+            opts.affine_precision_code()
+        };
+        // In sixteenths: 4 = 1/4, 1 = 1/16.
+        for (codec, gop, expected) in [
+            (Codec::Tdct, 50, 4),
+            (Codec::Jpeg, 50, 4),
+            (Codec::Hevc, 1, 4),
+            (Codec::Hevc, 50, 4),
+            (Codec::Av1, 1, 4),
+            (Codec::Av1, 50, 1),
+            (Codec::Mpeg4, 50, 1),
+        ] {
+            assert_eq!(code(codec, gop), expected, "{codec:?} gop {gop}");
+        }
+        let asked = EncodeOptions {
+            codec: Codec::Av1,
+            affine_precision: Some(0.5),
+            ..EncodeOptions::default()
+        };
+        assert_eq!(asked.affine_precision_code(), 8);
     }
 }
