@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # `make bench`: the motion bench (segmentation + prediction speed and residual energy), then a rate
-# sweep of mcgv-video (JPEG and MPEG-4) and of the peer codecs (Draco, zstd, PCA, Dynapack-style with
-# zstd and with an arithmetic coder, gltfpack raw and Brotli'd, meshoptimizer's vertex codec) over
-# media/ and, when present, ../shared/media, then a shorter sweep of the encoder variants (skinning
+# sweep of mcgv-video (JPEG, MPEG-4, tdct, and HEVC and AV1 with P-frames and all-intra) and of the
+# peer codecs (Draco, zstd, PCA, Dynapack-style with zstd and with an arithmetic coder, gltfpack raw
+# and Brotli'd, meshoptimizer's vertex codec) over media/ and, when present, ../shared/media, then a shorter sweep of the encoder variants (skinning
 # predictor, decimation segmentation, both; every codec at quality 10 and 50
 # when the binary has it), then one RD plot per sequence, the README tables and the peers' page:
 #   bench-out/motion.txt, sweep.csv, sweep-variants.csv, peers.csv, peers.skipped.csv (what a peer
 #   could not take, and why), plots/SEQUENCE.png, table.md, peers.md
 # MCGV_PYTHON is the virtualenv's python (`make bench` passes it). BENCH_VARIANTS overrides the
-# variants (scripts/sweep.sh VARIANTS); empty skips the variant sweep.
+# variants (scripts/sweep.sh VARIANTS); empty skips the variant sweep. JPEG_QUALITIES,
+# MPEG4_QUALITIES, TDCT_QUALITIES, HEVC_QUALITIES, HEVC_INTRA_QUALITIES, AV1_QUALITIES and
+# AV1_INTRA_QUALITIES override the main sweep's qualities (scripts/sweep.sh; set but empty: none).
 set -euo pipefail
 py=${MCGV_PYTHON:-.venv/bin/python}
 mkdir -p bench-out
@@ -32,6 +34,8 @@ cargo bench --quiet --bench motion -- "${inputs[@]}" | tee bench-out/motion.txt
 rm -f bench-out/sweep.csv bench-out/sweep-variants.csv bench-out/peers.csv bench-out/peers.skipped.csv
 VARIANTS=default HEVC_QUALITIES=${HEVC_QUALITIES-"10 30 50 75 90 97"} \
     HEVC_INTRA_QUALITIES=${HEVC_INTRA_QUALITIES-"10 30 50 75 90"} \
+    AV1_QUALITIES=${AV1_QUALITIES-"10 30 50 75 90 97"} \
+    AV1_INTRA_QUALITIES=${AV1_INTRA_QUALITIES-"10 30 50 75 90"} \
     bash scripts/sweep.sh bench-out/sweep.csv "${inputs[@]}"
 csvs=(bench-out/sweep.csv)
 variants=${BENCH_VARIANTS-"skinning decimation skinning+decimation"}
@@ -50,7 +54,8 @@ MCGV_PYTHON=$py bash scripts/peers_page.sh bench-out/peers.md bench-out/peers.sk
     echo "# Rate-distortion tables"
     echo
     echo "Written by \`make bench\` (\`scripts/rd_table.py\` over ${csvs[*]#bench-out/}, copied beside this"
-    echo "page); the narrative and older measurements are in [../results.md](../results.md)."
+    echo "page); the narrative and older measurements are in [../results.md](../results.md). The other CSVs"
+    echo "in this folder are older measurements that results.md cites; they do not feed these tables."
     echo
     cat bench-out/table.md
 } > docs/bench/tables.md

@@ -46,7 +46,7 @@ Every row: one encoding and one decoding, each its own process under GNU time (w
 seconds: Node or Python start-up included), measured by \`mcgv-video eval\` on the PC2 that
 \`mcgv-video convert\` wrote (bpvf counts every byte of the stream; RMSE is the papers' surface
 measure over the first frame's bbox diagonal; KG error = 100 · ‖A − Ã‖ / ‖A − E(A)‖, E(A) the
-per-frame centroid). The mcgv-video rows are those of docs/bench/sweep*.csv.
+per-frame centroid). The mcgv-video rows are those of docs/bench/sweep.csv (default encoder).
 
 Commands. \`make bench\` runs every peer at its default settings (scripts/peers.py SETTINGS). The rows
 of docs/bench/peers.csv for the peers of issue 19 were measured by these (MCGV_BIN a release build of commit b0f0ade;
@@ -70,8 +70,9 @@ PEERS_SETTINGS="gltfpack=vp 16;gltfpack-br=vp 16;dynapack-ac=qp 16;meshopt-vm=qp
   run d.csv bench-out/media/chickenCrossing
 PEERS_CODECS="gltfpack gltfpack-br" PEERS_SETTINGS="gltfpack=vp 16;gltfpack-br=vp 16" run f.csv bench-out/media/pcow
 PEERS_CODECS="zstd pca dynapack" run c.csv media/*.glb SHARED/threejs_*/*.glb      # default settings
-scripts/peers_page.sh docs/bench/peers.md docs/bench/peers.skipped.csv docs/bench/sweep*.csv docs/bench/peers.csv
-target/release/examples/rd_plot docs/bench docs/bench/sweep*.csv docs/bench/peers.csv
+PEERS_NOT_RUN="draco on the glTF samples (the slowest peer to measure)" \\
+  scripts/peers_page.sh docs/bench/peers.md docs/bench/peers.skipped.csv docs/bench/sweep.csv docs/bench/peers.csv
+target/release/examples/rd_plot docs/bench docs/bench/sweep.csv docs/bench/peers.csv
 \`\`\`
 
 (A first run at the default settings, vp 10–16, was stopped after horse-collapse's gltfpack rows and
