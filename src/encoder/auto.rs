@@ -110,7 +110,6 @@ pub(super) fn choose(
     let reference = &ff.decoded_positions;
     let mut candidates = Vec::with_capacity(models.len());
     let mut costs = Vec::with_capacity(models.len());
-    let vertex_frames = (mesh.vertex_count() * frames) as f64;
     let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
     let mut best: Option<Best> = None;
     let segmentations = segmentations(models);
@@ -147,7 +146,7 @@ pub(super) fn choose(
             let (bytes, encoded) = trial(&shared, &analysed, &progress)?;
             let error = match &encoded {
                 Some(encoded) if opts.codec.has_images() => {
-                    Some(distortion::squared_error(mesh, encoded)?)
+                    Some(distortion::vertex_rmse(mesh, encoded)?)
                 }
                 _ => None,
             };
@@ -165,7 +164,7 @@ pub(super) fn choose(
                 segmentation: segmentation.name(),
                 clusters: partition.clusters(),
                 bytes,
-                vertex_rmse: error.map(|e| (e / vertex_frames).sqrt() / diagonal),
+                vertex_rmse: error.map(|e| e / diagonal),
                 seconds: start.elapsed().as_secs_f64(),
             });
             costs.push(cost);

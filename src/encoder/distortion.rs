@@ -7,7 +7,7 @@
 //! stream (measured: horse-gallop, AV1 quality 70 with 1/4 affine precision kept affine maps on
 //! k-means, 206 382 bytes at vertex RMSE 5.9e-4, over skinning on decimation, 239 334 bytes at
 //! 3.3e-4). So the choice compares bits at equal error: each
-//! candidate's squared error is measured by decoding its stream, and its cost is the rate it would
+//! candidate's vertex RMSE is measured by decoding its stream, and its cost is the rate it would
 //! need at a common error on a rate–distortion curve of slope −[`RD_SLOPE`] in log-log (RMSE ∝
 //! rate^−RD_SLOPE), i.e. the candidate with the least `bits × RMSE^(1/RD_SLOPE)` is kept.
 
@@ -15,6 +15,7 @@ use super::Encoded;
 use crate::decoder::Decoder;
 use crate::error::{Error, Result};
 use crate::mesh::AnimatedMesh;
+use crate::metrics;
 
 /// The log-log slope of the codecs' rate–distortion curves the choice assumes: RMSE ∝
 /// rate^−RD_SLOPE. The picture codecs' curves between qualities 30 and 75 measure 1.0 (JPEG on
@@ -24,39 +25,31 @@ use crate::mesh::AnimatedMesh;
 /// (docs/results.md, "Bits at equal error in the automatic choice").
 pub const RD_SLOPE: f64 = 2.0;
 
-/// Sum over frames and vertices of the squared distance between `mesh` (in the stream's vertex
-/// order) and `encoded` as the decoder reconstructs it, in model units.
-pub fn squared_error(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<f64> {
+/// RMS distance over frames and vertices between `mesh` (in the stream's vertex order) and
+/// `encoded` as the decoder reconstructs it, in model units ([`metrics::vertex_errors`], what
+/// `eval` reports as vertex RMSE before normalising).
+pub fn vertex_rmse(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<f64> {
     let bytes = encoded.to_bytes();
     let decoded = Decoder::new(&bytes)?.decode_all()?;
-    if decoded.frame_count() != mesh.frame_count() || decoded.vertex_count() != mesh.vertex_count()
-    {
-        return Err(Error::Codec(format!(
+    let errors = metrics::vertex_errors(mesh, &decoded).ok_or_else(|| {
+        Error::Codec(format!(
             "a trial stream decoded to {} frames of {} vertices for {} of {}",
             decoded.frame_count(),
             decoded.vertex_count(),
             mesh.frame_count(),
             mesh.vertex_count()
-        )));
-    }
-    let sum = mesh
-        .frames()
-        .iter()
-        .zip(decoded.frames())
-        .flat_map(|(a, b)| a.iter().zip(b))
-        .map(|(p, q)| (0..3).map(|c| f64::from(p[c] - q[c]).powi(2)).sum::<f64>())
-        .sum();
-    Ok(sum)
+        ))
+    })?;
+    Ok(errors.rmse)
 }
 
 /// A candidate's cost, compared between candidates (lower is better): `log2(bits)` plus
-/// `log2` of its RMS error (from `squared_error`; the vertex count cancels) over [`RD_SLOPE`]. A
-/// difference of one is twice the bits at equal error. Without an error (a sampled trial), the
-/// bits alone.
-pub fn cost(bits: f64, squared_error: Option<f64>) -> f64 {
+/// `log2` of its RMS error ([`vertex_rmse`]) over [`RD_SLOPE`]. A difference of one is twice the
+/// bits at equal error. Without an error (a sampled trial), the bits alone.
+pub fn cost(bits: f64, rmse: Option<f64>) -> f64 {
     let rate = bits.max(1.0).log2();
-    match squared_error {
-        Some(e) => rate + 0.5 * e.max(f64::MIN_POSITIVE).log2() / RD_SLOPE,
+    match rmse {
+        Some(e) => rate + e.max(f64::MIN_POSITIVE).log2() / RD_SLOPE,
         None => rate,
     }
 }
@@ -69,14 +62,13 @@ mod tests {
     fn a_larger_stream_wins_only_with_an_error_lower_than_the_curve_gives() {
         let base = cost(8000.0, Some(1.0));
         // Twice the bits at a quarter of the RMSE (slope 2): a tie.
-        let quarter_rmse = 0.25f64.powi(2);
-        assert!((cost(16000.0, Some(quarter_rmse)) - base).abs() < 1e-12);
+        assert!((cost(16000.0, Some(0.25)) - base).abs() < 1e-12);
         // 57 % more bits for 39 % less RMSE loses (horse-gallop, AV1 quality 10); so do 30 %
         // more for 30 % less (walking cat, AV1 quality 30).
-        assert!(cost(12560.0, Some(0.61f64.powi(2))) > base);
-        assert!(cost(10400.0, Some(0.70f64.powi(2))) > base);
+        assert!(cost(12560.0, Some(0.61)) > base);
+        assert!(cost(10400.0, Some(0.70)) > base);
         // 16 % more bits for 44 % less RMSE wins (horse-gallop, AV1 quality 70).
-        assert!(cost(9280.0, Some(0.56f64.powi(2))) < base);
+        assert!(cost(9280.0, Some(0.56)) < base);
         assert_eq!(cost(7920.0, None), 7920f64.log2());
         assert!(cost(1.0, Some(0.0)).is_finite());
     }

@@ -208,3 +208,17 @@ impl mcgv_video::Progress for Counter {
             .fetch_add(count, std::sync::atomic::Ordering::Relaxed);
     }
 }
+
+/// RMS vertex displacement over the first frame's bounding-box diagonal (cheap, and
+/// independent of the library's metrics: tests compare many decodings with it).
+pub fn vertex_rmse(a: &AnimatedMesh, b: &AnimatedMesh) -> f64 {
+    let mut sum = 0.0f64;
+    let mut n = 0usize;
+    for f in 0..a.frame_count() {
+        for (p, q) in a.frame(f).iter().zip(b.frame(f)) {
+            sum += (0..3).map(|i| f64::from(p[i] - q[i]).powi(2)).sum::<f64>();
+            n += 1;
+        }
+    }
+    (sum / n as f64).sqrt() / a.bbox_diagonal()
+}

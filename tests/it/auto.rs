@@ -2,7 +2,7 @@
 //! the quality's step and keeps the smallest stream (tdct) or the fewest bits at equal error
 //! (picture codecs, whose errors at one step differ), saying so in its report.
 
-use crate::common::{animate, decode_all, decoder, tube, Counter};
+use crate::common::{animate, decode_all, decoder, tube, vertex_rmse, Counter};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::distortion;
 use mcgv_video::encoder::{
@@ -235,19 +235,6 @@ fn picture_codecs_try_a_sample_of_frames_then_code_the_winner_whole() {
     );
 }
 
-/// RMS vertex error of `bytes` decoded against `mesh`, over its first frame's diagonal.
-fn vertex_rmse(mesh: &AnimatedMesh, bytes: Vec<u8>) -> f64 {
-    let decoded = decode_all(bytes).expect("decodes");
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for (a, b) in mesh.frames().iter().zip(decoded.frames()) {
-        for (p, q) in a.iter().zip(b) {
-            sum += (0..3).map(|c| f64::from(p[c] - q[c]).powi(2)).sum::<f64>();
-            n += 1;
-        }
-    }
-    (sum / n as f64).sqrt() / mesh.bbox_diagonal()
-}
-
 #[test]
 fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
     let mesh = skinned_bend();
@@ -261,14 +248,12 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
     };
     let encoded = encode(&mesh, &options).expect("encodes");
     let choice = encoded.report.choice.clone().expect("a choice");
-    let vertex_frames = (mesh.vertex_count() * mesh.frame_count()) as f64;
     let diagonal = mesh.bbox_diagonal();
     let cost = |c: &Candidate| {
         let rmse = c
             .vertex_rmse
             .expect("MPEG-4 codes every candidate whole and decodes it");
-        let squared = (rmse * diagonal).powi(2) * vertex_frames;
-        distortion::cost(8.0 * c.bytes as f64, Some(squared))
+        distortion::cost(8.0 * c.bytes as f64, Some(rmse * diagonal))
     };
     let best = choice
         .candidates
@@ -281,7 +266,7 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
     );
     assert!(choice.reason.contains("equal error"), "{}", choice.reason);
     // The error the choice weighed is the decoded stream's.
-    let measured = vertex_rmse(&mesh, encoded.to_bytes());
+    let measured = vertex_rmse(&mesh, &decode_all(encoded.to_bytes()).expect("decodes"));
     let reported = best.vertex_rmse.expect("an error");
     assert!(
         (measured / reported - 1.0).abs() < 1e-6,

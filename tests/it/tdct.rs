@@ -2,7 +2,7 @@
 //! both segmentations, progressive decoding of a band prefix or a truncated file, random access,
 //! and damaged or forged streams.
 
-use crate::common::{encode_bytes, read_media};
+use crate::common::{encode_bytes, read_media, vertex_rmse};
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::{AnimatedMesh, Triangle};
@@ -33,20 +33,6 @@ fn decoder(
 
 fn decode_all(bytes: Vec<u8>, max_bands: Option<usize>) -> mcgv_video::Result<AnimatedMesh> {
     decoder(bytes, max_bands)?.decode_all()
-}
-
-/// RMS vertex displacement over the first frame's bounding-box diagonal (cheap: the tests below
-/// compare many decodings; the surface RMSE is checked by the round-trip tests).
-fn vertex_rmse(a: &AnimatedMesh, b: &AnimatedMesh) -> f64 {
-    let mut sum = 0.0f64;
-    let mut n = 0usize;
-    for f in 0..a.frame_count() {
-        for (p, q) in a.frame(f).iter().zip(b.frame(f)) {
-            sum += (0..3).map(|i| f64::from(p[i] - q[i]).powi(2)).sum::<f64>();
-            n += 1;
-        }
-    }
-    (sum / n as f64).sqrt() / a.bbox_diagonal()
 }
 
 /// Triangles as a set, each rotated so its smallest index comes first (orientation kept).
