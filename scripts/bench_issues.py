@@ -18,14 +18,15 @@ does (its functions), never extrapolated ("—").
 import sys
 from collections import defaultdict
 
-from rd_table import PAPER_RATES, at_rate, bits_at_error, frontier, read
+from rd_table import PAPER_RATES, at_rate, bits_at_error, e4, frontier, lower, read, take_option
 
 OBJ = ("chickenCrossing", "horse-collapse", "horse-gallop", "pcow", "pdance", "walking_cat")
 INTRA_TARGETS = (4e-4, 2e-4)
 
 
-def e4(v):
-    return "—" if v is None else f"{v * 1e4:.3g}"
+def better(*values):
+    """The lowest of the measured `values` (None where none was)."""
+    return min((v for v in values if v is not None), default=None)
 
 
 def ratio(a, b):
@@ -67,9 +68,7 @@ def tables(seqs, speed_rows):
         cells = []
         for b in PAPER_RATES:
             m, h, a = (at_rate(f.get(c, []), b) for c in ("mpeg4", "hevc", "av1"))
-            best = min((v for v in (h, a) if v is not None), default=None)
-            lower = "—" if m is None or best is None else f"{100 * (1 - best / m):.0f} %"
-            cells.append(f"{e4(m)} / {e4(h)} / {e4(a)} | {lower}")
+            cells.append(f"{e4(m)} / {e4(h)} / {e4(a)} | {lower(better(h, a), m)}")
         out.append(f"| {s} | " + " | ".join(cells) + " |")
     out += ["", "#### All-intra bits at equal RMSE: bpvf of jpeg / hevc-intra / av1-intra, and the better's saving", "",
             "| sequence | " + " | ".join(f"RMSE {t:.0e}: jpeg / hevc-intra / av1-intra | fewer bits" for t in INTRA_TARGETS)
@@ -78,9 +77,8 @@ def tables(seqs, speed_rows):
         cells = []
         for t in INTRA_TARGETS:
             j, h, a = (bits_at_error(f.get(c, []), t) for c in ("jpeg", "hevc-intra", "av1-intra"))
-            best = min((v for v in (h, a) if v is not None), default=None)
-            saving = "—" if j is None or best is None else f"{100 * (1 - best / j):.0f} %"
-            cells.append(" / ".join("—" if v is None else f"{v:.3g}" for v in (j, h, a)) + f" | {saving}")
+            cells.append(" / ".join("—" if v is None else f"{v:.3g}" for v in (j, h, a))
+                         + f" | {lower(better(h, a), j)}")
         out.append(f"| {s} | " + " | ".join(cells) + " |")
     out += ["", "#### hevc and av1 up to 16 bpvf: points by quality, and the error's fall per 3 bpvf", "",
             "Falls: RMSE lower at every higher quality. Per 3 bpvf: the RMSE's factor of decrease per 3 bpvf "
@@ -126,11 +124,7 @@ def speed(rows):
 
 def main():
     args = sys.argv[1:]
-    name = "pdance"
-    if "--speed" in args:
-        k = args.index("--speed")
-        name = args[k + 1]
-        del args[k:k + 2]
+    name = take_option(args, "--speed", "pdance")
     if not args:
         sys.exit(__doc__)
     rows = [r for r in read(args) if "+" not in r["codec"]]

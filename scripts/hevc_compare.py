@@ -19,7 +19,7 @@ import sys
 from collections import defaultdict
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rd_table import at_rate, bits_at_error, frontier, read  # noqa: E402
+from rd_table import at_rate, bits_at_error, frontier, lower, read, take_option  # noqa: E402
 
 RATES = (2.2, 4.0, 8.0)
 ERRORS = (4e-4, 2e-4)
@@ -29,20 +29,9 @@ def fmt(value, scale=1.0):
     return "—" if value is None else f"{value * scale:.3g}"
 
 
-def lower(ours, theirs):
-    """How much lower `ours` is than `theirs`, in per cent."""
-    if ours is None or theirs is None:
-        return "—"
-    return f"{100.0 * (1.0 - ours / theirs):.0f} %"
-
-
 def main():
     args = sys.argv[1:]
-    speed = "pdance"
-    if "--speed" in args:
-        i = args.index("--speed")
-        speed = args[i + 1]
-        del args[i:i + 2]
+    speed = take_option(args, "--speed", "pdance")
     rows = read(args)
     fronts = defaultdict(dict)
     points = defaultdict(lambda: defaultdict(list))

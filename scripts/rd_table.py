@@ -106,6 +106,23 @@ def e4(value):
     return "—" if value is None else f"{value * 1e4:.3g}"
 
 
+def lower(ours, theirs):
+    """How much lower `ours` is than `theirs`, in per cent ("—" without both)."""
+    if ours is None or theirs is None:
+        return "—"
+    return f"{100.0 * (1.0 - ours / theirs):.0f} %"
+
+
+def take_option(args, name, default):
+    """Removes `name VALUE` from the argument list `args` and returns VALUE (`default` without)."""
+    if name not in args:
+        return default
+    k = args.index(name)
+    value = args[k + 1]
+    del args[k:k + 2]
+    return value
+
+
 def split(codec):
     """(image codec, variant) of an mcgv-video series, variant "" for the default encoder."""
     base, _, variant = codec.partition("+")
@@ -376,11 +393,7 @@ def show(pick):
 
 def main():
     args = sys.argv[1:]
-    speed = None
-    if "--speed" in args:
-        k = args.index("--speed")
-        speed = args[k + 1]
-        del args[k:k + 2]
+    speed = take_option(args, "--speed", None)
     if not args:
         sys.exit(__doc__)
     rows = read(args)
