@@ -40,6 +40,12 @@ tdct=(--codec tdct --clusters 4 --fps 6 --quality 10 --quiet)
 # A coarse first frame the residuals correct (tdct's first-frame trials keep 8-12 bits).
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/tdct-ff8.mcgv" --first-frame-bits 8 \
 	"${tdct[@]}"
+# Temporal segments (issue 20): segment markers, per-segment parts after the shared ones, a
+# version-4 container; tdct bands and MPEG-4 groups of pictures restart in each segment.
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/tdct-segments.mcgv" --segment-frames 3 \
+	"${tdct[@]}"
+"$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/mpeg4-segments.mcgv" --codec mpeg4 --gop 2 \
+	--segment-frames 3 "${small[@]}"
 # Decimation finds K itself, so it takes no --clusters.
 "$bin" encode "$media/RiggedSimple.glb" -o "$out/decode_stream/jpeg-decimation.mcgv" --codec jpeg \
 	--segmentation decimation --lattice 64x64 --fps 6 --quiet

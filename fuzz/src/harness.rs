@@ -38,7 +38,22 @@ fn decode_and_check(bytes: &[u8]) -> Result<()> {
     let mut decoder = Decoder::new(bytes)?;
     let mesh = decoder.decode_all()?;
     let last = mesh.frame_count() - 1;
-    let alone = decoder.decode_frame(last)?;
+    // The last frame reads the open (last) segment again; the first one, in a segmented stream,
+    // reopens the first segment.
+    for f in [last, 0] {
+        let alone = decoder.decode_frame(f)?;
+        check_alone(&decoder, &mesh, f, &alone);
+    }
+    Ok(())
+}
+
+/// Frame `f` decoded alone against the same frame decoded in sequence.
+fn check_alone(
+    decoder: &Decoder<std::io::Cursor<&[u8]>>,
+    mesh: &AnimatedMesh,
+    f: usize,
+    alone: &[[f32; 3]],
+) {
     if decoder.header().codec == Codec::Tdct {
         // The frame alone sums the bands' basis functions directly, the whole sequence goes
         // through the fast inverse DCT: equal up to rounding, of the order of the coordinates'.
@@ -51,18 +66,17 @@ fn decode_and_check(bytes: &[u8]) -> Result<()> {
             .filter(|x| x.is_finite())
             .fold(1.0f32, |m, x| m.max(x.abs()));
         assert!(
-            close(&alone, mesh.frame(last), 1e-6 * scale),
-            "frame {last} decodes differently alone and in sequence"
+            close(alone, mesh.frame(f), 1e-6 * scale),
+            "frame {f} decodes differently alone and in sequence"
         );
     } else {
         // Image codecs decode the same pictures either way: the frame read alone is the one read
         // in sequence, bit for bit.
         assert!(
-            same_bits(&alone, mesh.frame(last)),
-            "frame {last} decodes differently alone and in sequence"
+            same_bits(alone, mesh.frame(f)),
+            "frame {f} decodes differently alone and in sequence"
         );
     }
-    Ok(())
 }
 
 /// Reads `data` as a mesh: the first byte picks OBJ (0), PC2 + base OBJ separated by a NUL byte
@@ -146,9 +160,10 @@ pub fn fix_checksums(bytes: &mut [u8]) {
         return;
     };
     let mut pos = FILE_HEADER_LEN;
-    let mut index: Option<(usize, usize)> = None;
-    let mut frames: Option<(usize, usize)> = None;
-    for _ in 0..count.min(64) {
+    // Each segment of a segmented stream has its own frame index and images part.
+    let mut index: Option<IndexSpan> = None;
+    let mut pairs: Vec<(IndexSpan, (usize, usize))> = Vec::new();
+    for _ in 0..count.min(1024) {
         let Some(head) = bytes.get(pos..pos + PART_HEADER_LEN) else {
             return;
         };
@@ -167,8 +182,8 @@ pub fn fix_checksums(bytes: &mut [u8]) {
                 .copy_from_slice(&crc);
         }
         match &tag {
-            b"INDX" => index = Some((start, end)),
-            b"FRMS" => frames = Some((start, end)),
+            b"INDX" => index = Some((pos, start, end)),
+            b"FRMS" => pairs.extend(index.take().map(|i| (i, (start, end)))),
             _ => {}
         }
         if whole {
@@ -177,9 +192,23 @@ pub fn fix_checksums(bytes: &mut [u8]) {
         }
         pos = end;
     }
-    // Frame chunks: the index lists (length, CRC, key) per frame, chunks laid end to end.
-    let (Some((i_start, i_end)), Some((f_start, f_end))) = (index, frames) else {
-        return;
+    for (index, frames) in pairs {
+        fix_chunks(bytes, index, frames);
+    }
+}
+
+/// A frame index part: its header's offset, and its payload's start and end.
+type IndexSpan = (usize, usize, usize);
+
+/// Frame chunks: the index (header at `i_pos`, payload `i_start..i_end`) lists (length, CRC, key)
+/// per frame, chunks laid end to end in `f_start..f_end`; the index's own CRC changes with them.
+fn fix_chunks(
+    bytes: &mut [u8],
+    (i_pos, i_start, i_end): IndexSpan,
+    (f_start, f_end): (usize, usize),
+) {
+    let word = |b: &[u8], at: usize| -> Option<u32> {
+        Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
     };
     let mut offset = f_start;
     let mut at = i_start + 4;
@@ -195,8 +224,10 @@ pub fn fix_checksums(bytes: &mut [u8]) {
         offset = end;
         at += 9;
     }
-    // The index is a whole-checked part written before the images: its CRC changed with the chunks'.
-    refresh_part_crc(bytes, b"INDX");
+    if bytes[i_pos + 4] == 0 {
+        let crc = crc32fast::hash(&bytes[i_start..i_end]).to_le_bytes();
+        bytes[i_pos + 13..i_pos + 17].copy_from_slice(&crc);
+    }
 }
 
 /// Where the payload of the part whose header starts at `pos` lies, if it lies inside `bytes`.
@@ -208,24 +239,6 @@ fn payload_span(bytes: &[u8], pos: usize) -> Option<(usize, usize)> {
     (end <= bytes.len()).then_some((start, end))
 }
 
-/// Recomputes the part CRC of the (first) part tagged `tag`.
-fn refresh_part_crc(bytes: &mut [u8], tag: &[u8; 4]) {
-    let mut pos = FILE_HEADER_LEN;
-    while let Some(head) = bytes.get(pos..pos + PART_HEADER_LEN) {
-        let Some((start, end)) = payload_span(bytes, pos) else {
-            return;
-        };
-        if &head[..4] == tag {
-            if head[4] == 0 {
-                let crc = crc32fast::hash(&bytes[start..end]).to_le_bytes();
-                bytes[pos + 13..pos + 17].copy_from_slice(&crc);
-            }
-            return;
-        }
-        pos = end;
-    }
-}
-
 /// Payload span of the (first) part tagged `tag`. The last part may be cut short by the end of the
 /// file (a progressive part does that legitimately): its span then ends with the file.
 fn part_span(bytes: &[u8], tag: &[u8; 4]) -> Option<(usize, usize)> {
@@ -235,6 +248,15 @@ fn part_span(bytes: &[u8], tag: &[u8; 4]) -> Option<(usize, usize)> {
 /// Header offset, payload start, declared payload length and payload end (clipped to the file) of
 /// the first part tagged `tag`, walking the part table as far as it makes sense.
 fn part_layout(bytes: &[u8], tag: &[u8; 4]) -> Option<(usize, usize, u64, usize)> {
+    part_layout_nth(bytes, tag, 0)
+}
+
+/// [`part_layout`] of the `n`-th part tagged `tag` (a segmented stream repeats a segment's tags).
+fn part_layout_nth(
+    bytes: &[u8],
+    tag: &[u8; 4],
+    mut n: usize,
+) -> Option<(usize, usize, u64, usize)> {
     let mut pos = FILE_HEADER_LEN;
     loop {
         let head = bytes.get(pos..pos + PART_HEADER_LEN)?;
@@ -245,7 +267,10 @@ fn part_layout(bytes: &[u8], tag: &[u8; 4]) -> Option<(usize, usize, u64, usize)
             .and_then(|l| l.checked_add(start))
             .map_or(bytes.len(), |e| e.min(bytes.len()));
         if &head[..4] == tag {
-            return Some((pos, start, len, end));
+            if n == 0 {
+                return Some((pos, start, len, end));
+            }
+            n -= 1;
         }
         if end == bytes.len() {
             return None;
@@ -258,11 +283,21 @@ fn part_layout(bytes: &[u8], tag: &[u8; 4]) -> Option<(usize, usize, u64, usize)
 /// coefficients part (TDCT), re-coding the index; its part CRC is left to [`fix_checksums`]. An
 /// index that no longer parses is left as it is: refusing it is the decoder's job.
 pub fn fix_band_index(bytes: &mut Vec<u8>) {
-    let Some((_, c_start, c_declared, c_end)) = part_layout(bytes, b"TDCT") else {
-        return;
+    // One index and one coefficients part per segment; each splice keeps the later parts' order.
+    for n in 0..64 {
+        if !fix_nth_band_index(bytes, n) {
+            return;
+        }
+    }
+}
+
+/// [`fix_band_index`] for the `n`-th index and coefficients part; false when there is none.
+fn fix_nth_band_index(bytes: &mut Vec<u8>, n: usize) -> bool {
+    let Some((_, c_start, c_declared, c_end)) = part_layout_nth(bytes, b"TDCT", n) else {
+        return false;
     };
-    let Some((i_pos, i_start, _, i_end)) = part_layout(bytes, b"TDIX") else {
-        return;
+    let Some((i_pos, i_start, _, i_end)) = part_layout_nth(bytes, b"TDIX", n) else {
+        return false;
     };
     // The index states its own band count; the decoder checks it against the header's frames.
     let Some(count) = bytes
@@ -270,11 +305,11 @@ pub fn fix_band_index(bytes: &mut Vec<u8>) {
         .and_then(|b| b.try_into().ok())
         .map(u32::from_le_bytes)
     else {
-        return;
+        return true;
     };
     let Ok(mut index) = BandIndex::from_bytes(&bytes[i_start..i_end], count as usize, c_declared)
     else {
-        return;
+        return true;
     };
     for band in &mut index.bands {
         // Bands past the end of a cut file keep their CRC: the decoder stops before them.
@@ -289,10 +324,11 @@ pub fn fix_band_index(bytes: &mut Vec<u8>) {
         }
     }
     let Ok(coded) = index.to_bytes() else {
-        return;
+        return true;
     };
     // Re-coding may change the index's length (a mutated index that still parses need not be the
     // encoder's own coding of it): splice it in and fix the part's declared length.
     bytes.splice(i_start..i_end, coded.iter().copied());
     bytes[i_pos + 5..i_pos + 13].copy_from_slice(&(coded.len() as u64).to_le_bytes());
+    true
 }

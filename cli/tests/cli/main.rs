@@ -13,4 +13,5 @@ mod gltf;
 mod info;
 mod outputs;
 mod segmentation;
+mod segments;
 mod skinning;
