@@ -3,7 +3,7 @@
 //! refused.
 
 use crate::common::{animate, decoder, encode_bytes, harness, parts, rebuild, tube};
-use mcgv_video::encoder::segments::SegmentedEncoder;
+use mcgv_video::encoder::segments::{analysis_frames, SegmentedEncoder};
 use mcgv_video::stream::container::{Checksum, Tag, VERSION, VERSION_SEGMENTED};
 use mcgv_video::{encode, AnimatedMesh, Codec, EncodeOptions, Lattice, PredictorChoice, Silent};
 use mcgv_video::{PredictorKind, SegmentationChoice};
@@ -160,14 +160,21 @@ fn segments_pushed_one_by_one_make_the_stream_encode_makes() {
     let opts = options(Codec::Jpeg, Some(8));
     let whole = encode(&mesh, &opts).unwrap();
     assert_eq!(whole.report.segments, 3);
-    let first = AnimatedMesh::new(mesh.triangles().to_vec(), mesh.frames()[..8].to_vec()).unwrap();
-    let mut encoder = SegmentedEncoder::start(&first, &opts, 8, &Silent).unwrap();
-    let too_long = encoder.push(mesh.frames()[8..17].to_vec(), &Silent);
+    let spread = analysis_frames(20, 8);
+    assert_eq!(spread, [0, 2, 5, 8, 10, 13, 16, 19]);
+    let analysis = AnimatedMesh::new(
+        mesh.triangles().to_vec(),
+        spread.iter().map(|&f| mesh.frame(f).to_vec()).collect(),
+    )
+    .unwrap();
+    let mut encoder = SegmentedEncoder::start(&analysis, &opts, 8, &Silent).unwrap();
+    let too_long = encoder.push(mesh.frames()[..9].to_vec(), &Silent);
     assert!(too_long.is_err());
-    encoder
-        .push(mesh.frames()[8..16].to_vec(), &Silent)
-        .unwrap();
-    encoder.push(mesh.frames()[16..].to_vec(), &Silent).unwrap();
+    for range in [0..8, 8..16, 16..20] {
+        encoder
+            .push(mesh.frames()[range].to_vec(), &Silent)
+            .unwrap();
+    }
     assert_eq!(encoder.frames(), 20);
     assert_eq!(encoder.finish().unwrap().to_bytes(), whole.to_bytes());
     let zero = encode(&mesh, &options(Codec::Jpeg, Some(0)));
