@@ -9,6 +9,7 @@ use crate::codec::{Codec, Plane, ResidualDecoder, StreamLayout};
 use crate::error::{Error, Result};
 use crate::first_frame;
 use crate::geometry_image::FrameRanges;
+use crate::limits::{self, DEFAULT_MAX_POSITIONS};
 use crate::mesh::{AnimatedMesh, Attributes, Point, Triangle};
 use crate::motion::{predict_frame, AffineTrack, Partition, PredictorKind, SkinningWeights};
 use crate::progress::{Progress, Silent};
@@ -22,10 +23,22 @@ use std::io::{BufReader, Cursor, Read, Seek};
 use std::path::Path;
 
 /// Choices a reader can make about decoding.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct DecodeOptions {
     /// Temporal DCT only: decode no more than this many frequency bands (a progressive preview).
     pub max_bands: Option<usize>,
+    /// Refuse a stream whose header promises more positions (vertices × frames) than this, before
+    /// reading anything else (default [`DEFAULT_MAX_POSITIONS`]).
+    pub max_positions: u64,
+}
+
+impl Default for DecodeOptions {
+    fn default() -> Self {
+        Self {
+            max_bands: None,
+            max_positions: DEFAULT_MAX_POSITIONS,
+        }
+    }
 }
 
 /// An opened stream: everything but the coded residuals is read and checked at open.
@@ -67,6 +80,7 @@ impl<R: Read + Seek> Decoder<R> {
     /// Reads and checks every part but the coded residuals (temporal-DCT bands are decoded here).
     pub fn from_container(mut reader: ContainerReader<R>, options: &DecodeOptions) -> Result<Self> {
         let header = Header::from_bytes(&reader.part(Tag::HEADER)?)?;
+        limits::check_stream(header.vertices, header.frames, options.max_positions)?;
         let (v, f) = (header.vertices as usize, header.frames as usize);
         let (triangles, reference) = first_frame::decode(&reader.part(Tag::FIRST_FRAME)?)?;
         if reference.len() != v || triangles.len() != header.triangles as usize {
@@ -97,9 +111,11 @@ impl<R: Read + Seek> Decoder<R> {
                 ),
             ));
         }
-        // The codec's parts come first: their per-frame figures (ranges, band index) take a few
-        // bytes a frame, so reading them proves the header's frame count before the affine track
-        // allocates 12 coefficients per frame and cluster.
+        // The affine part is read first keeping none of its levels (constant memory): it must hold
+        // every frame up to its end word, which proves the header's frame count before the codec's
+        // parts allocate per frame (a temporal-DCT index of empty bands takes a fraction of a bit
+        // a frame and proves none) and before the track gets room for 12 levels a frame and cluster.
+        side_info::check_affine(&reader.part(Tag::AFFINE)?, f, &partition, &reference)?;
         let layout = StreamLayout {
             header: &header,
             triangles: &triangles,

@@ -14,7 +14,7 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     let opts: ReadOptions = (&args.input_args).into();
     let original = super::read_input(&args.original, &opts, quiet)?;
     let measures = if is_mcgv(&args.decoded) {
-        let options = super::decode::decode_options(args.bands);
+        let options = super::decode::decode_options(args.bands, args.input_args.max_positions);
         let path = Path::new(&args.decoded);
         let mut decoder =
             Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;
