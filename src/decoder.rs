@@ -123,8 +123,12 @@ impl<R: Read + Seek> Decoder<R> {
         let residuals = header
             .codec
             .open_decoder(&layout, &mut reader, options.max_bands)?;
-        let track =
-            side_info::decode_affine(&reader.part(Tag::AFFINE)?, f, &partition, &reference)?;
+        let track = side_info::decode_checked_affine(
+            &reader.part(Tag::AFFINE)?,
+            f,
+            &partition,
+            &reference,
+        )?;
         let weights = read_weights(&mut reader, &header, &partition, &triangles)?;
         Ok(Self {
             reader,

@@ -193,8 +193,18 @@ pub fn decode_affine(
     partition: &Partition,
     reference: &[Point],
 ) -> Result<AffineTrack> {
+    check_affine(bytes, frames, partition, reference)?;
+    decode_checked_affine(bytes, frames, partition, reference)
+}
+
+/// [`decode_affine`] of a part that [`check_affine`] has passed: read once.
+pub(crate) fn decode_checked_affine(
+    bytes: &[u8],
+    frames: usize,
+    partition: &Partition,
+    reference: &[Point],
+) -> Result<AffineTrack> {
     let mut part = AffinePart::open(bytes, frames, partition, reference)?;
-    part.read()?;
     part.q.values = vec![0; frames * part.q.clusters * 12];
     part.read()?;
     AffineTrack::from_quantised(part.q, part.geometry)

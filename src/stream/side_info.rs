@@ -12,6 +12,7 @@ use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
 use crate::motion::{cluster_neighbours, Partition, SkinningWeights};
 
+pub(crate) use super::affine_coding::decode_checked_affine;
 pub use super::affine_coding::{check_affine, decode_affine, encode_affine};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::entropy::{
