@@ -17,9 +17,11 @@ use crate::stream::attributes::decode_attributes;
 use crate::stream::container::{ContainerReader, Tag};
 use crate::stream::frame_index::ChunkEntry;
 use crate::stream::header::Header;
+use crate::stream::segments;
 use crate::stream::side_info;
 use std::fs::File;
 use std::io::{BufReader, Cursor, Read, Seek};
+use std::ops::Range;
 use std::path::Path;
 
 /// Choices a reader can make about decoding.
@@ -48,10 +50,22 @@ pub struct Decoder<R> {
     triangles: Vec<Triangle>,
     reference: Vec<Point>,
     partition: Partition,
-    track: AffineTrack,
     weights: Option<SkinningWeights>,
-    residuals: Box<dyn ResidualDecoder<R>>,
     attributes: Attributes,
+    options: DecodeOptions,
+    /// The frames of each temporal segment (one segment for a stream not cut into them).
+    segments: Vec<Range<usize>>,
+    /// The segment whose parts are read: its affine maps and residual decoder. A stream of one
+    /// segment reads it at open; a segmented one when a frame of it is first asked for.
+    open: Option<OpenSegment<R>>,
+}
+
+/// One temporal segment's predictor and residual decoder, read when a frame of it is asked for.
+struct OpenSegment<R> {
+    index: usize,
+    frames: Range<usize>,
+    track: AffineTrack,
+    residuals: Box<dyn ResidualDecoder<R>>,
 }
 
 impl Decoder<BufReader<File>> {
@@ -77,7 +91,8 @@ impl<'a> Decoder<Cursor<&'a [u8]>> {
 }
 
 impl<R: Read + Seek> Decoder<R> {
-    /// Reads and checks every part but the coded residuals (temporal-DCT bands are decoded here).
+    /// Reads and checks every part but the coded residuals (temporal-DCT bands are decoded here),
+    /// and of a segmented stream, the first segment's.
     pub fn from_container(mut reader: ContainerReader<R>, options: &DecodeOptions) -> Result<Self> {
         let header = Header::from_bytes(&reader.part(Tag::HEADER)?)?;
         limits::check_stream(header.vertices, header.frames, options.max_positions)?;
@@ -111,35 +126,30 @@ impl<R: Read + Seek> Decoder<R> {
                 ),
             ));
         }
-        // The affine part is read first keeping none of its levels (constant memory): it must hold
-        // every frame up to its end word, which proves the header's frame count before the codec's
-        // parts allocate per frame (a temporal-DCT index of empty bands takes a fraction of a bit
-        // a frame and proves none) and before the track gets room for 12 levels a frame and cluster.
-        side_info::check_affine(&reader.part(Tag::AFFINE)?, f, &partition, &reference)?;
-        let layout = StreamLayout {
+        let weights = read_weights(&mut reader, &header, &partition, &triangles)?;
+        let segments = segments::read_ranges(&mut reader, f)?;
+        let shared = Shared {
             header: &header,
             triangles: &triangles,
+            reference: &reference,
+            partition: &partition,
+            options,
         };
-        let residuals = header
-            .codec
-            .open_decoder(&layout, &mut reader, options.max_bands)?;
-        let track = side_info::decode_checked_affine(
-            &reader.part(Tag::AFFINE)?,
-            f,
-            &partition,
-            &reference,
-        )?;
-        let weights = read_weights(&mut reader, &header, &partition, &triangles)?;
+        let open = match reader.segments() {
+            0 => Some(shared.open_segment(&mut reader, &segments, 0)?),
+            _ => None,
+        };
         Ok(Self {
             reader,
             header,
             triangles,
             reference,
             partition,
-            track,
             weights,
-            residuals,
             attributes,
+            options: *options,
+            segments,
+            open,
         })
     }
 
@@ -178,28 +188,65 @@ impl<R: Read + Seek> Decoder<R> {
         &self.reader
     }
 
-    /// The geometry-image side of the stream (`None` for codecs without images).
+    /// The frames of each temporal segment, in order (one segment for a stream not cut into them).
+    pub fn segments(&self) -> &[Range<usize>] {
+        &self.segments
+    }
+
+    /// The segment whose parts are read, if any: the one [`Decoder::images`], [`Decoder::bands`]
+    /// and the figures built on them describe. A stream of one segment opens it with the stream;
+    /// a segmented one opens none until a frame is asked for or [`Decoder::seek_segment`].
+    pub fn open_segment(&self) -> Option<usize> {
+        self.open.as_ref().map(|o| o.index)
+    }
+
+    /// Reads segment `s`'s affine maps and residual parts (the segment's alone), unless open.
+    pub fn seek_segment(&mut self, s: usize) -> Result<()> {
+        if self.open_segment() == Some(s) {
+            return Ok(());
+        }
+        if s >= self.segments.len() {
+            return Err(Error::Usage(format!(
+                "segment {s}: the stream has {} segments",
+                self.segments.len()
+            )));
+        }
+        let shared = Shared {
+            header: &self.header,
+            triangles: &self.triangles,
+            reference: &self.reference,
+            partition: &self.partition,
+            options: &self.options,
+        };
+        // The old segment goes first: two segments' decoded bands are never held at once.
+        self.open = None;
+        self.open = Some(shared.open_segment(&mut self.reader, &self.segments, s)?);
+        Ok(())
+    }
+
+    /// The geometry-image side of the open segment (`None` for codecs without images).
     pub fn images(&self) -> Option<&ImageLayout> {
-        self.residuals.images()
+        self.open.as_ref().and_then(|o| o.residuals.images())
     }
 
-    /// The temporal-DCT bands (`None` for codecs without bands).
+    /// The open segment's temporal-DCT bands (`None` for codecs without bands).
     pub fn bands(&self) -> Option<&Bands> {
-        self.residuals.bands()
+        self.open.as_ref().and_then(|o| o.residuals.bands())
     }
 
-    /// Temporal-DCT bands decoded (all of them for a complete stream, fewer for a truncated one
-    /// or a preview); 0 for image codecs.
+    /// Temporal-DCT bands decoded in the open segment (all of them for a complete stream, fewer
+    /// for a truncated one or a preview); 0 for image codecs.
     pub fn bands_decoded(&self) -> usize {
         self.bands().map_or(0, |b| b.decoded.len())
     }
 
-    /// Temporal-DCT bands in the stream (one per frame); 0 for image codecs.
+    /// Temporal-DCT bands in the open segment (one per frame); 0 for image codecs.
     pub fn bands_total(&self) -> usize {
         self.bands().map_or(0, |b| b.lengths.len())
     }
 
-    /// Byte length of every temporal-DCT band, low to high frequency (empty for image codecs).
+    /// Byte length of every temporal-DCT band of the open segment, low to high frequency (empty
+    /// for image codecs).
     pub fn band_lengths(&self) -> &[u64] {
         self.bands().map_or(&[], |b| &b.lengths)
     }
@@ -209,10 +256,10 @@ impl<R: Read + Seek> Decoder<R> {
         self.bands().map(|b| b.step)
     }
 
-    /// Whether the file ends inside the temporal-DCT coefficients (the bands after the cut are
-    /// decoded as zero: a coarser animation).
+    /// Whether the file ends inside the temporal-DCT coefficients (of the last segment: the bands
+    /// after the cut are decoded as zero, a coarser animation).
     pub fn truncated(&self) -> bool {
-        self.bands().is_some_and(|b| b.truncated)
+        self.reader.cut_short()
     }
 
     /// Lattice pixel of every vertex (empty for codecs without a lattice).
@@ -220,47 +267,64 @@ impl<R: Read + Seek> Decoder<R> {
         self.images().map_or(&[], |i| &i.pixels)
     }
 
-    /// The residual range of every frame and coordinate (empty for codecs without images).
+    /// The residual range of every frame of the open segment and coordinate (empty for codecs
+    /// without images).
     pub fn ranges(&self) -> &[FrameRanges] {
         self.images().map_or(&[], |i| &i.ranges)
     }
 
-    /// Where frame `f`'s coded picture lies in the images part.
+    /// Frame `f`'s residual range per coordinate (`None` for codecs without images).
+    pub fn frame_ranges(&mut self, f: usize) -> Result<Option<FrameRanges>> {
+        let local = self.seek_frame(f)?;
+        Ok(self.ranges().get(local).copied())
+    }
+
+    /// Where frame `f`'s coded picture lies in its segment's images part (`f` must be a frame of
+    /// the open segment: see [`Decoder::seek_segment`]).
     pub fn frame_entry(&self, f: usize) -> Result<ChunkEntry> {
-        match self.images() {
-            Some(i) => i.index.entry(f),
-            None => Err(Error::Usage(format!(
+        let Some(images) = self.images() else {
+            return Err(Error::Usage(format!(
                 "a {} stream has no images: its residuals are temporal-DCT bands",
                 self.header.codec.name()
+            )));
+        };
+        match &self.open {
+            Some(open) if open.frames.contains(&f) => images.index.entry(f - open.frames.start),
+            _ => Err(Error::Usage(format!(
+                "frame {f} is not in the open segment: seek its segment first"
             ))),
         }
     }
 
     /// The decoded picture (x | y | z residual images side by side) of frame `f`.
     pub fn decoded_plane(&mut self, f: usize) -> Result<Plane<u16>> {
-        self.residuals.picture(&mut self.reader, f)
+        let local = self.seek_frame(f)?;
+        let open = self.open.as_mut().ok_or_else(closed)?;
+        open.residuals.picture(&mut self.reader, local)
     }
 
-    /// Decodes frame `f` alone: reads only its own chunk for intra streams, the chunks from the
-    /// last key frame for P-frame streams, and sums the decoded bands' basis functions at `f` for
-    /// temporal-DCT streams.
-    pub fn decode_frame(&mut self, f: usize) -> Result<Vec<Point>> {
-        let frames = self.header.frames as usize;
-        if f >= frames {
-            return Err(Error::Usage(format!(
+    /// Opens the segment of frame `f`; returns `f`'s index in it.
+    fn seek_frame(&mut self, f: usize) -> Result<usize> {
+        let s = segments::segment_of(&self.segments, f).ok_or_else(|| {
+            Error::Usage(format!(
                 "frame {f}: the stream has frames 0 to {}",
-                frames - 1
-            )));
-        }
-        let mut out = self.predict(f)?;
-        self.residuals.add_frame(&mut self.reader, f, &mut out)?;
-        // decode_all refuses such a frame (a mesh holds finite coordinates only): a frame read
-        // alone must not come back as infinities instead.
-        if let Some(v) = out.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
-            return Err(Error::Stream(format!(
-                "frame {f}, vertex {v}: coordinate is not a finite number"
-            )));
-        }
+                self.header.frames - 1
+            ))
+        })?;
+        self.seek_segment(s)?;
+        Ok(f - self.segments[s].start)
+    }
+
+    /// Decodes frame `f` alone: reads only its segment's parts, and of them only its own chunk for
+    /// intra streams, the chunks from the last key frame for P-frame streams, and sums the decoded
+    /// bands' basis functions at `f` for temporal-DCT streams.
+    pub fn decode_frame(&mut self, f: usize) -> Result<Vec<Point>> {
+        let local = self.seek_frame(f)?;
+        let mut out = self.predict(local)?;
+        let open = self.open.as_mut().ok_or_else(closed)?;
+        open.residuals
+            .add_frame(&mut self.reader, local, &mut out)?;
+        finite(f, &out)?;
         Ok(out)
     }
 
@@ -271,27 +335,127 @@ impl<R: Read + Seek> Decoder<R> {
 
     /// Decodes every frame in order, telling `progress` each frame done.
     pub fn decode_all_with_progress(&mut self, progress: &dyn Progress) -> Result<AnimatedMesh> {
-        let frames = self.header.frames as usize;
-        let mut out = (0..frames)
-            .map(|f| self.predict(f))
-            .collect::<Result<Vec<_>>>()?;
-        self.residuals
-            .add_all(&mut self.reader, &mut out, progress)?;
+        let mut frames = Vec::with_capacity(self.segments.last().map_or(0, |r| r.end));
+        self.for_each_frame(progress, |_, frame| {
+            frames.push(frame);
+            Ok(())
+        })?;
         let rate = f64::from(self.header.frame_rate);
-        Ok(AnimatedMesh::new(self.triangles.clone(), out)?
+        Ok(AnimatedMesh::new(self.triangles.clone(), frames)?
             .with_attributes(self.attributes.clone())?
             .with_frame_rate(Some(rate)))
     }
 
-    fn predict(&self, f: usize) -> Result<Vec<Point>> {
+    /// Decodes every frame in order and hands each to `each` (frame number, positions) as soon as
+    /// its segment is decoded: no more than one segment's frames are held at once.
+    pub fn for_each_frame(
+        &mut self,
+        progress: &dyn Progress,
+        mut each: impl FnMut(usize, Vec<Point>) -> Result<()>,
+    ) -> Result<()> {
+        for s in 0..self.segments.len() {
+            let start = self.segments[s].start;
+            for (i, frame) in self.decode_segment(s, progress)?.into_iter().enumerate() {
+                each(start + i, frame)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Decodes the frames of segment `s` ([`Decoder::segments`]) in order.
+    pub fn decode_segment(&mut self, s: usize, progress: &dyn Progress) -> Result<Vec<Vec<Point>>> {
+        self.seek_segment(s)?;
+        let frames = self.segments[s].clone();
+        let mut out = (0..frames.len())
+            .map(|f| self.predict(f))
+            .collect::<Result<Vec<_>>>()?;
+        let open = self.open.as_mut().ok_or_else(closed)?;
+        open.residuals
+            .add_all(&mut self.reader, &mut out, progress)?;
+        for (f, frame) in frames.zip(&out) {
+            finite(f, frame)?;
+        }
+        Ok(out)
+    }
+
+    /// The prediction of the open segment's frame `local`.
+    fn predict(&self, local: usize) -> Result<Vec<Point>> {
+        let open = self.open.as_ref().ok_or_else(closed)?;
         predict_frame(
-            &self.track,
+            &open.track,
             self.weights.as_ref(),
-            f,
+            local,
             &self.reference,
             &self.partition,
         )
     }
+}
+
+/// A mesh holds finite coordinates only: a decoded frame with an infinity or NaN is refused.
+fn finite(f: usize, frame: &[Point]) -> Result<()> {
+    match frame.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
+        Some(v) => Err(Error::Stream(format!(
+            "frame {f}, vertex {v}: coordinate is not a finite number"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// What every segment is decoded against: the parts the whole stream shares.
+struct Shared<'a> {
+    header: &'a Header,
+    triangles: &'a [Triangle],
+    reference: &'a [Point],
+    partition: &'a Partition,
+    options: &'a DecodeOptions,
+}
+
+impl Shared<'_> {
+    /// Reads segment `s`'s residual parts and affine maps.
+    fn open_segment<R: Read + Seek>(
+        &self,
+        reader: &mut ContainerReader<R>,
+        segments: &[Range<usize>],
+        s: usize,
+    ) -> Result<OpenSegment<R>> {
+        let frames = segments
+            .get(s)
+            .cloned()
+            .ok_or_else(|| Error::Stream(format!("no segment {s}")))?;
+        reader.select(s as u32)?;
+        // The segment's residual coder sees a clip of the segment's frames.
+        let header = Header {
+            frames: frames.len() as u32,
+            ..self.header.clone()
+        };
+        let layout = StreamLayout {
+            header: &header,
+            triangles: self.triangles,
+        };
+        // The affine part is read first keeping none of its levels (constant memory): it must hold
+        // every frame up to its end word, which proves the segment's frame count before the
+        // codec's parts allocate per frame (a temporal-DCT index of empty bands takes a fraction
+        // of a bit a frame and proves none) and before the track gets room for 12 levels a frame
+        // and cluster.
+        let affine = reader.part(Tag::AFFINE)?;
+        let (partition, reference) = (self.partition, self.reference);
+        side_info::check_affine(&affine, frames.len(), partition, reference)?;
+        let residuals = header
+            .codec
+            .open_decoder(&layout, reader, self.options.max_bands)?;
+        let track = side_info::decode_checked_affine(&affine, frames.len(), partition, reference)?;
+        Ok(OpenSegment {
+            index: s,
+            frames,
+            track,
+            residuals,
+        })
+    }
+}
+
+/// The error of a frame asked of no open segment (a segment that failed to open).
+fn closed() -> Error {
+    Error::Stream("no segment is open".into())
 }
 
 /// The skinning weights part, which a skinning stream must have and an affine one must not.

@@ -10,16 +10,16 @@ use crate::stream::container::{FILE_HEADER_LEN, PART_HEADER_LEN};
 use std::io::{Read, Seek};
 
 /// Bytes each part of an opened stream takes in the file (its part header included), in file
-/// order, after the file header.
+/// order, after the file header; the parts of one kind in a segmented stream are summed.
 pub fn part_bytes<R: Read + Seek>(decoder: &Decoder<R>) -> Vec<(String, u64)> {
     let mut parts = vec![("file header".to_string(), FILE_HEADER_LEN as u64)];
-    parts.extend(
-        decoder
-            .container()
-            .parts()
-            .iter()
-            .map(|p| (p.tag.name().to_string(), p.len + PART_HEADER_LEN as u64)),
-    );
+    for p in decoder.container().parts() {
+        let bytes = p.len + PART_HEADER_LEN as u64;
+        match parts.iter_mut().find(|(name, _)| name == p.tag.name()) {
+            Some((_, total)) => *total += bytes,
+            None => parts.push((p.tag.name().to_string(), bytes)),
+        }
+    }
     parts
 }
 
@@ -41,6 +41,13 @@ pub fn encoder_images<R: Read + Seek>(
     frames: &[usize],
 ) -> Result<Vec<EncoderImages>> {
     let header = decoder.header();
+    if decoder.segments().len() > 1 {
+        return Err(Error::Usage(
+            "the encoder's images of a stream cut into temporal segments are not redone (later \
+             segments are predicted from the first one's analysis); leave out the original"
+                .into(),
+        ));
+    }
     let pictures = header.codec.pictures()?.ok_or_else(|| {
         Error::Usage(format!(
             "a {} stream has no geometry images",

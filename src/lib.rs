@@ -53,12 +53,12 @@ pub mod stream;
 pub use codec::Codec;
 pub use decoder::{DecodeOptions, Decoder};
 pub use encoder::{
-    encode, encode_with_progress, EncodeOptions, EncodeReport, Encoded, PredictorChoice,
-    Segmentation, SegmentationChoice,
+    encode, encode_source, encode_with_progress, EncodeOptions, EncodeReport, Encoded,
+    PredictorChoice, Segmentation, SegmentationChoice,
 };
 pub use error::{Error, Result};
 pub use geometry_image::Lattice;
 pub use limits::DEFAULT_MAX_POSITIONS;
-pub use mesh::{read_animation, AnimatedMesh, Attributes, ReadOptions};
+pub use mesh::{read_animation, AnimatedMesh, Attributes, FrameSource, ReadOptions};
 pub use motion::PredictorKind;
 pub use progress::{Progress, Silent};

@@ -185,6 +185,12 @@ pub struct EncodeArgs {
     /// Bits per texture coordinate over each UV set's bounding box (inputs with UVs only).
     #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u8).range(1..=24))]
     pub uv_bits: u8,
+    /// Frames per temporal segment: a longer clip is coded as segments of N frames, each with its
+    /// own temporal DCT or groups of pictures, sharing the first frame, clusters and atlas (the
+    /// automatic choices are made on the first segment); 0 codes any clip as one segment
+    /// [default: 256].
+    #[arg(long, value_name = "N")]
+    pub segment_frames: Option<u64>,
     /// Retired with stream version 2 (the step now follows --quality, not each frame's range);
     /// kept hidden so that old scripts get a clear error rather than "unexpected argument".
     #[arg(long, hide = true)]

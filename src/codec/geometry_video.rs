@@ -82,7 +82,7 @@ pub fn padding_method(codec: &dyn PictureCodec, opts: &EncodeOptions) -> padding
 
 /// The residual images an encoding with `codec` makes of `input`'s residuals.
 pub fn images(codec: &dyn PictureCodec, input: &ResidualInput) -> Result<GeometryImages> {
-    let step = pixel_step(codec, input.mesh.bbox_diagonal(), input.options)?;
+    let step = pixel_step(codec, input.diagonal, input.options)?;
     let (reference, triangles) = (input.reference, input.mesh.triangles());
     let build =
         || lattice::build_atlas(reference, triangles, input.partition, input.options.lattice);

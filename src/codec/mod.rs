@@ -208,8 +208,11 @@ fn unavailable() -> Error {
 /// What the encoder hands a residual coder: the animation, the decoder's reference frame and
 /// partition, and every frame's residual against the quantised predictor.
 pub struct ResidualInput<'a> {
-    /// The animation (vertices in the stream's order).
+    /// The animation (vertices in the stream's order): the clip, or one temporal segment of it.
     pub mesh: &'a AnimatedMesh,
+    /// The clip's first-frame bounding-box diagonal, which steps are fractions of (a segment's
+    /// own first frame is not the clip's).
+    pub diagonal: f64,
     /// The decoded first frame, which the decoder will have.
     pub reference: &'a [Point],
     /// The motion clusters.

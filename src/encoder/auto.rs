@@ -362,6 +362,7 @@ impl Sample {
             .collect();
         let coded = opts.codec.encoder()?.encode(&ResidualInput {
             mesh: &self.mesh,
+            diagonal: self.mesh.bbox_diagonal(),
             reference,
             partition: analysed.partition,
             residuals: &residuals,

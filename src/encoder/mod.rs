@@ -8,6 +8,7 @@ pub mod auto;
 pub mod distortion;
 pub mod first_frame_bits;
 mod options;
+pub mod segments;
 
 pub use analysis::{Prediction, SegmentationReport};
 pub use auto::{Candidate, ChoiceReport};
@@ -15,8 +16,9 @@ pub use first_frame_bits::FirstFrameTrial;
 pub use options::{
     default_affine_precision, kmeans_ladder, EncodeOptions, MotionModel, PredictorChoice,
     Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS, DEFAULT_QUALITY,
-    FIRST_FRAME_BITS_TRIED,
+    DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
+pub use segments::{encode_source, SegmentedEncoder};
 
 use crate::codec::{CodecParams, ResidualInput};
 use crate::error::Result;
@@ -59,6 +61,9 @@ pub struct EncodeReport {
     /// tdct with the first frame's precision left open: each precision tried and its stream's
     /// bytes (empty otherwise); the header says which was kept.
     pub first_frame_trials: Vec<FirstFrameTrial>,
+    /// Temporal segments the stream is cut into (1: not cut). The choices above were made on the
+    /// first segment.
+    pub segments: usize,
     /// If the first-frame coder reordered vertices: new index → input index.
     #[serde(skip)]
     pub permutation: Option<Vec<u32>>,
@@ -101,6 +106,9 @@ pub fn encode_with_progress(
     progress: &dyn Progress,
 ) -> Result<Encoded> {
     opts.check(mesh)?;
+    if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
+        return segments::encode(mesh, opts, length, progress);
+    }
     match (opts.first_frame_bits, opts.codec) {
         (None, crate::codec::Codec::Tdct) => first_frame_bits::choose(mesh, opts, progress),
         _ => encode_once(mesh, opts, progress, None),
@@ -184,6 +192,7 @@ fn code(
     let (partition, prediction) = (analysed.partition, analysed.prediction);
     let coded = opts.codec.encoder()?.encode(&ResidualInput {
         mesh,
+        diagonal: mesh.bbox_diagonal(),
         reference: &ff.decoded_positions,
         partition,
         residuals: &prediction.residuals,
@@ -212,6 +221,7 @@ fn code(
         segmentation: analysed.segmentation.clone(),
         choice: None,
         first_frame_trials: Vec::new(),
+        segments: 1,
         permutation: ff.permutation.clone(),
     };
     Ok(Encoded {

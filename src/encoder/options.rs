@@ -72,6 +72,10 @@ pub struct EncodeOptions {
     pub step: Option<f64>,
     /// Bits per texture coordinate over each set's bounding box (1..=24; inputs with UVs only).
     pub uv_bits: u8,
+    /// Frames per temporal segment: a longer clip is coded as segments of this many frames, each
+    /// with its own temporal DCT or groups of pictures ([`super::segments`]); `None` codes any
+    /// clip as one.
+    pub segment_frames: Option<usize>,
 }
 
 impl Default for EncodeOptions {
@@ -97,9 +101,14 @@ impl Default for EncodeOptions {
             weight_bits: motion::WEIGHT_BITS,
             step: None,
             uv_bits: 12,
+            segment_frames: Some(DEFAULT_SEGMENT_FRAMES),
         }
     }
 }
+
+/// Frames per temporal segment unless asked otherwise. Measured: see docs/results.md
+/// "Temporal segments".
+pub const DEFAULT_SEGMENT_FRAMES: usize = 256;
 
 /// The affine precision `k` (step = k·Δ) a codec with groups of `gop` pictures gets unless asked
 /// otherwise, measured by total bytes at equal vertex RMSE: 1/4 for tdct (CesiumMan, RiggedFigure,
@@ -312,6 +321,7 @@ impl EncodeOptions {
             weight_bits: weight_bits.unwrap_or(motion::WEIGHT_BITS),
             step: None,
             uv_bits: 12,
+            segment_frames: None,
         })
     }
 
@@ -337,6 +347,9 @@ impl EncodeOptions {
     }
 
     fn check_ranges(&self) -> Result<()> {
+        if self.segment_frames == Some(0) {
+            return Err(Error::option("segment_frames", "must be at least 1"));
+        }
         if self.clusters == 0 {
             return Err(Error::option("clusters", "must be at least 1"));
         }

@@ -130,17 +130,47 @@ pub fn write_obj_sequence(mesh: &AnimatedMesh, dir: &Path) -> Result<()> {
 /// Like [`write_obj_sequence`], numbering the files from `first` (e.g. `decode --frame 57` writes
 /// `frame_0057.obj`).
 pub fn write_obj_sequence_from(mesh: &AnimatedMesh, dir: &Path, first: usize) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let digits = (first + mesh.frame_count().saturating_sub(1))
-        .to_string()
-        .len()
-        .max(4);
+    let last = first + mesh.frame_count().saturating_sub(1);
+    let writer = ObjFrameWriter::new(dir, last, mesh.triangles(), mesh.attributes())?;
     for (f, frame) in mesh.frames().iter().enumerate() {
-        let path = dir.join(format!("frame_{:0digits$}.obj", first + f));
-        let text = obj::obj_text(mesh.triangles(), frame, mesh.attributes());
-        write_atomic(&path, text.as_bytes())?;
+        writer.write(first + f, frame)?;
     }
     Ok(())
+}
+
+/// Writes frames of one connectivity as they come (a decoder's, one at a time), named as
+/// [`write_obj_sequence`] names them: no frame needs to wait for the others.
+pub struct ObjFrameWriter<'a> {
+    dir: &'a Path,
+    digits: usize,
+    triangles: &'a [super::Triangle],
+    attributes: &'a super::Attributes,
+}
+
+impl<'a> ObjFrameWriter<'a> {
+    /// A writer into `dir` (created if missing) for frames numbered up to `last`.
+    pub fn new(
+        dir: &'a Path,
+        last: usize,
+        triangles: &'a [super::Triangle],
+        attributes: &'a super::Attributes,
+    ) -> Result<Self> {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        Ok(Self {
+            dir,
+            digits: last.to_string().len().max(4),
+            triangles,
+            attributes,
+        })
+    }
+
+    /// Writes frame number `f`.
+    pub fn write(&self, f: usize, positions: &[super::Point]) -> Result<()> {
+        let digits = self.digits;
+        let path = self.dir.join(format!("frame_{f:0digits$}.obj"));
+        let text = obj::obj_text(self.triangles, positions, self.attributes);
+        write_atomic(&path, text.as_bytes())
+    }
 }
 
 /// Writes one frame as an OBJ file (`v` lines in vertex order, then the triangles). Rust prints an

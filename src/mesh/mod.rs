@@ -4,6 +4,7 @@
 //! [`topology`] holds the adjacency helpers the later stages need.
 
 mod attributes;
+pub mod frames;
 pub mod gltf_write;
 pub mod io;
 mod summary;
@@ -14,6 +15,7 @@ mod obj;
 mod pc2;
 
 pub use attributes::Attributes;
+pub use frames::FrameSource;
 
 /// Frames per second of a glTF output when the source's rate is unknown (OBJ and PC2 inputs).
 pub const DEFAULT_FPS: f64 = 30.0;
@@ -121,6 +123,23 @@ impl AnimatedMesh {
     /// All frames, each `V` positions.
     pub fn frames(&self) -> &[Vec<Point>] {
         &self.frames
+    }
+
+    /// Frames `range` as an animation of their own, with the same connectivity, attributes and
+    /// frame rate (an empty or out-of-bounds range is an error).
+    pub fn clip(&self, range: std::ops::Range<usize>) -> Result<Self> {
+        match self.frames.get(range.clone()) {
+            Some(frames) if !frames.is_empty() => Ok(Self {
+                triangles: self.triangles.clone(),
+                frames: frames.to_vec(),
+                attributes: self.attributes.clone(),
+                frame_rate: self.frame_rate,
+            }),
+            _ => Err(Error::Usage(format!(
+                "frames {range:?}: the animation has {}",
+                self.frames.len()
+            ))),
+        }
     }
 
     /// The positions of frame `f` (panics if `f` is out of range: callers index with `0..frame_count()`).

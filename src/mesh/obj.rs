@@ -318,7 +318,7 @@ pub(crate) fn read_sequence(files: &[PathBuf]) -> Result<AnimatedMesh> {
 }
 
 /// The error naming `path` and the first way its mesh differs from the first frame's.
-fn check_same_mesh(
+pub(crate) fn check_same_mesh(
     triangles: &[Triangle],
     vertex_count: usize,
     first_path: &Path,

@@ -23,7 +23,13 @@ pub(crate) struct PointCache {
 /// beside it); the base's vertex count must equal the cache's point count.
 pub(crate) fn read_pc2_animation(path: &Path, base: Option<&Path>) -> Result<AnimatedMesh> {
     let cache = read_pc2(path)?;
-    let base: PathBuf = match base {
+    let mesh = read_obj(&base_path(path, base)?)?;
+    with_base(cache, mesh, path, &base_path(path, base)?)
+}
+
+/// The base OBJ of the PC2 cache at `path`: `base`, else the `.obj` of the same stem beside it.
+pub(crate) fn base_path(path: &Path, base: Option<&Path>) -> Result<PathBuf> {
+    Ok(match base {
         Some(b) => b.to_path_buf(),
         None => {
             let beside = path.with_extension("obj");
@@ -39,9 +45,7 @@ pub(crate) fn read_pc2_animation(path: &Path, base: Option<&Path>) -> Result<Ani
             }
             beside
         }
-    };
-    let mesh = read_obj(&base)?;
-    with_base(cache, mesh, path, &base)
+    })
 }
 
 /// Parses PC2 bytes held in memory with the base mesh's OBJ text; the paths only name errors.
@@ -84,11 +88,21 @@ pub(crate) fn read_pc2(path: &Path) -> Result<PointCache> {
 
 /// Parses PC2 bytes; the error says what is wrong.
 fn parse_pc2(bytes: &[u8]) -> std::result::Result<PointCache, String> {
+    let (points, _) = parse_header(bytes, bytes.len() as u64)?;
+    let frames = bytes[HEADER_LEN..]
+        .chunks_exact(points * 12)
+        .map(parse_frame)
+        .collect();
+    Ok(PointCache { frames })
+}
+
+/// Checks a PC2 header against the file's length `file_len`; returns the point and sample counts.
+pub(crate) fn parse_header(
+    bytes: &[u8],
+    file_len: u64,
+) -> std::result::Result<(usize, usize), String> {
     let header = bytes.get(..HEADER_LEN).ok_or_else(|| {
-        format!(
-            "{} bytes is too short for a PC2 header ({HEADER_LEN} bytes)",
-            bytes.len()
-        )
+        format!("{file_len} bytes is too short for a PC2 header ({HEADER_LEN} bytes)")
     })?;
     if &header[..12] != MAGIC {
         return Err("not a PC2 point cache (no POINTCACHE2 signature)".into());
@@ -105,37 +119,39 @@ fn parse_pc2(bytes: &[u8]) -> std::result::Result<PointCache, String> {
             "header says {points} points and {samples} samples; both must be positive"
         ));
     }
-    let (points, samples) = (points as usize, samples as usize);
+    let (points, samples) = (points as u64, samples as u64);
     let expected = points
         .checked_mul(samples)
         .and_then(|n| n.checked_mul(12))
-        .and_then(|n| n.checked_add(HEADER_LEN))
+        .and_then(|n| n.checked_add(HEADER_LEN as u64))
         .ok_or_else(|| format!("header counts {points} × {samples} are too large"))?;
-    if bytes.len() != expected {
-        let state = if bytes.len() < expected {
+    if file_len != expected {
+        let state = if file_len < expected {
             "truncated"
         } else {
             "inconsistent"
         };
         return Err(format!(
-            "{state}: {points} points × {samples} samples need {expected} bytes, the file has {}",
-            bytes.len()
+            "{state}: {points} points × {samples} samples need {expected} bytes, the file has \
+             {file_len}"
         ));
     }
-    let frames = bytes[HEADER_LEN..]
-        .chunks_exact(points * 12)
-        .map(|frame| {
-            frame
-                .chunks_exact(12)
-                .map(|p| {
-                    let f = |k: usize| f32::from_le_bytes([p[k], p[k + 1], p[k + 2], p[k + 3]]);
-                    [f(0), f(4), f(8)]
-                })
-                .collect()
-        })
-        .collect();
-    Ok(PointCache { frames })
+    Ok((points as usize, samples as usize))
 }
+
+/// One sample's positions from its `points × 12` bytes.
+pub(crate) fn parse_frame(frame: &[u8]) -> Vec<Point> {
+    frame
+        .chunks_exact(12)
+        .map(|p| {
+            let f = |k: usize| f32::from_le_bytes([p[k], p[k + 1], p[k + 2], p[k + 3]]);
+            [f(0), f(4), f(8)]
+        })
+        .collect()
+}
+
+/// Bytes before the first sample.
+pub(crate) const SAMPLES_START: u64 = HEADER_LEN as u64;
 
 /// The PC2 bytes of an animation: start frame 0, one sample per frame.
 pub(crate) fn pc2_bytes(mesh: &AnimatedMesh) -> Result<Vec<u8>> {

@@ -6,10 +6,12 @@
 //! the exact nearest-triangle machinery; [`sampling`] where the surfaces are sampled.
 
 pub mod bvh;
+mod running;
 pub mod sampling;
 pub mod surface;
 pub mod triangle;
 
+pub use running::Comparison;
 pub use surface::{
     frame_distance, frame_distance_planned, FrameDistance, IndexCache, OneSided, Surface,
     SurfacePlans,
@@ -17,7 +19,6 @@ pub use surface::{
 
 use crate::error::{Error, Result};
 use crate::mesh::AnimatedMesh;
-use rayon::prelude::*;
 use serde::Serialize;
 
 /// The measures of one decoded animation against its original.
@@ -77,16 +78,7 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
             decoded.frame_count()
         )));
     }
-    let diagonal = original.bbox_diagonal();
-    if diagonal.is_nan() || diagonal <= 0.0 {
-        return Err(Error::Mesh(
-            "the original's first frame has a zero bounding-box diagonal, the unit of every measure"
-                .into(),
-        ));
-    }
-    let spacing = sampling::sample_spacing(diagonal);
-    // Sampled where each mesh's first frame says, so that every frame is measured alike.
-    let plans = SurfacePlans::new(
+    let mut comparison = Comparison::new(
         Surface {
             triangles: original.triangles(),
             positions: original.frame(0),
@@ -95,43 +87,9 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
             triangles: decoded.triangles(),
             positions: decoded.frame(0),
         },
-        spacing,
-    );
-    let per_frame: Vec<FrameDistance> = (0..frames)
-        .into_par_iter()
-        .map_init(IndexCache::default, |cache, f| {
-            frame_distance_planned(
-                Surface {
-                    triangles: original.triangles(),
-                    positions: original.frame(f),
-                },
-                Surface {
-                    triangles: decoded.triangles(),
-                    positions: decoded.frame(f),
-                },
-                &plans,
-                cache,
-            )
-            .map_err(|e| match e {
-                Error::Mesh(m) => Error::Mesh(format!("frame {f}: {m}")),
-                other => other,
-            })
-        })
-        .collect::<Result<_>>()?;
-    let frame_rmse: Vec<f64> = per_frame.iter().map(|d| d.rms() / diagonal).collect();
-    let rmse = frame_rmse.iter().sum::<f64>() / frames as f64;
-    let hausdorff = per_frame.iter().map(|d| d.max()).fold(0.0, f64::max) / diagonal;
-    let vertex = vertex_errors(original, decoded);
-    Ok(Measures {
-        rmse,
-        vertex_rmse: vertex.map(|v| v.rmse / diagonal),
-        kg_error: vertex.and_then(|v| v.kg),
-        hausdorff,
-        bpvf: None,
-        frames,
-        vertices: original.vertex_count(),
-        frame_rmse,
-    })
+    )?;
+    comparison.add(original.frames(), decoded.frames())?;
+    Ok(comparison.finish())
 }
 
 /// Per-vertex errors of two animations with corresponding vertices.
@@ -150,8 +108,25 @@ pub fn vertex_errors(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Option<
     {
         return None;
     }
-    let (mut err, mut spread) = (0.0f64, 0.0f64);
+    let mut sums = VertexSums::default();
     for (a, b) in original.frames().iter().zip(decoded.frames()) {
+        sums.add_frame(a, b);
+    }
+    Some(sums.errors(original.vertex_count() as f64 * original.frame_count() as f64))
+}
+
+/// The running sums behind vertex RMSE and KG error, a frame at a time.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct VertexSums {
+    /// Squared vertex displacements.
+    err: f64,
+    /// Squared distances of the original's vertices to their frame's centroid.
+    spread: f64,
+}
+
+impl VertexSums {
+    /// Adds one frame: original `a` against decoded `b` (corresponding vertices).
+    pub(crate) fn add_frame(&mut self, a: &[crate::mesh::Point], b: &[crate::mesh::Point]) {
         let n = a.len().max(1) as f64;
         let mut c = [0.0f64; 3];
         for p in a {
@@ -161,16 +136,19 @@ pub fn vertex_errors(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Option<
         }
         for (p, q) in a.iter().zip(b) {
             for k in 0..3 {
-                err += (p[k] as f64 - q[k] as f64).powi(2);
-                spread += (p[k] as f64 - c[k]).powi(2);
+                self.err += (p[k] as f64 - q[k] as f64).powi(2);
+                self.spread += (p[k] as f64 - c[k]).powi(2);
             }
         }
     }
-    let count = original.vertex_count() as f64 * original.frame_count() as f64;
-    Some(VertexErrors {
-        rmse: (err / count).sqrt(),
-        kg: (spread > 0.0).then(|| 100.0 * err.sqrt() / spread.sqrt()),
-    })
+
+    /// The errors over `count` vertex positions (vertices × frames).
+    pub(crate) fn errors(self, count: f64) -> VertexErrors {
+        VertexErrors {
+            rmse: (self.err / count).sqrt(),
+            kg: (self.spread > 0.0).then(|| 100.0 * self.err.sqrt() / self.spread.sqrt()),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -19,14 +19,20 @@ pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 /// would decode to a wrong animation without noticing.
 pub const VERSION: u16 = 3;
 
+/// The version of a stream cut into temporal segments ([`Tag::SEGMENT`] parts, issue 20). Only
+/// such streams carry it, so a clip of one segment keeps version 3's bytes, and a reader that
+/// predates segments says "update" instead of misreading them.
+pub const VERSION_SEGMENTED: u16 = 4;
+
 /// Bytes of a part header: tag, checksum kind, length, CRC.
 pub const PART_HEADER_LEN: usize = 17;
 
 /// Bytes of the file header: magic, version, reserved, part count.
 pub const FILE_HEADER_LEN: usize = 16;
 
-/// Largest number of parts a file may declare: refuses absurd headers before allocating.
-const MAX_PARTS: u32 = 64;
+/// Largest number of parts a file may declare (a segmented stream has a few per segment); the
+/// part table is also allocated no larger than the file's bytes can hold part headers.
+const MAX_PARTS: u32 = 1 << 20;
 
 /// A part's four-character tag.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -59,6 +65,9 @@ impl Tag {
     pub const TDCT_INDEX: Tag = Tag(*b"TDIX");
     /// Temporal-DCT coefficients, one chunk per frequency band, low to high.
     pub const TDCT: Tag = Tag(*b"TDCT");
+    /// Start of a temporal segment: its first frame and frame count. The parts after it, up to
+    /// the next, are the segment's own (see [`Tag::per_segment`]).
+    pub const SEGMENT: Tag = Tag(*b"SEGM");
 
     /// A human-readable name, for reports and errors.
     pub fn name(self) -> &'static str {
@@ -76,8 +85,18 @@ impl Tag {
             b"FRMS" => "images",
             b"TDIX" => "temporal DCT index",
             b"TDCT" => "temporal DCT coefficients",
+            b"SEGM" => "segment start",
             _ => "unknown part",
         }
+    }
+
+    /// Whether a part belongs to one temporal segment (its frames' predictor and residuals) rather
+    /// than to the whole stream (header, first frame, partition, atlas, skinning weights).
+    pub fn per_segment(self) -> bool {
+        matches!(
+            &self.0,
+            b"AFFN" | b"RANG" | b"CSET" | b"INDX" | b"FRMS" | b"TDIX" | b"TDCT"
+        )
     }
 }
 
@@ -168,24 +187,42 @@ impl ContainerWriter {
         self.parts.is_empty()
     }
 
-    /// Bytes each part takes in the file (payload plus its part header), by part name, in file order.
+    /// Bytes each part takes in the file (payload plus its part header), by part name, in the
+    /// order of first appearance; a segmented stream's parts of one kind are summed.
     pub fn part_sizes(&self) -> Vec<(String, u64)> {
+        let mut sizes: Vec<(String, u64)> = Vec::new();
+        for (tag, payload, _) in &self.parts {
+            let bytes = (PART_HEADER_LEN + payload.len()) as u64;
+            match sizes.iter_mut().find(|(name, _)| name == tag.name()) {
+                Some((_, total)) => *total += bytes,
+                None => sizes.push((tag.name().to_string(), bytes)),
+            }
+        }
+        sizes
+    }
+
+    /// Takes the parts out, in file order.
+    pub fn into_parts(self) -> Vec<Part> {
         self.parts
-            .iter()
-            .map(|(tag, payload, _)| {
-                (
-                    tag.name().to_string(),
-                    (PART_HEADER_LEN + payload.len()) as u64,
-                )
+            .into_iter()
+            .map(|(tag, bytes, checksum)| Part {
+                tag,
+                bytes,
+                checksum,
             })
             .collect()
     }
 
     /// The whole file as bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
+        let segmented = self.parts.iter().any(|(tag, ..)| *tag == Tag::SEGMENT);
         let mut w = ByteWriter::new();
         w.raw(&MAGIC)
-            .u16(VERSION)
+            .u16(if segmented {
+                VERSION_SEGMENTED
+            } else {
+                VERSION
+            })
             .u16(0)
             .u32(self.parts.len() as u32);
         for (tag, payload, checksum) in &self.parts {
@@ -224,6 +261,8 @@ pub struct PartEntry {
     pub crc: u32,
     /// How the payload is checked.
     pub checksum: Checksum,
+    /// The temporal segment the part belongs to (`None`: the whole stream's).
+    pub segment: Option<u32>,
 }
 
 /// Reads a container lazily: the part table at open, payloads on request, verified against their CRC.
@@ -232,8 +271,13 @@ pub struct ContainerReader<R> {
     source: R,
     parts: Vec<PartEntry>,
     file_len: u64,
-    /// The progressive last part cut short by the end of the file, and the length it declared.
-    truncated: Option<(Tag, u64)>,
+    /// The progressive last part cut short by the end of the file: its tag, segment and the
+    /// length it declared.
+    truncated: Option<(Tag, Option<u32>, u64)>,
+    /// Temporal segments in the stream (0: not segmented).
+    segments: u32,
+    /// The segment whose parts [`ContainerReader::entry`] finds.
+    selected: Option<u32>,
 }
 
 impl ContainerReader<BufReader<File>> {
@@ -249,19 +293,26 @@ impl<R: Read + Seek> ContainerReader<R> {
     pub fn new(mut source: R) -> Result<Self> {
         let file_len = source.seek(SeekFrom::End(0)).map_err(table_io)?;
         source.seek(SeekFrom::Start(0)).map_err(table_io)?;
-        let count = read_file_header(&mut source)?;
-        let mut parts = Vec::with_capacity(count as usize);
+        let (version, count) = read_file_header(&mut source)?;
+        let fit = file_len.saturating_sub(FILE_HEADER_LEN as u64) / PART_HEADER_LEN as u64;
+        let mut parts = Vec::with_capacity((count as u64).min(fit) as usize);
         let mut pos = 16u64;
         let mut truncated = None;
+        let mut segments = 0u32;
         for i in 0..count {
-            let part = read_part_entry(&mut source, i, count, pos, file_len)?;
-            if part.truncated.is_some() {
-                truncated = part.truncated;
+            let mut part = read_part_entry(&mut source, i, count, pos, file_len)?;
+            if part.entry.tag == Tag::SEGMENT {
+                segments += 1;
+            }
+            part.entry.segment = segments.checked_sub(1);
+            if let Some((tag, declared)) = part.truncated {
+                truncated = Some((tag, part.entry.segment, declared));
             }
             parts.push(part.entry);
             pos = part.end;
             source.seek(SeekFrom::Start(pos)).map_err(table_io)?;
         }
+        check_scopes(&parts, version)?;
         if pos != file_len {
             return Err(Error::Stream(format!(
                 "{} bytes after the last part (file damaged or concatenated?)",
@@ -273,6 +324,8 @@ impl<R: Read + Seek> ContainerReader<R> {
             parts,
             file_len,
             truncated,
+            segments,
+            selected: segments.checked_sub(1).map(|_| 0),
         })
     }
 
@@ -280,8 +333,48 @@ impl<R: Read + Seek> ContainerReader<R> {
     /// it (its entry then holds only the bytes present); `None` for a complete part.
     pub fn truncated(&self, tag: Tag) -> Option<u64> {
         self.truncated
-            .filter(|&(t, _)| t == tag)
-            .map(|(_, declared)| declared)
+            .filter(|&(t, segment, _)| t == tag && (!tag.per_segment() || segment == self.selected))
+            .map(|(.., declared)| declared)
+    }
+
+    /// Whether the file ends inside its progressive last part.
+    pub fn cut_short(&self) -> bool {
+        self.truncated.is_some()
+    }
+
+    /// Temporal segments in the stream (0 for a stream that is not cut into segments).
+    pub fn segments(&self) -> u32 {
+        self.segments
+    }
+
+    /// Makes [`ContainerReader::entry`] (and every read by tag) find segment `segment`'s own
+    /// parts; the whole stream's parts are found whatever the segment.
+    pub fn select(&mut self, segment: u32) -> Result<()> {
+        if segment >= self.segments.max(1) {
+            return Err(Error::Stream(format!(
+                "segment {segment}: the stream has {} segments",
+                self.segments.max(1)
+            )));
+        }
+        self.selected = (self.segments > 0).then_some(segment);
+        Ok(())
+    }
+
+    /// The payload of segment `segment`'s start marker (a segmented stream's), verified.
+    pub fn segment_start(&mut self, segment: u32) -> Result<Vec<u8>> {
+        let e = self
+            .parts
+            .iter()
+            .find(|p| p.tag == Tag::SEGMENT && p.segment == Some(segment))
+            .copied()
+            .ok_or_else(|| Error::Stream(format!("missing start of segment {segment}")))?;
+        let bytes = self.read_at(e.offset, e.len, e.tag)?;
+        if crc32fast::hash(&bytes) != e.crc {
+            return Err(Error::Stream(format!(
+                "the start of segment {segment} fails its checksum (damaged file)"
+            )));
+        }
+        Ok(bytes)
     }
 
     /// The part table.
@@ -294,18 +387,31 @@ impl<R: Read + Seek> ContainerReader<R> {
         self.file_len
     }
 
-    /// The entry of a part that must be present.
+    /// The entry of a part that must be present (of the selected segment, for a segment's part).
     pub fn entry(&self, tag: Tag) -> Result<PartEntry> {
-        self.parts
-            .iter()
-            .find(|p| p.tag == tag)
-            .copied()
-            .ok_or_else(|| Error::Stream(format!("missing part {tag}")))
+        self.find(tag).ok_or_else(|| match self.selected {
+            Some(s) if tag.per_segment() => {
+                Error::Stream(format!("missing part {tag} in segment {s}"))
+            }
+            _ => Error::Stream(format!("missing part {tag}")),
+        })
     }
 
-    /// Whether a part is present.
+    /// Whether a part is present (in the selected segment, for a segment's part).
     pub fn has(&self, tag: Tag) -> bool {
-        self.parts.iter().any(|p| p.tag == tag)
+        self.find(tag).is_some()
+    }
+
+    fn find(&self, tag: Tag) -> Option<PartEntry> {
+        let scope = if tag.per_segment() {
+            self.selected
+        } else {
+            None
+        };
+        self.parts
+            .iter()
+            .find(|p| p.tag == tag && p.segment == scope)
+            .copied()
     }
 
     /// A whole part's payload, verified against its CRC.
@@ -358,8 +464,49 @@ fn table_io(e: std::io::Error) -> Error {
     Error::Stream(format!("reading the part table: {e}"))
 }
 
-/// Reads and checks the 16-byte file header (magic, version); returns the part count.
-fn read_file_header<R: Read>(source: &mut R) -> Result<u32> {
+/// Checks where each part lies: a version-3 stream has no segments; a segmented one has its
+/// segments' parts after their start markers and the whole stream's before the first; no part
+/// appears twice in one place (a damaged tag could otherwise shadow another part).
+fn check_scopes(parts: &[PartEntry], version: u16) -> Result<()> {
+    let segmented = parts.iter().any(|p| p.tag == Tag::SEGMENT);
+    if segmented != (version == VERSION_SEGMENTED) {
+        return Err(Error::Stream(format!(
+            "stream version {version} {} segments (damaged file?)",
+            if segmented {
+                "cannot hold"
+            } else {
+                "must hold"
+            }
+        )));
+    }
+    let mut seen = rustc_hash::FxHashSet::default();
+    for p in parts {
+        if segmented && p.tag != Tag::SEGMENT && p.tag.per_segment() != p.segment.is_some() {
+            return Err(Error::Stream(format!(
+                "part {} lies {} (damaged file?)",
+                p.tag,
+                if p.segment.is_some() {
+                    "inside a segment but belongs to the whole stream"
+                } else {
+                    "before the first segment but belongs to one"
+                }
+            )));
+        }
+        if !seen.insert((p.tag, p.segment)) {
+            return Err(Error::Stream(format!(
+                "part {} appears twice{} (damaged file?)",
+                p.tag,
+                p.segment
+                    .map_or(String::new(), |s| format!(" in segment {s}"))
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Reads and checks the 16-byte file header (magic, version); returns the version and the part
+/// count.
+fn read_file_header<R: Read>(source: &mut R) -> Result<(u16, u32)> {
     let mut head = [0u8; 16];
     read_exact_or(source, &mut head, "the file header")?;
     let mut r = ByteReader::new(&head, "file header");
@@ -375,10 +522,10 @@ fn read_file_header<R: Read>(source: &mut R) -> Result<u32> {
              reads stream version {VERSION} only: re-encode the animation from its source"
         )));
     }
-    if version != VERSION {
+    if version > VERSION_SEGMENTED {
         return Err(Error::Stream(format!(
-            "stream version {version} is newer than this build reads (version {VERSION}): \
-             update mcgv-video"
+            "stream version {version} is newer than this build reads (versions {VERSION} and \
+             {VERSION_SEGMENTED}): update mcgv-video"
         )));
     }
     let _reserved = r.u16()?;
@@ -388,7 +535,7 @@ fn read_file_header<R: Read>(source: &mut R) -> Result<u32> {
             "header claims {count} parts (at most {MAX_PARTS})"
         )));
     }
-    Ok(count)
+    Ok((version, count))
 }
 
 /// One part header as read by [`read_part_entry`].
@@ -461,6 +608,7 @@ fn read_part_entry<R: Read>(
         len,
         crc,
         checksum,
+        segment: None,
     };
     Ok(PartRead {
         entry,

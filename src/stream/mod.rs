@@ -9,5 +9,6 @@ pub mod container;
 pub mod entropy;
 pub mod frame_index;
 pub mod header;
+pub mod segments;
 pub mod side_info;
 mod texcoords;

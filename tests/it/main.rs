@@ -20,6 +20,7 @@ mod mesh_io;
 mod metrics_reference;
 mod motion;
 mod roundtrip;
+mod segments;
 mod skinning;
 mod tdct;
 mod tdct_spatial;

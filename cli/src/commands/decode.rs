@@ -8,7 +8,7 @@ use crate::progress;
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::gltf_write::MANY_MORPH_TARGETS;
-use mcgv_video::mesh::io::{write_obj_mesh_frame, write_obj_sequence_from};
+use mcgv_video::mesh::io::{write_obj_mesh_frame, write_obj_sequence_from, ObjFrameWriter};
 use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions, DEFAULT_FPS};
 use std::fs::File;
 use std::io::BufReader;
@@ -27,7 +27,12 @@ pub fn warn_if_truncated<R>(decoder: &Decoder<R>)
 where
     R: std::io::Read + std::io::Seek,
 {
-    if decoder.truncated() {
+    if decoder.truncated() && decoder.segments().len() > 1 {
+        eprintln!(
+            "mcgv-video: warning: stream truncated inside its last segment's temporal-DCT bands: \
+             that segment decodes coarser"
+        );
+    } else if decoder.truncated() {
         eprintln!(
             "mcgv-video: warning: stream truncated: decoded {} of {} temporal-DCT bands, a coarser animation",
             decoder.bands_decoded(),
@@ -69,6 +74,13 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             args.input.display()
         );
     }
+    if kind == OutputKind::ObjFolder && args.frame.is_none() && args.frames.is_none() {
+        prepare_frame_folder(&args.output, args.force)?;
+        let frames = stream_obj_frames(&mut decoder, &args.output, quiet)
+            .map_err(|e| super::in_file(&args.input, e))?;
+        let vertices = decoder.header().vertices as usize;
+        return report(args, quiet, start, frames, vertices);
+    }
     let mesh =
         decode_mesh(&mut decoder, args, quiet).map_err(|e| super::in_file(&args.input, e))?;
     match kind {
@@ -95,18 +107,44 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
         }
     }
+    report(args, quiet, start, mesh.frame_count(), mesh.vertex_count())
+}
+
+/// Says what was written, unless `quiet`.
+fn report(
+    args: &DecodeArgs,
+    quiet: bool,
+    start: Instant,
+    frames: usize,
+    vertices: usize,
+) -> Result<()> {
     if !quiet {
         let seconds = start.elapsed().as_secs_f64();
         outln!(
-            "{}: {} frame(s) of {} vertices written in {:.2} s ({:.1} frames/s)",
+            "{}: {frames} frame(s) of {vertices} vertices written in {seconds:.2} s ({:.1} frames/s)",
             args.output.display(),
-            mesh.frame_count(),
-            mesh.vertex_count(),
-            seconds,
-            mesh.frame_count() as f64 / seconds.max(1e-9)
+            frames as f64 / seconds.max(1e-9)
         )?;
     }
     Ok(())
+}
+
+/// Decodes every frame into an OBJ folder, each file written as soon as its segment is decoded:
+/// memory holds one segment, whatever the clip's length. Returns the frames written.
+fn stream_obj_frames(
+    decoder: &mut Decoder<BufReader<File>>,
+    dir: &std::path::Path,
+    quiet: bool,
+) -> Result<usize> {
+    let frames = decoder.header().frames as usize;
+    let (triangles, attributes) = (decoder.triangles().to_vec(), decoder.attributes().clone());
+    let writer = ObjFrameWriter::new(dir, frames.saturating_sub(1), &triangles, &attributes)?;
+    let pb = progress::bar(frames as u64, "decode", quiet);
+    decoder.for_each_frame(&crate::progress::Reporter(&pb), |f, positions| {
+        writer.write(f, &positions)
+    })?;
+    pb.finish_and_clear();
+    Ok(frames)
 }
 
 /// The frames `--frame` asks for (all by default), decoded.

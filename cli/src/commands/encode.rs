@@ -89,6 +89,11 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
         weight_bits: args.weight_bits,
         step: args.step,
         uv_bits: args.uv_bits,
+        segment_frames: match args.segment_frames {
+            None => defaults.segment_frames,
+            Some(0) => None,
+            Some(n) => Some(usize::try_from(n).unwrap_or(usize::MAX)),
+        },
     })
 }
 
@@ -248,11 +253,11 @@ fn encode_one(
     }
     let start = Instant::now();
     let spin = progress::spinner("reading", quiet);
-    let mesh = super::read_input(&args.input, read_options, quiet);
+    let source = super::open_source(&args.input, read_options, quiet);
     spin.finish_and_clear();
-    let mesh = mesh?;
-    let pb = progress::bar(mesh.frame_count() as u64, "encode", quiet);
-    let encoded = encoder::encode_with_progress(&mesh, opts, &progress::Reporter(&pb))?;
+    let mut source = source?;
+    let pb = progress::bar(source.frame_count() as u64, "encode", quiet);
+    let encoded = encoder::encode_source(&mut source, opts, &progress::Reporter(&pb))?;
     pb.finish_and_clear();
     if to_stdout {
         write_stdout_bytes(&encoded.to_bytes())?;
@@ -295,6 +300,10 @@ fn encode_one(
             choice.reason
         ),
         None => line,
+    };
+    let line = match r.segments {
+        1 => line,
+        n => format!("{line}\nsegments: {n}, coded with the first segment's choices"),
     };
     let line = match r.first_frame_trials.as_slice() {
         [] => line,

@@ -5,31 +5,26 @@ use crate::progress;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::error::{Error, Result};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
-use mcgv_video::mesh::{AnimatedMesh, ReadOptions};
-use mcgv_video::metrics::{compare, Measures};
+use mcgv_video::mesh::{AnimatedMesh, FrameSource, ReadOptions};
+use mcgv_video::metrics::{compare, Comparison, Measures, Surface};
+use std::fs::File;
+use std::io::BufReader;
 use std::path::Path;
 
 /// Runs `eval`.
 pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     let opts: ReadOptions = (&args.input_args).into();
-    let original = super::read_input(&args.original, &opts, quiet)?;
     let measures = if is_mcgv(&args.decoded) {
+        let mut original = super::open_source(&args.original, &opts, quiet)?;
         let options = super::decode::decode_options(args.bands, args.input_args.max_positions);
         let path = Path::new(&args.decoded);
         let mut decoder =
             Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;
         super::decode::warn_if_truncated(&decoder);
         let bits = decoder.container().file_len() * 8;
-        let pb = progress::bar(decoder.header().frames as u64, "decode", quiet);
-        let decoded = decoder
-            .decode_all_with_progress(&crate::progress::Reporter(&pb))
-            .map_err(|e| super::in_file(path, e))?;
-        pb.finish_and_clear();
-        let decoded = match decoder.header().reorder {
-            true => input_order(&original, decoded, decoder.header().first_frame_bits)?,
-            false => decoded,
-        };
-        compare(&original, &decoded)?.with_bits(bits)
+        compare_stream(&mut original, &mut decoder, quiet)
+            .map_err(|e| super::in_file(path, e))?
+            .with_bits(bits)
     } else {
         if args.bands.is_some() {
             return Err(Error::option(
@@ -37,6 +32,7 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
                 "applies to a .mcgv stream of codec tdct",
             ));
         }
+        let original = super::read_input(&args.original, &opts, quiet)?;
         compare(&original, &super::read_input(&args.decoded, &opts, quiet)?)?
     };
     if args.json {
@@ -48,28 +44,90 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     }
 }
 
+/// The measures of a stream against its original, a segment of each at a time: memory holds one
+/// segment of both, whatever the clip's length.
+fn compare_stream(
+    original: &mut FrameSource,
+    decoder: &mut Decoder<BufReader<File>>,
+    quiet: bool,
+) -> Result<Measures> {
+    let frames = original.frame_count();
+    if decoder.header().frames as usize != frames {
+        return Err(Error::Usage(format!(
+            "the original has {frames} frames but the decoded animation has {}; frames must correspond",
+            decoder.header().frames
+        )));
+    }
+    let bits = decoder.header().first_frame_bits;
+    let same_vertices = original.first().vertex_count() == decoder.header().vertices as usize;
+    let order = match decoder.header().reorder && same_vertices {
+        true => input_order(original.first(), bits)?,
+        false => None,
+    };
+    let triangles = match &order {
+        Some(inverse) => AnimatedMesh::new(
+            decoder.triangles().to_vec(),
+            vec![decoder.reference().to_vec()],
+        )?
+        .permuted(inverse)?
+        .triangles()
+        .to_vec(),
+        None => decoder.triangles().to_vec(),
+    };
+    let pb = progress::bar(frames as u64, "decode", quiet);
+    let mut comparison: Option<Comparison> = None;
+    for (s, range) in decoder.segments().to_vec().into_iter().enumerate() {
+        let mut decoded = decoder.decode_segment(s, &crate::progress::Reporter(&pb))?;
+        if let Some(inverse) = &order {
+            for frame in &mut decoded {
+                *frame = inverse.iter().map(|&v| frame[v as usize]).collect();
+            }
+        }
+        let originals = original.read(range)?;
+        let comparison = match &mut comparison {
+            Some(c) => c,
+            None => comparison.insert(Comparison::new(
+                Surface {
+                    triangles: original.first().triangles(),
+                    positions: &originals[0],
+                },
+                Surface {
+                    triangles: &triangles,
+                    positions: &decoded[0],
+                },
+            )?),
+        };
+        comparison.add(&originals, &decoded)?;
+    }
+    pb.finish_and_clear();
+    comparison
+        .map(Comparison::finish)
+        .ok_or_else(|| Error::Stream("the stream has no frames".into()))
+}
+
 /// A stream encoded with `--reorder` holds its vertices in the first-frame coder's traversal
 /// order, and keeps no permutation (that is what saves its bits). The coder is deterministic, so
-/// coding the original's first frame again gives the permutation, and the decoded animation is put
-/// back in the input order: vertex RMSE and KG error then compare each vertex with itself.
-fn input_order(original: &AnimatedMesh, decoded: AnimatedMesh, bits: u8) -> Result<AnimatedMesh> {
+/// coding the original's first frame again gives the permutation: the returned `inverse` puts the
+/// decoded vertices back in the input order (input vertex `v` is decoded vertex `inverse[v]`), so
+/// that vertex RMSE and KG error compare each vertex with itself.
+fn input_order(original: &AnimatedMesh, bits: u8) -> Result<Option<Vec<u32>>> {
     let options = FirstFrameOptions {
         bits,
         reorder: true,
     };
     let coded = first_frame::encode(original.frame(0), original.triangles(), &options)?;
     let Some(permutation) = coded.permutation else {
-        return Ok(decoded);
+        return Ok(None);
     };
-    if permutation.len() != decoded.vertex_count() {
-        return Ok(decoded);
+    if permutation.len() != original.vertex_count() {
+        return Ok(None);
     }
     // permutation[new] = old; the decoded mesh is in `new` order, so vertex `old` is at inverse[old].
     let mut inverse = vec![0u32; permutation.len()];
     for (new, &old) in permutation.iter().enumerate() {
         inverse[old as usize] = new as u32;
     }
-    decoded.permuted(&inverse)
+    Ok(Some(inverse))
 }
 
 /// Whether a path names a `.mcgv` stream (compared after decoding, with its bpvf).

@@ -14,6 +14,11 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
     let options = super::decode::decode_options(None, args.input_args.max_positions);
     let mut decoder =
         Decoder::open_with(&args.input, &options).map_err(|e| super::in_file(&args.input, e))?;
+    let segments = decoder.segments().to_vec();
+    // The codec figures (bit depth, bands, step) are the first segment's.
+    decoder
+        .seek_segment(0)
+        .map_err(|e| super::in_file(&args.input, e))?;
     let header = decoder.header().clone();
     let total = decoder.container().file_len();
     let parts = mcgv_video::inspect::part_bytes(&decoder);
@@ -54,12 +59,20 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "bytes": total,
             "bpvf": bpvf,
             "parts": parts_obj,
+            "segments": segments.len(),
             "band_bytes": (!bands.is_empty()).then_some(&bands),
             "step": decoder.band_step(),
         });
         return outln!("{value}");
     }
     outln!("{}", summary(&header, &args.input))?;
+    if segments.len() > 1 {
+        outln!(
+            "{} temporal segments of up to {} frames (parts of a kind summed; bands of the first)",
+            segments.len(),
+            segments[0].len()
+        )?;
+    }
     outln!(
         "{:<22} {:>12} {:>14} {:>7} {:>8}",
         "part",
@@ -250,7 +263,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
 
     for &f in &frames {
         let plane = decoder.decoded_plane(f)?;
-        let ranges = decoder.ranges().get(f).copied();
+        let ranges = decoder.frame_ranges(f)?;
         save_residuals(
             &dir.join(format!("frame_{f:04}_decoded.png")),
             plane,

@@ -8,8 +8,20 @@ pub mod info;
 pub mod inspect;
 
 use mcgv_video::error::{Error, Result};
-use mcgv_video::mesh::{clips, read_animation, AnimatedMesh, Clip, ReadOptions};
+use mcgv_video::mesh::{clips, read_animation, AnimatedMesh, Clip, FrameSource, ReadOptions};
 use std::path::Path;
+
+/// An animation's frames as `encode` and `eval` read them: OBJ sequences and PC2 caches a run of
+/// frames at a time (a long clip is never held whole), a glTF clip baked whole by [`read_input`].
+pub fn open_source(input: &str, opts: &ReadOptions, quiet: bool) -> Result<FrameSource> {
+    let gltf = [".gltf", ".glb"]
+        .iter()
+        .any(|e| input.to_ascii_lowercase().ends_with(e));
+    if gltf {
+        return FrameSource::from_mesh(read_input(input, opts, quiet)?);
+    }
+    FrameSource::open(input, opts).map_err(|e| in_file(input, e))
+}
 
 /// Reads an animation as every command does; a glTF with several clips read without `--clip` says
 /// on stderr which clip it took and how to pick another (unless `quiet`).

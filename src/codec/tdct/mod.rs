@@ -41,7 +41,12 @@ pub const ROUNDING_LAMBDA: f64 = 0.1;
 /// bounding-box diagonal) or the one `quality` maps to, rounded to the `f32` the stream stores, so
 /// that the encoder quantises with exactly the step the decoder reads.
 pub fn step(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<f32> {
-    crate::codec::quality::stored_step("temporal-DCT step", mesh.bbox_diagonal(), opts, 1.0)
+    step_of_diagonal(mesh.bbox_diagonal(), opts)
+}
+
+/// [`step`] for a first frame of bounding-box diagonal `diagonal`.
+fn step_of_diagonal(diagonal: f64, opts: &EncodeOptions) -> Result<f32> {
+    crate::codec::quality::stored_step("temporal-DCT step", diagonal, opts, 1.0)
 }
 
 /// The temporal-DCT residual encoder.
@@ -51,7 +56,7 @@ impl ResidualEncoder for Encoder {
     fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals> {
         let clock = Instant::now();
         input.progress.stage("temporal DCT");
-        let step = step(input.mesh, input.options)?;
+        let step = step_of_diagonal(input.diagonal, input.options)?;
         let coefficients = coefficients::forward(input.residuals)?;
         let step64 = f64::from(step);
         // Plain rounding here only decides which bands are empty; the levels coded are chosen by

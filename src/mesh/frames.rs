@@ -1,0 +1,172 @@
+//! Animations read a run of frames at a time (issue 20): OBJ sequences file by file and PC2
+//! caches sample by sample, so that a long clip is never held whole. glTF clips are baked whole
+//! (the baker poses every frame from the clip's channels) and served from memory.
+
+use super::obj::{check_same_mesh, frame_files, read_obj};
+use super::{gltf, pc2, AnimatedMesh, Point, ReadOptions};
+use crate::error::{Error, Result};
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// An animation whose frames are read on request, in any order.
+pub struct FrameSource {
+    /// The first frame, with the connectivity, attributes and frame rate every run shares.
+    first: AnimatedMesh,
+    frames: usize,
+    origin: Origin,
+}
+
+/// Where the frames come from.
+enum Origin {
+    /// One OBJ file per frame (the first one's connectivity checked in each).
+    Obj(Vec<PathBuf>),
+    /// A PC2 cache: `points` positions of 12 bytes per sample.
+    Pc2 {
+        file: File,
+        path: PathBuf,
+        points: usize,
+    },
+    /// Frames already in memory (glTF bakes).
+    Memory(AnimatedMesh),
+}
+
+impl FrameSource {
+    /// Opens an animation as [`super::read_animation`] names it, reading its first frame only
+    /// (all of it for glTF).
+    pub fn open(input: &str, opts: &ReadOptions) -> Result<Self> {
+        let path = Path::new(input);
+        let extension = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match extension.as_deref() {
+            Some("pc2") => Self::open_pc2(path, opts.base.as_deref()),
+            Some("gltf") | Some("glb") => {
+                let clip = opts.clip.as_deref();
+                Self::from_mesh(gltf::read_gltf(path, opts.fps, clip, opts.max_positions)?)
+            }
+            _ => Self::open_obj(frame_files(input)?),
+        }
+    }
+
+    /// A source over an animation in memory.
+    pub fn from_mesh(mesh: AnimatedMesh) -> Result<Self> {
+        Ok(Self {
+            frames: mesh.frame_count(),
+            first: mesh.clip(0..1)?,
+            origin: Origin::Memory(mesh),
+        })
+    }
+
+    fn open_obj(files: Vec<PathBuf>) -> Result<Self> {
+        let path = files
+            .first()
+            .ok_or_else(|| Error::Usage("no .obj files to read".into()))?;
+        let frame = read_obj(path)?;
+        let first = AnimatedMesh::new(frame.triangles, vec![frame.positions])?
+            .with_attributes(frame.attributes)?;
+        Ok(Self {
+            frames: files.len(),
+            first,
+            origin: Origin::Obj(files),
+        })
+    }
+
+    fn open_pc2(path: &Path, base: Option<&Path>) -> Result<Self> {
+        let mesh_error = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
+        let mut file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+        let mut header = Vec::new();
+        (&mut file)
+            .take(pc2::SAMPLES_START)
+            .read_to_end(&mut header)
+            .map_err(|e| Error::io(path, e))?;
+        let (points, samples) = pc2::parse_header(&header, len).map_err(mesh_error)?;
+        let base = pc2::base_path(path, base)?;
+        let obj = read_obj(&base)?;
+        if obj.positions.len() != points {
+            return Err(mesh_error(format!(
+                "{points} points per frame but its base mesh {} has {} vertices",
+                base.display(),
+                obj.positions.len()
+            )));
+        }
+        let mut source = Self {
+            frames: samples,
+            first: AnimatedMesh::new(obj.triangles, vec![obj.positions])?
+                .with_attributes(obj.attributes)?,
+            origin: Origin::Pc2 {
+                file,
+                path: path.to_path_buf(),
+                points,
+            },
+        };
+        // The cache's own first sample is the first frame (the base OBJ gives faces only).
+        let first = source.read(0..1)?;
+        source.first = AnimatedMesh::new(source.first.triangles().to_vec(), first)?
+            .with_attributes(source.first.attributes().clone())?;
+        Ok(source)
+    }
+
+    /// Frames in the animation.
+    pub fn frame_count(&self) -> usize {
+        self.frames
+    }
+
+    /// The first frame as a one-frame animation (connectivity, attributes, frame rate).
+    pub fn first(&self) -> &AnimatedMesh {
+        &self.first
+    }
+
+    /// The positions of `frames`.
+    pub fn read(&mut self, frames: Range<usize>) -> Result<Vec<Vec<Point>>> {
+        if frames.start > frames.end || frames.end > self.frames {
+            return Err(Error::Usage(format!(
+                "frames {frames:?}: the animation has {}",
+                self.frames
+            )));
+        }
+        match &mut self.origin {
+            Origin::Memory(mesh) => Ok(mesh.frames()[frames].to_vec()),
+            Origin::Obj(files) => {
+                let (vertices, triangles) = (self.first.vertex_count(), self.first.triangles());
+                files[frames]
+                    .iter()
+                    .map(|path| {
+                        let frame = read_obj(path)?;
+                        check_same_mesh(triangles, vertices, &files_first(files), &frame, path)?;
+                        Ok(frame.positions)
+                    })
+                    .collect()
+            }
+            Origin::Pc2 { file, path, points } => {
+                let bytes = *points as u64 * 12;
+                let at = pc2::SAMPLES_START + frames.start as u64 * bytes;
+                let io = |e| Error::io(path.as_path(), e);
+                file.seek(SeekFrom::Start(at)).map_err(io)?;
+                let mut buf = vec![0u8; *points * 12];
+                frames
+                    .map(|_| {
+                        file.read_exact(&mut buf).map_err(io)?;
+                        Ok(pc2::parse_frame(&buf))
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Frames `frames` as an animation with the first frame's connectivity, attributes and rate.
+    pub fn clip(&mut self, frames: Range<usize>) -> Result<AnimatedMesh> {
+        let positions = self.read(frames)?;
+        Ok(
+            AnimatedMesh::new(self.first.triangles().to_vec(), positions)?
+                .with_attributes(self.first.attributes().clone())?
+                .with_frame_rate(self.first.frame_rate()),
+        )
+    }
+}
+
+fn files_first(files: &[PathBuf]) -> PathBuf {
+    files.first().cloned().unwrap_or_default()
+}

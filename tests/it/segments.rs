@@ -1,0 +1,175 @@
+//! Temporal segments (issue 20): a long clip coded as runs of frames decodes as a whole and frame
+//! by frame alike, a frame reads its own segment only, and damaged or reordered segments are
+//! refused.
+
+use crate::common::{animate, decoder, encode_bytes, parts, rebuild, tube};
+use mcgv_video::encoder::segments::SegmentedEncoder;
+use mcgv_video::stream::container::{Checksum, Tag, VERSION, VERSION_SEGMENTED};
+use mcgv_video::{encode, AnimatedMesh, Codec, EncodeOptions, Lattice, PredictorChoice, Silent};
+use mcgv_video::{PredictorKind, SegmentationChoice};
+
+/// A bending tube of `frames` frames: two clusters' worth of motion, small enough to code fast.
+fn clip(frames: usize) -> AnimatedMesh {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, -2.0, 2.0, 9, 8);
+    animate(&points, tris, frames, |t, _, p| {
+        let bend = 0.4 * (6.0 * t).sin() * p[0].max(0.0);
+        [p[0], p[1] + bend, p[2] + 0.1 * t * p[0]]
+    })
+}
+
+fn options(codec: Codec, segment_frames: Option<usize>) -> EncodeOptions {
+    EncodeOptions {
+        codec,
+        quality: 60,
+        clusters: 2,
+        segmentation: SegmentationChoice::Fixed(mcgv_video::Segmentation::KMeans),
+        predictor: PredictorChoice::Fixed(PredictorKind::Affine),
+        lattice: match codec {
+            Codec::Tdct => Lattice::Auto,
+            _ => Lattice::Fixed(32, 32),
+        },
+        gop: if codec == Codec::Mpeg4 { 4 } else { 50 },
+        segment_frames,
+        ..EncodeOptions::default()
+    }
+}
+
+fn version(bytes: &[u8]) -> u16 {
+    u16::from_le_bytes([bytes[8], bytes[9]])
+}
+
+#[test]
+fn segmented_streams_decode_whole_and_frame_by_frame_alike() {
+    let mesh = clip(23);
+    for codec in [Codec::Tdct, Codec::Jpeg, Codec::Mpeg4] {
+        let bytes = encode_bytes(&mesh, &options(codec, Some(8)));
+        assert_eq!(version(&bytes), VERSION_SEGMENTED, "{codec:?}");
+        let mut dec = decoder(bytes).unwrap();
+        assert_eq!(dec.segments(), &[0..8, 8..16, 16..23], "{codec:?}");
+        let all = dec.decode_all().unwrap();
+        assert_eq!(all.frame_count(), 23);
+        // Backwards too: every seek reopens a segment.
+        for f in (0..23).rev() {
+            assert_eq!(
+                dec.decode_frame(f).unwrap(),
+                all.frame(f),
+                "{codec:?} frame {f}"
+            );
+        }
+        let worst = (0..23)
+            .flat_map(|f| all.frame(f).iter().zip(mesh.frame(f)))
+            .flat_map(|(a, b)| (0..3).map(move |i| (a[i] - b[i]).abs()))
+            .fold(0.0f32, f32::max);
+        assert!(worst < 0.1, "{codec:?}: worst error {worst}");
+    }
+}
+
+#[test]
+fn a_clip_of_one_segment_keeps_the_unsegmented_stream() {
+    let mesh = clip(12);
+    let long = encode_bytes(&mesh, &options(Codec::Tdct, Some(12)));
+    let never = encode_bytes(&mesh, &options(Codec::Tdct, None));
+    assert_eq!(long, never);
+    assert_eq!(version(&long), VERSION);
+}
+
+#[test]
+fn a_frame_reads_its_own_segment_only() {
+    let mesh = clip(24);
+    for codec in [Codec::Tdct, Codec::Mpeg4] {
+        let bytes = encode_bytes(&mesh, &options(codec, Some(8)));
+        let expected = decoder(bytes.clone()).unwrap().decode_frame(13).unwrap();
+        // Damage every payload of segments 0 and 2 (checksums made for the damaged bytes would
+        // hide it: leave them stale, so any read of those parts fails).
+        let mut segment = None;
+        let mut damaged = bytes.clone();
+        let reader_parts = parts(&bytes);
+        let mut offset = 16usize;
+        for (tag, payload, _) in &reader_parts {
+            offset += 17;
+            if *tag == Tag::SEGMENT {
+                segment = Some(segment.map_or(0, |s| s + 1));
+            }
+            if tag.per_segment() && segment != Some(1) && !payload.is_empty() {
+                damaged[offset + payload.len() / 2] ^= 0x5a;
+            }
+            offset += payload.len();
+        }
+        let mut dec = decoder(damaged).expect("opens: no segment is read at open");
+        assert_eq!(dec.decode_frame(13).unwrap(), expected, "{codec:?}");
+        assert_eq!(dec.open_segment(), Some(1));
+        assert!(
+            dec.decode_frame(20).is_err(),
+            "{codec:?}: segment 2 is damaged"
+        );
+        assert!(
+            dec.decode_frame(3).is_err(),
+            "{codec:?}: segment 0 is damaged"
+        );
+        assert_eq!(dec.decode_frame(9).unwrap().len(), mesh.vertex_count());
+    }
+}
+
+#[test]
+fn missing_reordered_or_misplaced_segments_are_refused() {
+    let mesh = clip(24);
+    let bytes = encode_bytes(&mesh, &options(Codec::Tdct, Some(8)));
+    let all = parts(&bytes);
+    let starts: Vec<usize> = (0..all.len())
+        .filter(|&i| all[i].0 == Tag::SEGMENT)
+        .collect();
+    // The last segment dropped.
+    let dropped = rebuild(all[..starts[2]].to_vec());
+    let err = decoder(dropped).err().expect("refused").to_string();
+    assert!(err.contains("missing segment"), "{err}");
+    // Segments 1 and 2 swapped.
+    let mut swapped = all[..starts[1]].to_vec();
+    swapped.extend_from_slice(&all[starts[2]..]);
+    swapped.extend_from_slice(&all[starts[1]..starts[2]]);
+    let err = decoder(rebuild(swapped))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(err.contains("out of order"), "{err}");
+    // A segment's part before the first segment.
+    let mut misplaced = all.clone();
+    let affine = misplaced.iter().position(|p| p.0 == Tag::AFFINE).unwrap();
+    let part = misplaced.remove(affine);
+    misplaced.insert(1, part);
+    let err = decoder(rebuild(misplaced))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(err.contains("belongs to one"), "{err}");
+    // A segment start in a stream that claims version 3.
+    let mut old = bytes.clone();
+    old[8..10].copy_from_slice(&VERSION.to_le_bytes());
+    let err = decoder(old).err().expect("refused").to_string();
+    assert!(err.contains("cannot hold segments"), "{err}");
+    // Two affine parts in one segment.
+    let mut twice = all.clone();
+    twice.insert(starts[1] + 1, (Tag::AFFINE, vec![0; 4], Checksum::Whole));
+    let err = decoder(rebuild(twice)).err().expect("refused").to_string();
+    assert!(err.contains("twice"), "{err}");
+}
+
+#[test]
+fn segments_pushed_one_by_one_make_the_stream_encode_makes() {
+    let mesh = clip(20);
+    let opts = options(Codec::Jpeg, Some(8));
+    let whole = encode(&mesh, &opts).unwrap();
+    assert_eq!(whole.report.segments, 3);
+    let first = AnimatedMesh::new(mesh.triangles().to_vec(), mesh.frames()[..8].to_vec()).unwrap();
+    let mut encoder = SegmentedEncoder::start(&first, &opts, 8, &Silent).unwrap();
+    let too_long = encoder.push(mesh.frames()[8..17].to_vec(), &Silent);
+    assert!(too_long.is_err());
+    encoder
+        .push(mesh.frames()[8..16].to_vec(), &Silent)
+        .unwrap();
+    encoder.push(mesh.frames()[16..].to_vec(), &Silent).unwrap();
+    assert_eq!(encoder.frames(), 20);
+    assert_eq!(encoder.finish().unwrap().to_bytes(), whole.to_bytes());
+    let zero = encode(&mesh, &options(Codec::Jpeg, Some(0)));
+    assert!(zero.err().unwrap().to_string().contains("segment_frames"));
+}
