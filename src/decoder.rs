@@ -9,6 +9,7 @@ use crate::codec::{Codec, Plane, ResidualDecoder, StreamLayout};
 use crate::error::{Error, Result};
 use crate::first_frame;
 use crate::geometry_image::FrameRanges;
+use crate::limits::{self, DEFAULT_MAX_POSITIONS};
 use crate::mesh::{AnimatedMesh, Attributes, Point, Triangle};
 use crate::motion::{predict_frame, AffineTrack, Partition, PredictorKind, SkinningWeights};
 use crate::progress::{Progress, Silent};
@@ -24,10 +25,22 @@ use std::ops::Range;
 use std::path::Path;
 
 /// Choices a reader can make about decoding.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct DecodeOptions {
     /// Temporal DCT only: decode no more than this many frequency bands (a progressive preview).
     pub max_bands: Option<usize>,
+    /// Refuse a stream whose header promises more positions (vertices × frames) than this, before
+    /// reading anything else (default [`DEFAULT_MAX_POSITIONS`]).
+    pub max_positions: u64,
+}
+
+impl Default for DecodeOptions {
+    fn default() -> Self {
+        Self {
+            max_bands: None,
+            max_positions: DEFAULT_MAX_POSITIONS,
+        }
+    }
 }
 
 /// An opened stream: everything but the coded residuals is read and checked at open.
@@ -82,6 +95,7 @@ impl<R: Read + Seek> Decoder<R> {
     /// and of a segmented stream, the first segment's.
     pub fn from_container(mut reader: ContainerReader<R>, options: &DecodeOptions) -> Result<Self> {
         let header = Header::from_bytes(&reader.part(Tag::HEADER)?)?;
+        limits::check_stream(header.vertices, header.frames, options.max_positions)?;
         let (v, f) = (header.vertices as usize, header.frames as usize);
         let (triangles, reference) = first_frame::decode(&reader.part(Tag::FIRST_FRAME)?)?;
         if reference.len() != v || triangles.len() != header.triangles as usize {
@@ -418,15 +432,18 @@ impl Shared<'_> {
             header: &header,
             triangles: self.triangles,
         };
-        // The codec's parts come first: their per-frame figures (ranges, band index) take a few
-        // bytes a frame, so reading them proves the segment's frame count before the affine
-        // track allocates 12 coefficients per frame and cluster.
+        // The affine part is read first keeping none of its levels (constant memory): it must hold
+        // every frame up to its end word, which proves the segment's frame count before the
+        // codec's parts allocate per frame (a temporal-DCT index of empty bands takes a fraction
+        // of a bit a frame and proves none) and before the track gets room for 12 levels a frame
+        // and cluster.
+        let affine = reader.part(Tag::AFFINE)?;
+        let (partition, reference) = (self.partition, self.reference);
+        side_info::check_affine(&affine, frames.len(), partition, reference)?;
         let residuals = header
             .codec
             .open_decoder(&layout, reader, self.options.max_bands)?;
-        let affine = reader.part(Tag::AFFINE)?;
-        let track =
-            side_info::decode_affine(&affine, frames.len(), self.partition, self.reference)?;
+        let track = side_info::decode_checked_affine(&affine, frames.len(), partition, reference)?;
         Ok(OpenSegment {
             index: s,
             frames,

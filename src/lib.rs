@@ -42,6 +42,7 @@ pub mod error;
 pub mod first_frame;
 pub mod geometry_image;
 pub mod inspect;
+pub mod limits;
 pub mod mesh;
 pub mod metrics;
 pub mod motion;
@@ -57,6 +58,7 @@ pub use encoder::{
 };
 pub use error::{Error, Result};
 pub use geometry_image::Lattice;
+pub use limits::DEFAULT_MAX_POSITIONS;
 pub use mesh::{read_animation, AnimatedMesh, Attributes, FrameSource, ReadOptions};
 pub use motion::PredictorKind;
 pub use progress::{Progress, Silent};

@@ -1,16 +1,20 @@
 //! Forged streams whose counts fit the header's limits but not the bytes that should carry them:
-//! refused with a clear error before anything is allocated per claimed element. A counting
-//! allocator measures the peak memory of each refusal on its own thread.
+//! refused with a clear error before anything is allocated per claimed element; and the positions
+//! limit, which bounds what a valid stream makes the decoder produce. A counting allocator measures
+//! the peak memory of each refusal on its own thread.
 
 mod common;
 
 use common::{parts, rebuild, tiny_stream};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
+use mcgv_video::stream::container::ContainerReader;
 use mcgv_video::stream::container::Tag;
 use mcgv_video::stream::entropy::max_symbols;
 use mcgv_video::{codec::Codec, stream::header::Header};
+use mcgv_video::{DecodeOptions, Decoder, Error, DEFAULT_MAX_POSITIONS};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
+use std::io::Cursor;
 
 /// The system allocator, counting the bytes live on each thread and their peak.
 struct Counting;
@@ -204,10 +208,11 @@ fn triangles_past_what_the_connectivity_stream_holds_are_refused() {
 }
 
 #[test]
-fn frames_past_what_the_ranges_hold_are_refused_before_the_affine_track() {
+fn frames_past_what_the_affine_part_holds_are_refused_before_the_affine_track() {
     // 4M frames of one cluster are 48M affine coefficients: 12 KB of zero bytes decode as that
-    // many (each at the coder's floor), so the affine part alone cannot refuse the claim. The
-    // residual ranges take 24 bytes a frame (a step and an offset per axis) and are read first.
+    // many (each at the coder's floor), so the affine part's length alone cannot refuse the claim.
+    // Its end word does, read in a dry run that keeps no level; the residual ranges (24 bytes a
+    // frame: a step and an offset per axis) would refuse it next, still before the track's 384 MB.
     const FRAMES: u32 = 1 << 22;
     let mut forged = parts(&tiny_stream(Codec::Jpeg));
     for (tag, payload, _) in forged.iter_mut() {
@@ -224,15 +229,133 @@ fn frames_past_what_the_ranges_hold_are_refused_before_the_affine_track() {
     }
     let bytes = rebuild(forged);
     let start = std::time::Instant::now();
-    let (result, peak) = peak_of(|| mcgv_video::decoder::Decoder::new(&bytes).map(|_| ()));
+    let (result, peak) = peak_of(|| Decoder::new(&bytes).map(|_| ()));
     let msg = match result {
         Ok(_) => panic!("a forged frame count was accepted"),
         Err(e) => e.to_string(),
     };
+    assert!(msg.contains(&format!("{FRAMES} frames")), "{msg}");
+    assert!(peak < SMALL, "refusing took {peak} bytes");
+    assert!(start.elapsed().as_secs() < 5, "refusing did the work first");
+}
+
+/// A real tdct stream whose header claims `frames` frames: its band index lists that many empty
+/// bands (zero bytes: each decodes as an empty band at the coder's floor, so the index is valid), and
+/// its affine part is zero bytes too, as few as the affine count check lets pass. About 15 KB with
+/// valid checksums; only the affine part's end word, after 12 levels a frame, is wrong.
+fn forged_tdct_frames(frames: u32) -> Vec<u8> {
+    let mut forged = parts(&tiny_stream(Codec::Tdct));
+    // Bytes that hold `n` symbols by `max_symbols`, and a margin for the models to reach the floor.
+    let holding = |n: u64| {
+        let per_byte = max_symbols(1) - max_symbols(0);
+        (n.div_ceil(per_byte) as usize + 64).next_multiple_of(4)
+    };
+    let (index_len, affine_len) = (holding(u64::from(frames)), holding(12 * u64::from(frames)));
+    for (tag, payload, _) in forged.iter_mut() {
+        if *tag == Tag::HEADER {
+            let mut header = Header::from_bytes(payload).expect("a valid header");
+            header.frames = frames;
+            *payload = header.to_bytes();
+        } else if *tag == Tag::TDCT_INDEX {
+            // The step, the band count, then the coded lengths.
+            payload.truncate(4);
+            payload.extend(frames.to_le_bytes());
+            payload.extend(vec![0u8; index_len]);
+        } else if *tag == Tag::TDCT {
+            payload.clear();
+        } else if *tag == Tag::AFFINE {
+            payload.truncate(4);
+            payload.extend(vec![0u8; affine_len]);
+        }
+    }
+    rebuild(forged)
+}
+
+#[test]
+fn a_forged_15_kb_tdct_stream_claiming_millions_of_frames_is_refused_in_little_memory() {
+    const FRAMES: u32 = 6_000_000;
+    let bytes = forged_tdct_frames(FRAMES);
     assert!(
-        msg.contains(&format!("2 residual ranges for {FRAMES} frames")),
+        (12_000..16_000).contains(&bytes.len()),
+        "{} bytes",
+        bytes.len()
+    );
+    let (result, peak) = peak_of(|| Decoder::new(&bytes).map(|_| ()));
+    let msg = match result {
+        Ok(_) => panic!("a forged frame count was accepted"),
+        Err(e) => e.to_string(),
+    };
+    eprintln!(
+        "forged tdct stream of {} bytes: peak {peak} bytes: {msg}",
+        bytes.len()
+    );
+    assert!(msg.contains(&format!("{FRAMES} frames")), "{msg}");
+    assert!(peak < 64 << 20, "refusing took {peak} bytes: {msg}");
+}
+
+#[test]
+fn a_first_frame_claiming_the_vertices_its_padding_could_hold_is_refused_in_little_memory() {
+    // 15 KB of zero bytes after the geometry pass the count check for 28M vertices: the decoder
+    // used to make room for all of them (786 MB) before decoding the first padded one.
+    let pad = 15_000;
+    let claim = |b: &[u8]| (max_symbols(word(b, GEOMETRY_LEN) as usize) / 3) as u32;
+    let c = claim(&forged_first_frame(true, GEOMETRY_LEN, pad, |_| {}));
+    let bytes = forged_first_frame(true, GEOMETRY_LEN, pad, |b| set_word(b, VERTEX_COUNT, c));
+    let (result, peak) = peak_of(|| first_frame::decode(&bytes).map(|_| ()));
+    let msg = result
+        .expect_err("zero bytes are not 28M positions")
+        .to_string();
+    assert!(c > 25_000_000, "a claim worth refusing: {c}");
+    assert!(msg.contains("first frame geometry"), "{msg}");
+    assert!(peak < SMALL, "refusing took {peak} bytes: {msg}");
+}
+
+/// Opens `bytes` with a positions limit.
+fn open_limited(bytes: &[u8], max_positions: u64) -> mcgv_video::Result<()> {
+    let options = DecodeOptions {
+        max_positions,
+        ..DecodeOptions::default()
+    };
+    let reader = ContainerReader::new(Cursor::new(bytes))?;
+    Decoder::from_container(reader, &options).map(|_| ())
+}
+
+#[test]
+fn the_positions_limit_refuses_a_stream_past_it_and_opens_one_at_it() {
+    let bytes = tiny_stream(Codec::Jpeg); // 4 vertices × 2 frames
+    open_limited(&bytes, 8).expect("8 positions are within a limit of 8");
+    let err = open_limited(&bytes, 7).expect_err("8 positions are past 7");
+    let msg = err.to_string();
+    assert!(
+        matches!(
+            err,
+            Error::InvalidOption {
+                option: "max_positions",
+                ..
+            }
+        ),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("is 7") && msg.contains("4 vertices × 2 frames = 8 positions"),
+        "{msg}"
+    );
+
+    // The default limit, against a header that claims 2^28 frames: refused before any other part.
+    let mut forged = parts(&bytes);
+    for (tag, payload, _) in forged.iter_mut() {
+        if *tag == Tag::HEADER {
+            let mut header = Header::from_bytes(payload).expect("a valid header");
+            header.frames = 1 << 28;
+            *payload = header.to_bytes();
+        }
+    }
+    let forged = rebuild(forged);
+    let (result, peak) = peak_of(|| open_limited(&forged, DEFAULT_MAX_POSITIONS));
+    let msg = result.expect_err("past the default").to_string();
+    assert!(
+        msg.contains(&format!("4 vertices × {} frames", 1 << 28)),
         "{msg}"
     );
     assert!(peak < SMALL, "refusing took {peak} bytes");
-    assert!(start.elapsed().as_secs() < 5, "refusing did the work first");
 }

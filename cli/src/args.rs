@@ -87,6 +87,10 @@ pub struct InputArgs {
     /// Base OBJ giving the connectivity of a PC2 point cache (default: the .obj beside the .pc2).
     #[arg(long)]
     pub base: Option<PathBuf>,
+    /// Refuse to bake a glTF clip or decode a .mcgv of more positions (frames × vertices) than N,
+    /// before allocating them (default 10^9, 12 GB as f32 points).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_positions: Option<u64>,
 }
 
 /// `encode` arguments.
@@ -301,6 +305,10 @@ pub struct DecodeArgs {
     /// tdct streams: decode only the first N temporal-DCT bands (a coarser, progressive preview).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub bands: Option<u64>,
+    /// Refuse a stream whose header promises more positions (frames × vertices) than N, before
+    /// allocating them (default 10^9, 12 GB as f32 points).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_positions: Option<u64>,
 }
 
 /// `A..B` with A < B, for `decode --frames`.
@@ -398,6 +406,9 @@ impl From<&InputArgs> for mcgv_video::ReadOptions {
             fps: args.fps,
             clip: args.clip.clone(),
             base: args.base.clone(),
+            max_positions: args
+                .max_positions
+                .unwrap_or(mcgv_video::DEFAULT_MAX_POSITIONS),
         }
     }
 }

@@ -48,16 +48,23 @@ pub(super) fn code_positions<C: SymbolCoder>(
     {
         return Err(corrupt("triangle indexes a missing vertex"));
     }
-    // Triangles around each vertex, as compressed rows.
-    let mut start = vec![0usize; vertex_count + 1];
+    // Triangles around each vertex, as compressed rows, for the vertices of some triangle: those in
+    // none follow and have no row. Sized by the decoded triangles, not by the header's vertex
+    // count, which only the positions decoded below prove.
+    let touched = triangles
+        .iter()
+        .flatten()
+        .max()
+        .map_or(0, |&v| v as usize + 1);
+    let mut start = vec![0usize; touched + 1];
     for &v in triangles.iter().flatten() {
         start[v as usize + 1] += 1;
     }
-    for k in 0..vertex_count {
+    for k in 0..touched {
         start[k + 1] += start[k];
     }
     let mut fill = start.clone();
-    let mut around = vec![0u32; start[vertex_count]];
+    let mut around = vec![0u32; start[touched]];
     for (t, tri) in triangles.iter().enumerate() {
         for &v in tri {
             around[fill[v as usize]] = t as u32;
@@ -67,11 +74,15 @@ pub(super) fn code_positions<C: SymbolCoder>(
     let by_edge = by_edge(triangles);
 
     let mut models = Models::default();
-    let mut cells: Vec<Cell> = Vec::with_capacity(vertex_count);
+    // Grown as positions decode (the encoder knows them all).
+    let mut cells: Vec<Cell> = Vec::with_capacity(actual.len().max(touched));
     for v in 0..vertex_count as u32 {
+        let row = start
+            .get(v as usize..v as usize + 2)
+            .map_or(0..0, |r| r[0]..r[1]);
         let (mut par_sum, mut par_n) = ([0i64; 3], 0i64);
         let (mut nb_sum, mut nb_n) = ([0i64; 3], 0i64);
-        for &t in &around[start[v as usize]..start[v as usize + 1]] {
+        for &t in &around[row] {
             let tri = triangles[t as usize];
             let Some(k) = tri.iter().position(|&x| x == v) else {
                 continue;

@@ -77,16 +77,16 @@ pub struct StreamSizes {
     pub order: usize,
 }
 
-/// Codes the triangles with a repeated vertex index.
+/// Codes the triangles with a repeated vertex index (`model` carries on from one call to the next).
 fn code_degenerate<C: SymbolCoder>(
     coder: &mut C,
+    model: &mut UIntModel,
     triangles: &mut [Triangle],
     vertex_count: usize,
 ) -> Result<()> {
-    let mut model = UIntModel::default();
     for tri in triangles.iter_mut() {
         for v in tri.iter_mut() {
-            let index = coder.unsigned(u64::from(*v), &mut model)?;
+            let index = coder.unsigned(u64::from(*v), model)?;
             *v = u32::try_from(index)
                 .ok()
                 .filter(|&i| (i as usize) < vertex_count)
@@ -128,7 +128,8 @@ pub fn encode(
         &traversal_cells,
     )?;
     to_traversal_indices(&mut degenerate, &oracle.to_traversal);
-    code_degenerate(&mut connectivity, &mut degenerate, vertex_count)?;
+    let mut model = UIntModel::default();
+    code_degenerate(&mut connectivity, &mut model, &mut degenerate, vertex_count)?;
 
     let order_stream = if opts.reorder {
         Vec::new()
@@ -299,8 +300,8 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
     )?;
     let cells =
         geometry::code_positions(&mut geometry, &grid, &state.triangles, vertex_count, &[])?;
-    let mut degenerate = vec![[0u32; 3]; header.degenerate as usize];
-    code_degenerate(&mut connectivity, &mut degenerate, vertex_count)?;
+    let degenerate =
+        decode_degenerate(&mut connectivity, header.degenerate as usize, vertex_count)?;
     let mut triangles = state.triangles;
     triangles.extend(degenerate);
     let mut positions: Vec<Point> = cells.iter().map(|&c| grid.dequantise(c)).collect();
@@ -320,6 +321,24 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
         }
     }
     Ok((triangles, positions))
+}
+
+/// Decodes `count` degenerate triangles a block at a time: the count is only a claim until they
+/// decode, so room is made as they do.
+fn decode_degenerate(
+    coder: &mut Decoder,
+    count: usize,
+    vertex_count: usize,
+) -> Result<Vec<Triangle>> {
+    const BLOCK: usize = 1 << 12;
+    let mut model = UIntModel::default();
+    let mut degenerate = Vec::new();
+    while degenerate.len() < count {
+        let at = degenerate.len();
+        degenerate.resize(at + (count - at).min(BLOCK), [0u32; 3]);
+        code_degenerate(coder, &mut model, &mut degenerate[at..], vertex_count)?;
+    }
+    Ok(degenerate)
 }
 
 fn truncated() -> Error {

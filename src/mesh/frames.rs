@@ -43,7 +43,8 @@ impl FrameSource {
         match extension.as_deref() {
             Some("pc2") => Self::open_pc2(path, opts.base.as_deref()),
             Some("gltf") | Some("glb") => {
-                Self::from_mesh(gltf::read_gltf(path, opts.fps, opts.clip.as_deref())?)
+                let clip = opts.clip.as_deref();
+                Self::from_mesh(gltf::read_gltf(path, opts.fps, clip, opts.max_positions)?)
             }
             _ => Self::open_obj(frame_files(input)?),
         }

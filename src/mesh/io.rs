@@ -5,11 +5,12 @@
 
 use super::{gltf, obj, pc2, AnimatedMesh};
 use crate::error::{Error, Result};
+use crate::limits::DEFAULT_MAX_POSITIONS;
 use crate::output::write_atomic;
 use std::path::{Path, PathBuf};
 
 /// Options that apply to reading any input form.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ReadOptions {
     /// Rate at which glTF animations are baked (default: the animation's keyframe rate, or 30).
     pub fps: Option<f64>,
@@ -17,6 +18,20 @@ pub struct ReadOptions {
     pub clip: Option<String>,
     /// Base OBJ with the connectivity of a PC2 point cache (default: the .obj beside the .pc2).
     pub base: Option<PathBuf>,
+    /// glTF: refuse a clip that bakes to more positions (frames × vertices) than this, before baking
+    /// (default [`DEFAULT_MAX_POSITIONS`]).
+    pub max_positions: u64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        Self {
+            fps: None,
+            clip: None,
+            base: None,
+            max_positions: DEFAULT_MAX_POSITIONS,
+        }
+    }
 }
 
 /// Reads an animation: a folder or glob of `.obj` files, a `.pc2` point cache, or a `.gltf`/`.glb`.
@@ -42,7 +57,9 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
     }
     match extension.as_deref() {
         Some("pc2") => pc2::read_pc2_animation(path, opts.base.as_deref()),
-        Some("gltf") | Some("glb") => gltf::read_gltf(path, opts.fps, opts.clip.as_deref()),
+        Some("gltf") | Some("glb") => {
+            gltf::read_gltf(path, opts.fps, opts.clip.as_deref(), opts.max_positions)
+        }
         _ => obj::read_sequence(&obj::frame_files(input)?),
     }
 }
@@ -99,7 +116,7 @@ pub fn parse_gltf(
     fps: Option<f64>,
     clip: Option<&str>,
 ) -> Result<AnimatedMesh> {
-    gltf::parse_gltf(bytes, name, fps, clip)
+    gltf::parse_gltf(bytes, name, fps, clip, DEFAULT_MAX_POSITIONS)
 }
 
 /// Writes one OBJ per frame into `dir` as `frame_0000.obj`, … (created if missing).

@@ -92,6 +92,8 @@ impl Models {
 
 /// Codes the levels cluster by cluster, coefficient by coefficient, each trajectory over all
 /// frames; `orders[k * 12 + c]` is trajectory (k, c)'s predictor order (filled when decoding).
+/// With `q.values` empty, a decoder reads every level and keeps none: a dry run that checks the
+/// part (its end word included) in constant memory before its levels are given room.
 fn code_trajectories<C: SymbolCoder>(
     c: &mut C,
     q: &mut QuantisedAffine,
@@ -100,7 +102,6 @@ fn code_trajectories<C: SymbolCoder>(
 ) -> Result<()> {
     let mut models = Models::new();
     let (frames, clusters) = (q.frames, q.clusters);
-    let mut history = Vec::with_capacity(frames);
     if identity.len() != clusters || orders.len() != clusters * 12 {
         return Err(Error::Stream(format!(
             "affine coefficients: {clusters} clusters, the partition has {}",
@@ -113,18 +114,20 @@ fn code_trajectories<C: SymbolCoder>(
             let slot = k * 12 + coeff;
             let order = 1 + c.symbol(orders[slot] - 1, &mut models.order[kind])?;
             orders[slot] = order;
-            history.clear();
+            // The last ORDERS levels, oldest first: all that `extrapolate` looks back at.
+            let mut history = [0i64; ORDERS];
             let mut class = 0;
             for f in 0..frames {
                 let i = (f * clusters + k) * 12 + coeff;
                 let (guess, model) = match f {
                     0 => (first, &mut models.first[kind]),
                     _ => (
-                        extrapolate(order, &history),
+                        extrapolate(order, &history[ORDERS - f.min(ORDERS)..]),
                         &mut models.residual[kind][class],
                     ),
                 };
-                let r = c.signed(q.values[i].wrapping_sub(guess), model)?;
+                let target = q.values.get(i).copied().unwrap_or(guess);
+                let r = c.signed(target.wrapping_sub(guess), model)?;
                 let value = guess.checked_add(r).filter(|v| v.abs() <= MAX_AFFINE_LEVEL);
                 let Some(value) = value else {
                     return Err(Error::Stream(format!(
@@ -132,16 +135,20 @@ fn code_trajectories<C: SymbolCoder>(
                          {f} is beyond ±2^40"
                     )));
                 };
-                q.values[i] = value;
-                history.push(value);
+                if let Some(slot) = q.values.get_mut(i) {
+                    *slot = value;
+                }
+                history.rotate_left(1);
+                history[ORDERS - 1] = value;
                 class = magnitude_class(r);
             }
         }
     }
     if c.raw_bits(u64::from(AFFINE_END), 32)? != u64::from(AFFINE_END) {
-        return Err(Error::Stream(
-            "affine coefficients: the coded data end early (truncated or damaged)".into(),
-        ));
+        return Err(Error::Stream(format!(
+            "affine coefficients: the coded data end before the levels of {frames} frames of \
+             {clusters} clusters do (truncated, damaged, or a forged frame count)"
+        )));
     }
     Ok(())
 }
@@ -176,40 +183,98 @@ pub fn encode_affine(track: &AffineTrack) -> Result<Vec<u8>> {
 }
 
 /// Decodes the affine track of `frames` frames for `partition`'s clusters on the decoded frame 0
-/// `reference` (whose cluster geometry sets the steps).
+/// `reference` (whose cluster geometry sets the steps). The part is read twice: once keeping no
+/// level (as [`check_affine`]), then into a track, so that its 12 levels a frame and cluster (96
+/// bytes) are allocated only for a part that holds them all; a byte of zeros decodes to thousands
+/// of levels, so its length alone proves little.
 pub fn decode_affine(
     bytes: &[u8],
     frames: usize,
     partition: &Partition,
     reference: &[Point],
 ) -> Result<AffineTrack> {
-    let mut r = ByteReader::new(bytes, "affine coefficients");
-    let step = r.f32()?;
-    let rest = r.take(r.remaining())?;
-    let clusters = partition.clusters();
-    let count = (frames as u64)
-        .saturating_mul(clusters as u64)
-        .saturating_mul(12);
-    if count > entropy::max_symbols(rest.len()) {
-        return Err(Error::Stream(format!(
-            "affine coefficients: {count} values cannot fit in {} bytes",
-            rest.len()
-        )));
+    check_affine(bytes, frames, partition, reference)?;
+    decode_checked_affine(bytes, frames, partition, reference)
+}
+
+/// [`decode_affine`] of a part that [`check_affine`] has passed: read once.
+pub(crate) fn decode_checked_affine(
+    bytes: &[u8],
+    frames: usize,
+    partition: &Partition,
+    reference: &[Point],
+) -> Result<AffineTrack> {
+    let mut part = AffinePart::open(bytes, frames, partition, reference)?;
+    part.q.values = vec![0; frames * part.q.clusters * 12];
+    part.read()?;
+    AffineTrack::from_quantised(part.q, part.geometry)
+}
+
+/// Checks that the affine part holds `frames` frames of `partition`'s clusters, end word
+/// included, in memory that does not grow with the frames (the levels are read and dropped).
+pub fn check_affine(
+    bytes: &[u8],
+    frames: usize,
+    partition: &Partition,
+    reference: &[Point],
+) -> Result<()> {
+    AffinePart::open(bytes, frames, partition, reference)?.read()
+}
+
+/// An affine part whose step and length are checked, ready to read.
+struct AffinePart<'a> {
+    /// The track read so far: no levels until they are given room.
+    q: QuantisedAffine,
+    geometry: ClusterGeometry,
+    /// The identity's levels of every cluster, which predict frame 0.
+    identity: Vec<[i64; 12]>,
+    coded: &'a [u8],
+}
+
+impl<'a> AffinePart<'a> {
+    fn open(
+        bytes: &'a [u8],
+        frames: usize,
+        partition: &Partition,
+        reference: &[Point],
+    ) -> Result<Self> {
+        let mut r = ByteReader::new(bytes, "affine coefficients");
+        let step = r.f32()?;
+        let coded = r.take(r.remaining())?;
+        let clusters = partition.clusters();
+        let count = (frames as u64)
+            .saturating_mul(clusters as u64)
+            .saturating_mul(12);
+        if count > entropy::max_symbols(coded.len()) {
+            return Err(Error::Stream(format!(
+                "affine coefficients: {count} values cannot fit in {} bytes",
+                coded.len()
+            )));
+        }
+        // The step sets the identity's levels below: refuse a forged one first.
+        QuantisedAffine::check_step(step)?;
+        let geometry = ClusterGeometry::of(reference, partition);
+        let identity = identity_of(&geometry, step);
+        let q = QuantisedAffine {
+            step,
+            frames,
+            clusters,
+            values: Vec::new(),
+        };
+        Ok(Self {
+            q,
+            geometry,
+            identity,
+            coded,
+        })
     }
-    let mut q = QuantisedAffine {
-        step,
-        frames,
-        clusters,
-        values: vec![0; count as usize],
-    };
-    // The step sets the identity's levels below: refuse a forged one first.
-    QuantisedAffine::check_step(step)?;
-    let geometry = ClusterGeometry::of(reference, partition);
-    let identity = identity_of(&geometry, step);
-    let mut orders = vec![1usize; clusters * 12];
-    let mut dec = Decoder::new(rest)?;
-    code_trajectories(&mut dec, &mut q, &mut orders, &identity)?;
-    AffineTrack::from_quantised(q, geometry)
+
+    /// Reads every level and the end word, keeping the levels where `q.values` has room.
+    fn read(&mut self) -> Result<()> {
+        let mut orders = vec![1usize; self.q.clusters * 12];
+        let mut dec = Decoder::new(self.coded)?;
+        code_trajectories(&mut dec, &mut self.q, &mut orders, &self.identity)
+    }
 }
 
 #[cfg(test)]
@@ -223,6 +288,8 @@ mod tests {
         assert_eq!(extrapolate(1, &line), 9);
         let square = [0, 1, 4, 9];
         assert_eq!(extrapolate(3, &square), 16);
+        // What the coder passes: the last three levels at most.
+        assert_eq!(extrapolate(3, &square[1..]), 16);
         assert_eq!(extrapolate(3, &square[..1]), 0);
         assert_eq!(best_order(&[0, 1, 4, 9, 16, 25, 36]), 3);
         assert_eq!(best_order(&[4, 4, 4, 4]), 1);

@@ -23,8 +23,11 @@ const PRECISION: usize = 16;
 const ONE: u32 = 1 << PRECISION;
 /// Probability floor of an adaptive bit (of `ONE`): bounds how many symbols a byte can hold.
 const MIN_PROBABILITY: u32 = 64;
-/// A symbol costs at least -log2(1 - MIN_PROBABILITY/ONE) ≈ 1/710 bit; rounded down for safety.
-const MAX_SYMBOLS_PER_BIT: u64 = 700;
+/// A symbol costs at least -log2(1 - MIN_PROBABILITY/ONE) = 1/709.4 bit (the range coder's
+/// rounding only adds to that), so a bit holds at most 709.4 symbols: rounded up, since the bound
+/// must never refuse what the encoder writes (10⁷ decisions at the floor take 1 764 bytes, 5 669
+/// a byte, which 700 a bit refused).
+const MAX_SYMBOLS_PER_BIT: u64 = 710;
 
 /// Upper bound on the number of symbols a decoder over `byte_len` bytes may read.
 ///
@@ -643,6 +646,27 @@ mod tests {
         let bytes = enc.finish().unwrap();
         // entropy of p = 0.01 is 0.08 bit: 10 000 symbols fit well under 200 bytes
         assert!(bytes.len() < 200, "{} bytes", bytes.len());
+    }
+
+    /// The densest data the coder writes: one decision after another at the probability floor.
+    /// `max_symbols` must let all of them decode back.
+    #[test]
+    fn decisions_at_the_floor_fit_the_symbol_bound() {
+        const N: u64 = 10_000_000;
+        let mut enc = Encoder::new();
+        let mut m = BitModel::default();
+        for _ in 0..N {
+            enc.bit(false, &mut m);
+        }
+        let bytes = enc.finish().unwrap();
+        // Within 1 % of the floor's 709.4 decisions a bit: the bound is as tight as it can be.
+        let per_byte = N as f64 / bytes.len() as f64;
+        assert!((5_620.0..=5_676.0).contains(&per_byte), "{per_byte}");
+        let mut dec = Decoder::new(&bytes).unwrap();
+        let mut m = BitModel::default();
+        for k in 0..N {
+            assert!(!dec.bit(&mut m).unwrap(), "decision {k}");
+        }
     }
 
     #[test]

@@ -12,7 +12,8 @@ use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
 use crate::motion::{cluster_neighbours, Partition, SkinningWeights};
 
-pub use super::affine_coding::{decode_affine, encode_affine};
+pub(crate) use super::affine_coding::decode_checked_affine;
+pub use super::affine_coding::{check_affine, decode_affine, encode_affine};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::entropy::{
     self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel,

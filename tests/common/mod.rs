@@ -60,7 +60,8 @@ pub fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
     decoder(bytes)?.decode_all()
 }
 
-/// A real two-frame stream of a square (two triangles, one cluster), small enough to forge quickly.
+/// A real two-frame stream of a square (two triangles, one cluster), small enough to forge quickly
+/// (a 16 × 16 lattice for the image codecs).
 pub fn tiny_stream(codec: Codec) -> Vec<u8> {
     let square = |t: f32| {
         vec![
@@ -75,9 +76,16 @@ pub fn tiny_stream(codec: Codec) -> Vec<u8> {
     let opts = EncodeOptions {
         codec,
         clusters: 1,
-        lattice: Lattice::Fixed(16, 16),
-        padding: Some(padding::Method::Cg),
         ..EncodeOptions::default()
+    };
+    // Only the image codecs have a lattice to pad.
+    let opts = match codec.has_images() {
+        true => EncodeOptions {
+            lattice: Lattice::Fixed(16, 16),
+            padding: Some(padding::Method::Cg),
+            ..opts
+        },
+        false => opts,
     };
     encode(&mesh, &opts).expect("encodes").to_bytes()
 }

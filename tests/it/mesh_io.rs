@@ -336,12 +336,48 @@ fn cesium_man_is_human_sized_and_moves_continuously() {
 }
 
 #[test]
+fn a_bake_past_the_positions_limit_is_refused_naming_the_rate_that_fits() {
+    let at = |fps: f64, max_positions: u64| {
+        let opts = ReadOptions {
+            fps: Some(fps),
+            max_positions,
+            ..Default::default()
+        };
+        read_animation(&media_path("CesiumMan.glb"), &opts)
+    };
+    let vertices = at(48.0, u64::MAX).unwrap().vertex_count() as u64;
+    // 95 frames at 48 frames/s: at the limit bakes, one position fewer is refused before baking.
+    assert_eq!(at(48.0, 95 * vertices).unwrap().frame_count(), 95);
+    let limit = 95 * vertices - 1;
+    let err = at(48.0, limit).unwrap_err().to_string();
+    for needle in [
+        "fps: 48 bakes",
+        "CesiumMan.glb",
+        "to 95 frames",
+        &format!("{vertices} vertices"),
+        &format!("limit of {limit}"),
+        "at most 94 frames fit",
+    ] {
+        assert!(err.contains(needle), "`{needle}` not in: {err}");
+    }
+    // The rate it names bakes within the limit.
+    let rate: f64 = err
+        .split("a rate of ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|r| r.parse().ok())
+        .unwrap_or_else(|| panic!("no rate in: {err}"));
+    assert!(rate < 48.0, "{err}");
+    assert!(at(rate, limit).unwrap().frame_count() <= 94);
+}
+
+#[test]
 fn frame_rate_and_clip_are_chosen_by_the_options() {
     let at = |fps: Option<f64>, clip: Option<&str>| {
         let opts = ReadOptions {
             fps,
             clip: clip.map(str::to_owned),
-            base: None,
+            ..Default::default()
         };
         read_animation(&media_path("CesiumMan.glb"), &opts)
     };
@@ -354,7 +390,7 @@ fn frame_rate_and_clip_are_chosen_by_the_options() {
     assert!(at(Some(0.0), None).unwrap_err().to_string().contains("fps"));
     let err = at(Some(1e6), None).unwrap_err().to_string();
     assert!(
-        err.contains("CesiumMan.glb") && err.contains("fps") && err.contains("lower rate"),
+        err.contains("CesiumMan.glb") && err.contains("fps") && err.contains("frames/s or lower"),
         "{err}"
     );
 

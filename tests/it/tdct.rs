@@ -27,7 +27,10 @@ fn decoder(
 ) -> mcgv_video::Result<Decoder<Cursor<Vec<u8>>>> {
     Decoder::from_container(
         ContainerReader::new(Cursor::new(bytes))?,
-        &DecodeOptions { max_bands },
+        &DecodeOptions {
+            max_bands,
+            ..DecodeOptions::default()
+        },
     )
 }
 

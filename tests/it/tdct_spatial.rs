@@ -98,7 +98,11 @@ fn spatial_prediction_on_a_cloth_round_trips() {
     let bytes = encode_bytes(&mesh, &opts);
     let open = |bands| {
         let reader = ContainerReader::new(Cursor::new(bytes.clone())).unwrap();
-        Decoder::from_container(reader, &DecodeOptions { max_bands: bands }).unwrap()
+        let options = DecodeOptions {
+            max_bands: bands,
+            ..DecodeOptions::default()
+        };
+        Decoder::from_container(reader, &options).unwrap()
     };
     let all = open(None).decode_all().unwrap();
     assert!(compare(&mesh, &all).unwrap().rmse < 1e-3);

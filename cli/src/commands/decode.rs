@@ -14,10 +14,11 @@ use std::fs::File;
 use std::io::BufReader;
 use std::time::Instant;
 
-/// The decoding options of `--bands`.
-pub fn decode_options(bands: Option<u64>) -> DecodeOptions {
+/// The decoding options of `--bands` and `--max-positions`.
+pub fn decode_options(bands: Option<u64>, max_positions: Option<u64>) -> DecodeOptions {
     DecodeOptions {
         max_bands: bands.map(|n| usize::try_from(n).unwrap_or(usize::MAX)),
+        max_positions: max_positions.unwrap_or(mcgv_video::DEFAULT_MAX_POSITIONS),
     }
 }
 
@@ -61,8 +62,9 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             "applies to a glTF output (.glb, .gltf)",
         ));
     }
-    let mut decoder = Decoder::open_with(&args.input, &decode_options(args.bands))
-        .map_err(|e| super::in_file(&args.input, e))?;
+    let mut decoder =
+        Decoder::open_with(&args.input, &decode_options(args.bands, args.max_positions))
+            .map_err(|e| super::in_file(&args.input, e))?;
     warn_if_truncated(&decoder);
     if decoder.header().reorder && !quiet {
         eprintln!(

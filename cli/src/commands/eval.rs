@@ -16,7 +16,7 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     let opts: ReadOptions = (&args.input_args).into();
     let measures = if is_mcgv(&args.decoded) {
         let mut original = super::open_source(&args.original, &opts, quiet)?;
-        let options = super::decode::decode_options(args.bands);
+        let options = super::decode::decode_options(args.bands, args.input_args.max_positions);
         let path = Path::new(&args.decoded);
         let mut decoder =
             Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;

@@ -11,7 +11,9 @@ use std::path::Path;
 
 /// Runs `inspect`.
 pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
-    let mut decoder = Decoder::open(&args.input).map_err(|e| super::in_file(&args.input, e))?;
+    let options = super::decode::decode_options(None, args.input_args.max_positions);
+    let mut decoder =
+        Decoder::open_with(&args.input, &options).map_err(|e| super::in_file(&args.input, e))?;
     let segments = decoder.segments().to_vec();
     // The codec figures (bit depth, bands, step) are the first segment's.
     decoder

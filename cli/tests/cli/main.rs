@@ -11,6 +11,7 @@ mod eval;
 mod frictions;
 mod gltf;
 mod info;
+mod limits;
 mod outputs;
 mod segmentation;
 mod segments;

@@ -22,6 +22,7 @@ mod validate;
 
 use super::AnimatedMesh;
 use crate::error::{Error, Result};
+use crate::limits::DEFAULT_MAX_POSITIONS;
 use std::path::{Path, PathBuf};
 
 /// The file's buffers, loaded.
@@ -33,13 +34,18 @@ fn buffer_data<'d>(buffers: Buffers<'d>, buffer: gltf::Buffer) -> Option<&'d [u8
 }
 
 /// Reads `path` and bakes the chosen clip (name or index, default the first) at `fps` (default the
-/// clip's keyframe rate if plausible, else 30).
-pub(crate) fn read_gltf(path: &Path, fps: Option<f64>, clip: Option<&str>) -> Result<AnimatedMesh> {
+/// clip's keyframe rate if plausible, else 30), refusing one of more than `max_positions` positions.
+pub(crate) fn read_gltf(
+    path: &Path,
+    fps: Option<f64>,
+    clip: Option<&str>,
+    max_positions: u64,
+) -> Result<AnimatedMesh> {
     // Read whole and parsed from memory: gltf's own reader allocates what a GLB header claims (up to
     // 4 GB for a 12-byte file) before reading it.
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let gltf = validate::from_slice(&bytes, path)?;
-    bake(gltf, path.parent(), path, fps, clip)
+    bake(gltf, path.parent(), path, fps, clip, max_positions)
 }
 
 /// The parsed document of a glTF file and its loaded buffers (for [`clips`] and the writer's
@@ -86,7 +92,7 @@ pub(crate) fn clips(path: &Path, fps: Option<f64>) -> Result<Vec<Clip>> {
     let mut clips = Vec::new();
     for animation in document.animations() {
         let channels = channels::read_channels(&animation, &buffers).map_err(fail)?;
-        let times = sample::FrameTimes::new(&channels, fps, 1, path)?;
+        let times = sample::FrameTimes::new(&channels, fps, 1, DEFAULT_MAX_POSITIONS, path)?;
         clips.push(Clip {
             index: animation.index(),
             name: animation.name().unwrap_or("").to_string(),
@@ -124,18 +130,21 @@ pub(crate) fn parse_gltf(
     path: &Path,
     fps: Option<f64>,
     clip: Option<&str>,
+    max_positions: u64,
 ) -> Result<AnimatedMesh> {
     let gltf = validate::from_slice(bytes, path)?;
-    bake(gltf, None, path, fps, clip)
+    bake(gltf, None, path, fps, clip, max_positions)
 }
 
-/// Bakes a parsed glTF; buffer files are looked up in `folder` (none: only embedded buffers).
+/// Bakes a parsed glTF's `clip` at `fps`; buffer files are looked up in `folder` (none: only
+/// embedded buffers).
 fn bake(
     gltf: gltf::Gltf,
     folder: Option<&Path>,
     path: &Path,
     fps: Option<f64>,
     clip: Option<&str>,
+    max_positions: u64,
 ) -> Result<AnimatedMesh> {
     let fail = |what: String| Error::Mesh(format!("{}: {what}", path.display()));
     let gltf::Gltf { document, blob } = gltf;
@@ -153,7 +162,8 @@ fn bake(
     let geometry = geometry::Geometry::gather(&document, &scene, data).map_err(fail)?;
     let skins = skin::read_skins(&document, data).map_err(fail)?;
 
-    let times = sample::FrameTimes::new(&channels, fps, geometry.vertex_count, path)?;
+    let times =
+        sample::FrameTimes::new(&channels, fps, geometry.vertex_count, max_positions, path)?;
     let pose = nodes::Pose::new(&document);
     let rate = times.rate();
     let frames = times

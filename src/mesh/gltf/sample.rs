@@ -2,7 +2,8 @@
 //! interpolation), the clip's keyframe rate, and the times at which frames are baked.
 
 use super::channels::Channel;
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::limits::{check_bake, Bake};
 use gltf::animation::{Interpolation, Property};
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::path::Path;
@@ -12,8 +13,6 @@ use std::path::Path;
 const FALLBACK_FPS: f64 = crate::mesh::DEFAULT_FPS;
 /// Estimated keyframe rates outside this range are not trusted (sparse or dense keys).
 const PLAUSIBLE_FPS: std::ops::RangeInclusive<f64> = 10.0..=240.0;
-/// More positions (frames × vertices) than this would not fit in memory: surely a mistaken `fps`.
-const MAX_POSITIONS: f64 = 4e8;
 
 /// The times of the baked frames: from the first key to the last at the frame rate, the last
 /// clamped to the clip's end.
@@ -27,11 +26,13 @@ pub(super) struct FrameTimes {
 
 impl FrameTimes {
     /// The frames of the clip at `fps` (default: its keyframe rate if plausible, else 30); an error
-    /// when `vertex_count` positions per frame would be too many to hold (`path` names the file).
+    /// when frames of `vertex_count` positions would be more than `max_positions` (`path` names the
+    /// file).
     pub(super) fn new(
         channels: &[Channel],
         fps: Option<f64>,
         vertex_count: usize,
+        max_positions: u64,
         path: &Path,
     ) -> Result<Self> {
         let (start, end) = channels
@@ -43,16 +44,14 @@ impl FrameTimes {
             });
         let rate = fps.unwrap_or_else(|| keyframe_rate(channels).unwrap_or(FALLBACK_FPS));
         let count = ((end - start).max(0.0) * rate + 1e-6).floor() + 1.0;
-        if !(count.is_finite() && count * vertex_count as f64 <= MAX_POSITIONS) {
-            return Err(Error::option(
-                "fps",
-                format!(
-                    "too high for {}: {:.3} s at {rate} frames/s is {count} frames of {vertex_count} vertices, too many to hold; give a lower rate",
-                    path.display(),
-                    end - start,
-                ),
-            ));
-        }
+        let bake = Bake {
+            file: &path.display().to_string(),
+            seconds: end - start,
+            rate,
+            frames: count,
+            vertices: vertex_count,
+        };
+        check_bake(&bake, max_positions)?;
         Ok(Self {
             start,
             end,
