@@ -28,6 +28,14 @@ fn run() -> i32 {
         Ok(cli) => cli,
         Err(e) => return clap_error(&e),
     };
+    if let Some(threads) = cli.threads {
+        // Before any parallel work: the global pool is built once.
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads as usize);
+        if let Err(e) = pool.build_global() {
+            eprintln!("mcgv-video: error: --threads {threads}: {e}");
+            return 1;
+        }
+    }
     let result = match &cli.command {
         Command::Encode(a) => commands::encode::run(a, cli.quiet),
         Command::Decode(a) => commands::decode::run(a, cli.quiet),

@@ -23,10 +23,11 @@ use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::{AnimatedMesh, FrameSource, Point, Triangle};
 use crate::motion::{self, AffineTrack, Partition, SkinningWeights};
 use crate::progress::Progress;
-use crate::stream::container::{ContainerWriter, Part, Tag};
+use crate::stream::container::{ContainerReader, ContainerWriter, Part, Tag};
 use crate::stream::header::Header;
 use crate::stream::segments::SegmentStart;
 use crate::stream::side_info;
+use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Instant;
 
@@ -133,6 +134,20 @@ impl SegmentedEncoder {
     /// (the first segment starts at the clip's first frame), in the input's vertex order, at most
     /// a segment's length.
     pub fn push(&mut self, frames: Vec<Vec<Point>>, progress: &dyn Progress) -> Result<()> {
+        let segment = self.code_segment(self.frames, frames, progress)?;
+        self.add(segment)
+    }
+
+    /// Codes the segment of `frames` starting at clip frame `first_frame`, without adding it: any
+    /// segment, in any order, on any thread — or on another machine whose encoder started from
+    /// the same analysis clip and options (the encoder is deterministic), to be
+    /// [added](SegmentedEncoder::add) in order here.
+    pub fn code_segment(
+        &self,
+        first_frame: usize,
+        frames: Vec<Vec<Point>>,
+        progress: &dyn Progress,
+    ) -> Result<CodedSegment> {
         if frames.is_empty() || frames.len() > self.length {
             return Err(Error::Usage(format!(
                 "a segment holds 1 to {} frames, not {}",
@@ -140,14 +155,28 @@ impl SegmentedEncoder {
                 frames.len()
             )));
         }
-        let range = self.frames..self.frames + frames.len();
+        let range = first_frame..first_frame + frames.len();
         let mut clip = AnimatedMesh::new(self.input_triangles.clone(), frames)?;
         if let Some(order) = &self.permutation {
             clip = clip.permuted(order)?;
         }
         let parts = self.code(&clip, &range, progress)?;
-        self.segments.push(parts);
-        self.frames = range.end;
+        Ok(CodedSegment {
+            frames: range,
+            parts,
+        })
+    }
+
+    /// Appends a coded segment; it must start where the segments added so far end.
+    pub fn add(&mut self, segment: CodedSegment) -> Result<()> {
+        if segment.frames.start != self.frames {
+            return Err(Error::Usage(format!(
+                "the segment of frames {:?} does not follow frame {}: add segments in order",
+                segment.frames, self.frames
+            )));
+        }
+        self.frames = segment.frames.end;
+        self.segments.push(segment.parts);
         Ok(())
     }
 
@@ -279,15 +308,22 @@ pub fn encode(
     progress.total(mesh.frame_count() as u64);
     let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
     drop(analysis);
-    for range in crate::stream::segments::split(mesh.frame_count(), length) {
-        progress.stage(&format!("segment from frame {}", range.start));
-        encoder.push(mesh.frames()[range].to_vec(), progress)?;
+    progress.stage("segments");
+    // The clip is in memory already: its segments are coded on rayon's threads.
+    let ranges = crate::stream::segments::split(mesh.frame_count(), length);
+    let coded: Vec<Result<CodedSegment>> = ranges
+        .into_par_iter()
+        .map(|range| encoder.code_segment(range.start, mesh.frames()[range].to_vec(), progress))
+        .collect();
+    for segment in coded {
+        encoder.add(segment?)?;
     }
     encoder.finish()
 }
 
-/// Encodes the animation `source` reads, a segment at a time when it is longer than the
-/// options' segment length: memory holds one segment's frames, whatever the clip's length.
+/// Encodes the animation `source` reads, in segments when it is longer than the options' segment
+/// length: memory holds one segment's frames per thread of rayon's pool (`--threads`), whatever
+/// the clip's length.
 pub fn encode_source(
     source: &mut FrameSource,
     opts: &EncodeOptions,
@@ -308,11 +344,77 @@ pub fn encode_source(
     progress.total(frames as u64);
     let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
     drop(analysis);
-    for range in crate::stream::segments::split(frames, length) {
-        progress.stage(&format!("segment from frame {}", range.start));
-        encoder.push(source.read(range)?, progress)?;
+    progress.stage("segments");
+    // As many segments at once as rayon has threads: memory holds that many segments' frames.
+    let ranges = crate::stream::segments::split(frames, length);
+    for batch in ranges.chunks(rayon::current_num_threads().max(1)) {
+        let read = batch
+            .iter()
+            .map(|r| Ok((r.start, source.read(r.clone())?)))
+            .collect::<Result<Vec<_>>>()?;
+        let coded: Vec<Result<CodedSegment>> = read
+            .into_par_iter()
+            .map(|(start, frames)| encoder.code_segment(start, frames, progress))
+            .collect();
+        for segment in coded {
+            encoder.add(segment?)?;
+        }
     }
     encoder.finish()
+}
+
+/// One coded segment, a separable unit of the stream: its start marker, affine maps and residual
+/// parts. [`CodedSegment::to_bytes`] makes it a file of its own (a container of those parts) to
+/// ship between machines; [`CodedSegment::from_bytes`] reads it back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CodedSegment {
+    frames: Range<usize>,
+    parts: Vec<Part>,
+}
+
+impl CodedSegment {
+    /// The clip frames the segment codes.
+    pub fn frames(&self) -> Range<usize> {
+        self.frames.clone()
+    }
+
+    /// The segment as bytes: a container of its parts.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut container = ContainerWriter::new();
+        self.parts.iter().for_each(|p| container.push(p.clone()));
+        container.to_bytes()
+    }
+
+    /// Reads a segment [`CodedSegment::to_bytes`] wrote, checking its parts' checksums.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut reader = ContainerReader::new(std::io::Cursor::new(bytes))?;
+        let entries = reader.parts().to_vec();
+        let one_segment =
+            reader.segments() == 1 && entries.first().map(|e| e.tag) == Some(Tag::SEGMENT);
+        if !one_segment {
+            return Err(Error::Stream(
+                "not a coded segment: it must hold one segment's parts and nothing else".into(),
+            ));
+        }
+        let start = SegmentStart::from_bytes(&reader.segment_start(0)?)?;
+        let first = start.first_frame as usize;
+        let mut parts = Vec::with_capacity(entries.len());
+        for e in entries {
+            let payload = match e.tag {
+                Tag::SEGMENT => reader.segment_start(0)?,
+                tag => reader.part(tag)?,
+            };
+            parts.push(Part {
+                tag: e.tag,
+                bytes: payload,
+                checksum: e.checksum,
+            });
+        }
+        Ok(Self {
+            frames: first..first + start.frames as usize,
+            parts,
+        })
+    }
 }
 
 /// Passes progress on, except the analysis clip's total: the whole clip's is told up front.

@@ -34,7 +34,8 @@ impl SegmentStart {
         Ok(Part::whole(Tag::SEGMENT, w.into_bytes()))
     }
 
-    fn from_bytes(bytes: &[u8]) -> Result<Self> {
+    /// Parses a marker's payload.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
         let mut r = ByteReader::new(bytes, "segment start");
         let start = Self {
             first_frame: r.u32()?,

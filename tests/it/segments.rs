@@ -3,7 +3,7 @@
 //! refused.
 
 use crate::common::{animate, decoder, encode_bytes, harness, parts, rebuild, tube};
-use mcgv_video::encoder::segments::{analysis_frames, SegmentedEncoder};
+use mcgv_video::encoder::segments::{analysis_frames, CodedSegment, SegmentedEncoder};
 use mcgv_video::stream::container::{Checksum, Tag, VERSION, VERSION_SEGMENTED};
 use mcgv_video::{encode, AnimatedMesh, Codec, EncodeOptions, Lattice, PredictorChoice, Silent};
 use mcgv_video::{PredictorKind, SegmentationChoice};
@@ -177,6 +177,33 @@ fn segments_pushed_one_by_one_make_the_stream_encode_makes() {
     }
     assert_eq!(encoder.frames(), 20);
     assert_eq!(encoder.finish().unwrap().to_bytes(), whole.to_bytes());
+    // Another encoder started alike codes the later segments, shipped as bytes, out of order.
+    let mut joiner = SegmentedEncoder::start(&analysis, &opts, 8, &Silent).unwrap();
+    let worker = SegmentedEncoder::start(&analysis, &opts, 8, &Silent).unwrap();
+    let shipped: Vec<Vec<u8>> = [16..20, 8..16]
+        .into_iter()
+        .map(|r| {
+            let coded = worker.code_segment(r.start, mesh.frames()[r].to_vec(), &Silent);
+            coded.unwrap().to_bytes()
+        })
+        .collect();
+    joiner.push(mesh.frames()[..8].to_vec(), &Silent).unwrap();
+    let late = CodedSegment::from_bytes(&shipped[0]).unwrap();
+    assert!(
+        joiner.add(late.clone()).is_err(),
+        "segments are added in order"
+    );
+    joiner
+        .add(CodedSegment::from_bytes(&shipped[1]).unwrap())
+        .unwrap();
+    joiner.add(late).unwrap();
+    assert_eq!(joiner.finish().unwrap().to_bytes(), whole.to_bytes());
+    // Its start marker (the first part's payload) flipped: refused by its checksum.
+    let mut damaged = shipped[1].clone();
+    damaged[16 + 17] ^= 1;
+    assert!(CodedSegment::from_bytes(&damaged).is_err());
+    // A whole stream is not a segment.
+    assert!(CodedSegment::from_bytes(&whole.to_bytes()).is_err());
     let zero = encode(&mesh, &options(Codec::Jpeg, Some(0)));
     assert!(zero.err().unwrap().to_string().contains("segment_frames"));
 }
