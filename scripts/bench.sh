@@ -6,7 +6,10 @@
 # predictor, decimation segmentation, both; every codec at quality 10 and 50
 # when the binary has it), then one RD plot per sequence, the README tables and the peers' page:
 #   bench-out/motion.txt, sweep.csv, sweep-variants.csv, peers.csv, peers.skipped.csv (what a peer
-#   could not take, and why), plots/SEQUENCE.png, table.md, peers.md
+#   could not take, and why), plots/SEQUENCE.png, table.md, peers.md; then temporal segments (issue
+#   20): segments-cost.csv (bits of segmenting the OBJ sequences, examples/segment_cost) and
+#   segments-memory.csv (peak RSS and time on a generated 50 000 x 2 000 clip,
+#   scripts/segments_memory.sh; SEGMENTS_V / SEGMENTS_F change its size; SKIP_SEGMENTS=1 skips both)
 # MCGV_PYTHON is the virtualenv's python (`make bench` passes it). BENCH_VARIANTS overrides the
 # variants (scripts/sweep.sh VARIANTS); empty skips the variant sweep. JPEG_QUALITIES,
 # MPEG4_QUALITIES, TDCT_QUALITIES, HEVC_QUALITIES, HEVC_INTRA_QUALITIES, AV1_QUALITIES and
@@ -61,4 +64,12 @@ MCGV_PYTHON=$py bash scripts/peers_page.sh bench-out/peers.md bench-out/peers.sk
 } > docs/bench/tables.md
 cp "${csvs[@]}" bench-out/peers.md docs/bench/
 cp bench-out/plots/*.png docs/bench/
+if [ -z "${SKIP_SEGMENTS:-}" ]; then
+    sequences=()
+    for input in "${inputs[@]}"; do [ -d "$input" ] && sequences+=("$input"); done
+    cargo run --release --quiet --example segment_cost -- bench-out/segments-cost.csv "${sequences[@]}"
+    V=${SEGMENTS_V:-50000} F=${SEGMENTS_F:-2000} bash scripts/segments_memory.sh target/release/mcgv-video \
+        bench-out/segments-memory >bench-out/segments-memory.csv
+    cp bench-out/segments-cost.csv bench-out/segments-memory.csv docs/bench/
+fi
 echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md, peers.md; docs/bench/ updated"
