@@ -192,7 +192,7 @@ pub struct EncodeArgs {
     /// Frames per temporal segment: a longer clip is coded as segments of N frames, each with its
     /// own temporal DCT or groups of pictures, sharing the first frame, clusters and atlas (the
     /// automatic choices are made on the first segment); 0 codes any clip as one segment
-    /// [default: 256].
+    /// [default: 128].
     #[arg(long, value_name = "N")]
     pub segment_frames: Option<u64>,
     /// Retired with stream version 2 (the step now follows --quality, not each frame's range);
