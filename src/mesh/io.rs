@@ -195,6 +195,53 @@ pub fn write_obj_mesh_frame(mesh: &AnimatedMesh, frame: usize, path: &Path) -> R
     write_atomic(path, text.as_bytes())
 }
 
+/// Writes a PC2 point cache a frame at a time (a decoder's, as they come), under a temporary name
+/// renamed into place by [`Pc2Writer::finish`] once every frame is written.
+pub struct Pc2Writer<'a> {
+    file: crate::output::AtomicFile<'a>,
+    points: usize,
+    left: usize,
+}
+
+impl<'a> Pc2Writer<'a> {
+    /// A cache of `frames` frames of `points` positions at `path`.
+    pub fn create(path: &'a Path, points: usize, frames: usize) -> Result<Self> {
+        let header = pc2::header_bytes(points, frames)?;
+        let mut file = crate::output::AtomicFile::create(path)?;
+        file.write_all(&header)?;
+        Ok(Self {
+            file,
+            points,
+            left: frames,
+        })
+    }
+
+    /// Appends the next frame.
+    pub fn write(&mut self, positions: &[super::Point]) -> Result<()> {
+        if positions.len() != self.points || self.left == 0 {
+            return Err(Error::Usage(format!(
+                "a PC2 frame of {} positions, expected {} ({} frames left)",
+                positions.len(),
+                self.points,
+                self.left
+            )));
+        }
+        self.left -= 1;
+        self.file.write_all(&pc2::frame_bytes(positions))
+    }
+
+    /// Puts the cache in place; every frame must have been written.
+    pub fn finish(self) -> Result<()> {
+        if self.left > 0 {
+            return Err(Error::Usage(format!(
+                "the PC2 cache misses its last {} frames",
+                self.left
+            )));
+        }
+        self.file.commit()
+    }
+}
+
 /// Writes the animation's positions as a PC2 point cache (start frame 0, one sample per frame).
 pub fn write_pc2(mesh: &AnimatedMesh, path: &Path) -> Result<()> {
     let bytes =

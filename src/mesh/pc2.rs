@@ -155,27 +155,36 @@ pub(crate) const SAMPLES_START: u64 = HEADER_LEN as u64;
 
 /// The PC2 bytes of an animation: start frame 0, one sample per frame.
 pub(crate) fn pc2_bytes(mesh: &AnimatedMesh) -> Result<Vec<u8>> {
+    let mut out = Vec::with_capacity(HEADER_LEN + mesh.frame_count() * mesh.vertex_count() * 12);
+    out.extend_from_slice(&header_bytes(mesh.vertex_count(), mesh.frame_count())?);
+    for frame in mesh.frames() {
+        out.extend_from_slice(&frame_bytes(frame));
+    }
+    Ok(out)
+}
+
+/// The 32-byte header of a cache of `points` positions × `samples` frames (start 0, rate 1).
+pub(crate) fn header_bytes(points: usize, samples: usize) -> Result<Vec<u8>> {
     let too_many =
         |what: &str, n: usize| Error::Usage(format!("{n} {what} do not fit in a PC2 file"));
-    let points = i32::try_from(mesh.vertex_count())
-        .map_err(|_| too_many("vertices", mesh.vertex_count()))?;
-    let samples =
-        i32::try_from(mesh.frame_count()).map_err(|_| too_many("frames", mesh.frame_count()))?;
-    let mut out = Vec::with_capacity(HEADER_LEN + mesh.frame_count() * mesh.vertex_count() * 12);
+    let points = i32::try_from(points).map_err(|_| too_many("vertices", points))?;
+    let samples = i32::try_from(samples).map_err(|_| too_many("frames", samples))?;
+    let mut out = Vec::with_capacity(HEADER_LEN);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&1i32.to_le_bytes());
     out.extend_from_slice(&points.to_le_bytes());
     out.extend_from_slice(&0f32.to_le_bytes());
     out.extend_from_slice(&1f32.to_le_bytes());
     out.extend_from_slice(&samples.to_le_bytes());
-    for frame in mesh.frames() {
-        for p in frame {
-            for c in p {
-                out.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-    }
     Ok(out)
+}
+
+/// One sample's bytes.
+pub(crate) fn frame_bytes(frame: &[Point]) -> Vec<u8> {
+    frame
+        .iter()
+        .flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes()))
+        .collect()
 }
 
 #[cfg(test)]

@@ -8,7 +8,9 @@ use crate::progress;
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::gltf_write::MANY_MORPH_TARGETS;
-use mcgv_video::mesh::io::{write_obj_mesh_frame, write_obj_sequence_from, ObjFrameWriter};
+use mcgv_video::mesh::io::{
+    write_obj_mesh_frame, write_obj_sequence_from, ObjFrameWriter, Pc2Writer,
+};
 use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions, DEFAULT_FPS};
 use std::fs::File;
 use std::io::BufReader;
@@ -74,10 +76,16 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             args.input.display()
         );
     }
-    if kind == OutputKind::ObjFolder && args.frame.is_none() && args.frames.is_none() {
-        prepare_frame_folder(&args.output, args.force)?;
-        let frames = stream_obj_frames(&mut decoder, &args.output, quiet)
-            .map_err(|e| super::in_file(&args.input, e))?;
+    let every_frame = args.frame.is_none() && args.frames.is_none();
+    if every_frame && matches!(kind, OutputKind::ObjFolder | OutputKind::Pc2) {
+        let frames = match kind {
+            OutputKind::Pc2 => stream_pc2(&mut decoder, &args.output, quiet),
+            _ => {
+                prepare_frame_folder(&args.output, args.force)?;
+                stream_obj_frames(&mut decoder, &args.output, quiet)
+            }
+        }
+        .map_err(|e| super::in_file(&args.input, e))?;
         let vertices = decoder.header().vertices as usize;
         return report(args, quiet, start, frames, vertices);
     }
@@ -127,6 +135,39 @@ fn report(
         )?;
     }
     Ok(())
+}
+
+/// Decodes every frame into a PC2 cache (and its base OBJ, frame 0, beside it), each frame written
+/// as soon as its segment is decoded. Returns the frames written.
+fn stream_pc2(
+    decoder: &mut Decoder<BufReader<File>>,
+    path: &std::path::Path,
+    quiet: bool,
+) -> Result<usize> {
+    let (frames, vertices) = (
+        decoder.header().frames as usize,
+        decoder.header().vertices as usize,
+    );
+    let (triangles, attributes) = (decoder.triangles().to_vec(), decoder.attributes().clone());
+    create_parent(path)?;
+    let base = path.with_extension("obj");
+    let mut cache = Pc2Writer::create(path, vertices, frames)?;
+    let pb = progress::bar(frames as u64, "decode", quiet);
+    let mut first = None;
+    decoder.for_each_frame(&crate::progress::Reporter(&pb), |f, positions| {
+        cache.write(&positions)?;
+        if f == 0 {
+            first = Some(positions);
+        }
+        Ok(())
+    })?;
+    pb.finish_and_clear();
+    // Both files are written only once every frame decoded: a damaged stream leaves neither.
+    let first = first.ok_or_else(|| Error::Stream("the stream has no frames".into()))?;
+    let first = AnimatedMesh::new(triangles, vec![first])?.with_attributes(attributes)?;
+    write_obj_mesh_frame(&first, 0, &base)?;
+    cache.finish()?;
+    Ok(frames)
 }
 
 /// Decodes every frame into an OBJ folder, each file written as soon as its segment is decoded:

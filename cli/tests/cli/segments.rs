@@ -92,6 +92,23 @@ fn a_segmented_stream_round_trips_through_every_command() {
     let rmse = measures["vertex_rmse"].as_f64().unwrap_or(1.0);
     assert!(rmse < 2e-3, "{measures}");
     assert_eq!(measures["frames"], 20);
+    // Decoded to a PC2 cache a segment at a time: the same animation eval measured.
+    let pc2 = dir.path().join("decoded.pc2");
+    ok(&run(&[
+        "decode",
+        stream,
+        "-o",
+        pc2.to_str().unwrap_or_default(),
+        "--quiet",
+    ]));
+    assert!(pc2.with_extension("obj").is_file());
+    let again = json(&run(&[
+        "eval",
+        &input,
+        pc2.to_str().unwrap_or_default(),
+        "--json",
+    ]));
+    assert_eq!(again["vertex_rmse"], measures["vertex_rmse"], "{again}");
     // One segment for the whole clip: no segment line, a version-3 stream.
     let whole = dir.path().join("w.mcgv");
     let whole = whole.to_str().unwrap_or_default();
