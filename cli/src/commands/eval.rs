@@ -6,7 +6,7 @@ use mcgv_video::decoder::Decoder;
 use mcgv_video::error::{Error, Result};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::{AnimatedMesh, FrameSource, ReadOptions};
-use mcgv_video::metrics::{compare, Comparison, Measures, Surface};
+use mcgv_video::metrics::{Comparison, Measures, Surface};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
@@ -32,8 +32,9 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
                 "applies to a .mcgv stream of codec tdct",
             ));
         }
-        let original = super::read_input(&args.original, &opts, quiet)?;
-        compare(&original, &super::read_input(&args.decoded, &opts, quiet)?)?
+        let mut original = super::open_source(&args.original, &opts, quiet)?;
+        let mut decoded = super::open_source(&args.decoded, &opts, quiet)?;
+        compare_sources(&mut original, &mut decoded)?
     };
     if args.json {
         let json = serde_json::to_string(&measures)
@@ -103,6 +104,33 @@ fn compare_stream(
     comparison
         .map(Comparison::finish)
         .ok_or_else(|| Error::Stream("the stream has no frames".into()))
+}
+
+/// The measures of two animations read a run of frames at a time (OBJ and PC2 inputs are never
+/// held whole).
+fn compare_sources(original: &mut FrameSource, decoded: &mut FrameSource) -> Result<Measures> {
+    let frames = original.frame_count();
+    if decoded.frame_count() != frames {
+        return Err(Error::Usage(format!(
+            "the original has {frames} frames but the decoded animation has {}; frames must correspond",
+            decoded.frame_count()
+        )));
+    }
+    let mut comparison = Comparison::new(first_surface(original), first_surface(decoded))?;
+    let run = mcgv_video::encoder::DEFAULT_SEGMENT_FRAMES;
+    for start in (0..frames).step_by(run) {
+        let range = start..(start + run).min(frames);
+        comparison.add(&original.read(range.clone())?, &decoded.read(range)?)?;
+    }
+    Ok(comparison.finish())
+}
+
+/// The first frame of an animation as a surface.
+fn first_surface(source: &FrameSource) -> Surface<'_> {
+    Surface {
+        triangles: source.first().triangles(),
+        positions: source.first().frame(0),
+    }
 }
 
 /// A stream encoded with `--reorder` holds its vertices in the first-frame coder's traversal
