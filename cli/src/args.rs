@@ -13,8 +13,9 @@ pub struct Cli {
     /// No progress bars or chatter; errors still go to stderr.
     #[arg(long, short, global = true)]
     pub quiet: bool,
-    /// Threads for the work done in parallel (groups of pictures, temporal segments of a clip in
-    /// memory, frames measured by eval) [default: one per core].
+    /// Threads for the work done in parallel (groups of pictures, frames measured by eval)
+    /// [default: one per core]; `encode` also codes N temporal segments at once (memory: N
+    /// segments' working data; default one).
     #[arg(long, global = true, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=1024))]
     pub threads: Option<u64>,
 }

@@ -37,7 +37,7 @@ fn run() -> i32 {
         }
     }
     let result = match &cli.command {
-        Command::Encode(a) => commands::encode::run(a, cli.quiet),
+        Command::Encode(a) => commands::encode::run(a, cli.quiet, cli.threads),
         Command::Decode(a) => commands::decode::run(a, cli.quiet),
         Command::Inspect(a) => commands::inspect::run(a, cli.quiet),
         Command::Eval(a) => commands::eval::run(a, cli.quiet),

@@ -76,6 +76,9 @@ pub struct EncodeOptions {
     /// with its own temporal DCT or groups of pictures ([`super::segments`]); `None` codes any
     /// clip as one.
     pub segment_frames: Option<usize>,
+    /// Segments coded at once (on rayon's threads): memory holds this many segments' working
+    /// data, so the default, 1, keeps an encoding of any length within one segment's.
+    pub parallel_segments: usize,
 }
 
 impl Default for EncodeOptions {
@@ -102,6 +105,7 @@ impl Default for EncodeOptions {
             step: None,
             uv_bits: 12,
             segment_frames: Some(DEFAULT_SEGMENT_FRAMES),
+            parallel_segments: 1,
         }
     }
 }
@@ -325,6 +329,7 @@ impl EncodeOptions {
             step: None,
             uv_bits: 12,
             segment_frames: None,
+            parallel_segments: 1,
         })
     }
 
@@ -352,6 +357,9 @@ impl EncodeOptions {
     fn check_ranges(&self) -> Result<()> {
         if self.segment_frames == Some(0) {
             return Err(Error::option("segment_frames", "must be at least 1"));
+        }
+        if self.parallel_segments == 0 {
+            return Err(Error::option("parallel_segments", "must be at least 1"));
         }
         if self.clusters == 0 {
             return Err(Error::option("clusters", "must be at least 1"));

@@ -309,21 +309,22 @@ pub fn encode(
     let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
     drop(analysis);
     progress.stage("segments");
-    // The clip is in memory already: its segments are coded on rayon's threads.
     let ranges = crate::stream::segments::split(mesh.frame_count(), length);
-    let coded: Vec<Result<CodedSegment>> = ranges
-        .into_par_iter()
-        .map(|range| encoder.code_segment(range.start, mesh.frames()[range].to_vec(), progress))
-        .collect();
-    for segment in coded {
-        encoder.add(segment?)?;
+    for batch in ranges.chunks(opts.parallel_segments.max(1)) {
+        let coded: Vec<Result<CodedSegment>> = batch
+            .par_iter()
+            .map(|r| encoder.code_segment(r.start, mesh.frames()[r.clone()].to_vec(), progress))
+            .collect();
+        for segment in coded {
+            encoder.add(segment?)?;
+        }
     }
     encoder.finish()
 }
 
 /// Encodes the animation `source` reads, in segments when it is longer than the options' segment
-/// length: memory holds one segment's frames per thread of rayon's pool (`--threads`), whatever
-/// the clip's length.
+/// length: memory holds `parallel_segments` segments' frames and working data (one by default),
+/// whatever the clip's length.
 pub fn encode_source(
     source: &mut FrameSource,
     opts: &EncodeOptions,
@@ -345,9 +346,9 @@ pub fn encode_source(
     let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
     drop(analysis);
     progress.stage("segments");
-    // As many segments at once as rayon has threads: memory holds that many segments' frames.
+    // `parallel_segments` at once: memory holds that many segments' frames and working data.
     let ranges = crate::stream::segments::split(frames, length);
-    for batch in ranges.chunks(rayon::current_num_threads().max(1)) {
+    for batch in ranges.chunks(opts.parallel_segments.max(1)) {
         let read = batch
             .iter()
             .map(|r| Ok((r.start, source.read(r.clone())?)))

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Parses the encode arguments into encoder options, rejecting nonsense with a clear message.
-pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
+pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions> {
     let lattice = parse_lattice(&args.lattice)?;
     let codec = match args.codec {
         CodecChoice::Jpeg => Codec::Jpeg,
@@ -94,6 +94,8 @@ pub fn options(args: &EncodeArgs) -> Result<EncodeOptions> {
             Some(0) => None,
             Some(n) => Some(usize::try_from(n).unwrap_or(usize::MAX)),
         },
+        // `--threads N` also codes N segments at once (memory: N segments' working data).
+        parallel_segments: threads.map_or(1, |n| usize::try_from(n).unwrap_or(1)),
     })
 }
 
@@ -184,8 +186,8 @@ fn check_not_input(input: &str, opts: &ReadOptions, output: &Path) -> Result<()>
 }
 
 /// Runs `encode`: one stream, or with `--clip all` one stream per glTF clip.
-pub fn run(args: &EncodeArgs, quiet: bool) -> Result<()> {
-    let opts = options(args)?;
+pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
+    let opts = options(args, threads)?;
     let read_options: ReadOptions = (&args.input_args).into();
     let to_stdout = args.output.as_os_str() == "-";
     if to_stdout && args.json {
