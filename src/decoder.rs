@@ -63,7 +63,6 @@ pub struct Decoder<R> {
 /// One temporal segment's predictor and residual decoder, read when a frame of it is asked for.
 struct OpenSegment<R> {
     index: usize,
-    frames: Range<usize>,
     track: AffineTrack,
     residuals: Box<dyn ResidualDecoder<R>>,
 }
@@ -288,8 +287,8 @@ impl<R: Read + Seek> Decoder<R> {
                 self.header.codec.name()
             )));
         };
-        match &self.open {
-            Some(open) if open.frames.contains(&f) => images.index.entry(f - open.frames.start),
+        match self.open_segment().map(|s| &self.segments[s]) {
+            Some(frames) if frames.contains(&f) => images.index.entry(f - frames.start),
             _ => Err(Error::Usage(format!(
                 "frame {f} is not in the open segment: seek its segment first"
             ))),
@@ -446,7 +445,6 @@ impl Shared<'_> {
         let track = side_info::decode_checked_affine(&affine, frames.len(), partition, reference)?;
         Ok(OpenSegment {
             index: s,
-            frames,
             track,
             residuals,
         })

@@ -48,7 +48,6 @@ pub struct SegmentedEncoder {
     diagonal: f64,
     atlas: AtlasCache,
     header: Header,
-    params: CodecParams,
     shared: Vec<Part>,
     segments: Vec<Vec<Part>>,
     frames: usize,
@@ -84,12 +83,6 @@ impl SegmentedEncoder {
         let bytes = encoded.to_bytes();
         let decoder = Decoder::new(&bytes)?;
         let header = decoder.header().clone();
-        let params = CodecParams {
-            lattice: (header.lattice_width, header.lattice_height),
-            qscale: header.qscale,
-            gop: header.gop,
-            padding: header.padding.clone(),
-        };
         // Every segment repeats the analysis clip's choices instead of making its own.
         let opts = EncodeOptions {
             predictor: PredictorChoice::Fixed(header.predictor),
@@ -115,7 +108,6 @@ impl SegmentedEncoder {
             diagonal: analysis.bbox_diagonal(),
             atlas: AtlasCache::default(),
             header,
-            params,
             shared,
             segments: Vec::new(),
             frames: 0,
@@ -263,18 +255,25 @@ impl SegmentedEncoder {
     /// A segment's codec must have made the analysis clip's lattice and settings: the header and
     /// the lattice part are the whole stream's.
     fn check_shared(&self, params: &CodecParams, before: &[Part]) -> Result<()> {
+        let h = &self.header;
+        let shared_params = CodecParams {
+            lattice: (h.lattice_width, h.lattice_height),
+            qscale: h.qscale,
+            gop: h.gop,
+            padding: h.padding.clone(),
+        };
         let same_parts = before.iter().all(|p| {
             self.shared
                 .iter()
                 .any(|s| s.tag == p.tag && s.bytes == p.bytes)
         });
-        if *params != self.params || !same_parts {
+        if *params != shared_params || !same_parts {
             return Err(Error::Codec(format!(
                 "segment from frame {}: the {} coder did not reproduce the analysis clip's \
                  lattice and settings ({params:?} against {:?})",
                 self.frames,
                 self.opts.codec.name(),
-                self.params
+                shared_params
             )));
         }
         Ok(())
@@ -298,28 +297,9 @@ pub fn encode(
     length: usize,
     progress: &dyn Progress,
 ) -> Result<Encoded> {
-    let frames = analysis_frames(mesh.frame_count(), length);
-    let analysis = AnimatedMesh::new(
-        mesh.triangles().to_vec(),
-        frames.iter().map(|&f| mesh.frame(f).to_vec()).collect(),
-    )?
-    .with_attributes(mesh.attributes().clone())?
-    .with_frame_rate(mesh.frame_rate());
-    progress.total(mesh.frame_count() as u64);
-    let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
-    drop(analysis);
-    progress.stage("segments");
-    let ranges = crate::stream::segments::split(mesh.frame_count(), length);
-    for batch in ranges.chunks(opts.parallel_segments.max(1)) {
-        let coded: Vec<Result<CodedSegment>> = batch
-            .par_iter()
-            .map(|r| encoder.code_segment(r.start, mesh.frames()[r.clone()].to_vec(), progress))
-            .collect();
-        for segment in coded {
-            encoder.add(segment?)?;
-        }
-    }
-    encoder.finish()
+    let frames = mesh.frame_count();
+    let read = |range: Range<usize>| Ok(mesh.frames()[range].to_vec());
+    encode_runs(mesh, frames, length, opts, progress, read)
 }
 
 /// Encodes the animation `source` reads, in segments when it is longer than the options' segment
@@ -335,25 +315,41 @@ pub fn encode_source(
         Some(n) if frames > n => n,
         _ => return super::encode_with_progress(&source.clip(0..frames)?, opts, progress),
     };
-    let mut analysis = Vec::with_capacity(length);
+    let first = source.first().clone();
+    encode_runs(&first, frames, length, opts, progress, |range| {
+        source.read(range)
+    })
+}
+
+/// Encodes a clip of `frames` frames in segments of `length`, reading its frames by ranges with
+/// `read`: the analysis clip's frames one by one, then `parallel_segments` segments at a time,
+/// coded on rayon's threads. `first` gives the connectivity, attributes and frame rate.
+fn encode_runs(
+    first: &AnimatedMesh,
+    frames: usize,
+    length: usize,
+    opts: &EncodeOptions,
+    progress: &dyn Progress,
+    mut read: impl FnMut(Range<usize>) -> Result<Vec<Vec<Point>>>,
+) -> Result<Encoded> {
+    let mut spread = Vec::with_capacity(length);
     for f in analysis_frames(frames, length) {
-        analysis.extend(source.read(f..f + 1)?);
+        spread.extend(read(f..f + 1)?);
     }
-    let analysis = AnimatedMesh::new(source.first().triangles().to_vec(), analysis)?
-        .with_attributes(source.first().attributes().clone())?
-        .with_frame_rate(source.first().frame_rate());
+    let analysis = AnimatedMesh::new(first.triangles().to_vec(), spread)?
+        .with_attributes(first.attributes().clone())?
+        .with_frame_rate(first.frame_rate());
     progress.total(frames as u64);
     let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
     drop(analysis);
     progress.stage("segments");
-    // `parallel_segments` at once: memory holds that many segments' frames and working data.
     let ranges = crate::stream::segments::split(frames, length);
     for batch in ranges.chunks(opts.parallel_segments.max(1)) {
-        let read = batch
+        let runs = batch
             .iter()
-            .map(|r| Ok((r.start, source.read(r.clone())?)))
+            .map(|r| Ok((r.start, read(r.clone())?)))
             .collect::<Result<Vec<_>>>()?;
-        let coded: Vec<Result<CodedSegment>> = read
+        let coded: Vec<Result<CodedSegment>> = runs
             .into_par_iter()
             .map(|(start, frames)| encoder.code_segment(start, frames, progress))
             .collect();
@@ -397,20 +393,19 @@ impl CodedSegment {
                 "not a coded segment: it must hold one segment's parts and nothing else".into(),
             ));
         }
-        let start = SegmentStart::from_bytes(&reader.segment_start(0)?)?;
+        let parts = entries
+            .iter()
+            .map(|e| {
+                Ok(Part {
+                    tag: e.tag,
+                    bytes: reader.payload(e)?,
+                    checksum: e.checksum,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        // The first part is the start marker (checked above).
+        let start = SegmentStart::from_bytes(&parts[0].bytes)?;
         let first = start.first_frame as usize;
-        let mut parts = Vec::with_capacity(entries.len());
-        for e in entries {
-            let payload = match e.tag {
-                Tag::SEGMENT => reader.segment_start(0)?,
-                tag => reader.part(tag)?,
-            };
-            parts.push(Part {
-                tag: e.tag,
-                bytes: payload,
-                checksum: e.checksum,
-            });
-        }
         Ok(Self {
             frames: first..first + start.frames as usize,
             parts,

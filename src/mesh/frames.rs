@@ -85,13 +85,7 @@ impl FrameSource {
         let (points, samples) = pc2::parse_header(&header, len).map_err(mesh_error)?;
         let base = pc2::base_path(path, base)?;
         let obj = read_obj(&base)?;
-        if obj.positions.len() != points {
-            return Err(mesh_error(format!(
-                "{points} points per frame but its base mesh {} has {} vertices",
-                base.display(),
-                obj.positions.len()
-            )));
-        }
+        pc2::check_base(points, &obj, path, &base)?;
         let mut source = Self {
             frames: samples,
             first: AnimatedMesh::new(obj.triangles, vec![obj.positions])?
@@ -131,11 +125,12 @@ impl FrameSource {
             Origin::Memory(mesh) => Ok(mesh.frames()[frames].to_vec()),
             Origin::Obj(files) => {
                 let (vertices, triangles) = (self.first.vertex_count(), self.first.triangles());
+                let first_path = &files[0];
                 files[frames]
                     .iter()
                     .map(|path| {
                         let frame = read_obj(path)?;
-                        check_same_mesh(triangles, vertices, &files_first(files), &frame, path)?;
+                        check_same_mesh(triangles, vertices, first_path, &frame, path)?;
                         Ok(frame.positions)
                     })
                     .collect()
@@ -165,8 +160,4 @@ impl FrameSource {
                 .with_frame_rate(self.first.frame_rate()),
         )
     }
-}
-
-fn files_first(files: &[PathBuf]) -> PathBuf {
-    files.first().cloned().unwrap_or_default()
 }

@@ -227,7 +227,9 @@ impl<'a> Pc2Writer<'a> {
             )));
         }
         self.left -= 1;
-        self.file.write_all(&pc2::frame_bytes(positions))
+        let mut bytes = Vec::with_capacity(positions.len() * 12);
+        pc2::push_frame(&mut bytes, positions);
+        self.file.write_all(&bytes)
     }
 
     /// Puts the cache in place; every frame must have been written.

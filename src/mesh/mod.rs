@@ -164,10 +164,15 @@ impl AnimatedMesh {
 
     /// Length of the diagonal of frame 0's axis-aligned bounding box: the unit every error is measured in.
     pub fn bbox_diagonal(&self) -> f64 {
-        let (lo, hi) = bounding_box(&self.frames[0]);
-        let d: f64 = (0..3).map(|a| (hi[a] - lo[a]) as f64).map(|x| x * x).sum();
-        d.sqrt()
+        bbox_diagonal(&self.frames[0])
     }
+}
+
+/// The diagonal of a point set's axis-aligned bounding box (0 for an empty set).
+pub fn bbox_diagonal(points: &[Point]) -> f64 {
+    let (lo, hi) = bounding_box(points);
+    let d: f64 = (0..3).map(|a| (hi[a] - lo[a]) as f64).map(|x| x * x).sum();
+    d.sqrt()
 }
 
 /// The axis-aligned bounding box `(min, max)` of a point set; `([0;3],[0;3])` for an empty set.

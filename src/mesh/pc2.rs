@@ -23,8 +23,8 @@ pub(crate) struct PointCache {
 /// beside it); the base's vertex count must equal the cache's point count.
 pub(crate) fn read_pc2_animation(path: &Path, base: Option<&Path>) -> Result<AnimatedMesh> {
     let cache = read_pc2(path)?;
-    let mesh = read_obj(&base_path(path, base)?)?;
-    with_base(cache, mesh, path, &base_path(path, base)?)
+    let base = base_path(path, base)?;
+    with_base(cache, read_obj(&base)?, path, &base)
 }
 
 /// The base OBJ of the PC2 cache at `path`: `base`, else the `.obj` of the same stem beside it.
@@ -64,20 +64,26 @@ pub(crate) fn parse_pc2_animation(
 /// The animation of `cache`'s frames on `mesh`'s triangles; their vertex counts must agree.
 fn with_base(cache: PointCache, mesh: ObjFrame, path: &Path, base: &Path) -> Result<AnimatedMesh> {
     let points = cache.frames.first().map_or(0, Vec::len);
-    if mesh.positions.len() != points {
-        return Err(Error::Mesh(format!(
-            "{} has {points} points per frame but its base mesh {} has {} vertices",
-            path.display(),
-            base.display(),
-            mesh.positions.len()
-        )));
-    }
+    check_base(points, &mesh, path, base)?;
     AnimatedMesh::new(mesh.triangles, cache.frames)
         .and_then(|m| m.with_attributes(mesh.attributes))
         .map_err(|e| match e {
             Error::Mesh(m) => Error::Mesh(format!("{}: {m}", path.display())),
             other => other,
         })
+}
+
+/// The base mesh must have a vertex per point of the cache at `path`.
+pub(crate) fn check_base(points: usize, mesh: &ObjFrame, path: &Path, base: &Path) -> Result<()> {
+    if mesh.positions.len() == points {
+        return Ok(());
+    }
+    Err(Error::Mesh(format!(
+        "{} has {points} points per frame but its base mesh {} has {} vertices",
+        path.display(),
+        base.display(),
+        mesh.positions.len()
+    )))
 }
 
 /// Reads and checks a PC2 file: magic, version, counts and exact length.
@@ -158,7 +164,7 @@ pub(crate) fn pc2_bytes(mesh: &AnimatedMesh) -> Result<Vec<u8>> {
     let mut out = Vec::with_capacity(HEADER_LEN + mesh.frame_count() * mesh.vertex_count() * 12);
     out.extend_from_slice(&header_bytes(mesh.vertex_count(), mesh.frame_count())?);
     for frame in mesh.frames() {
-        out.extend_from_slice(&frame_bytes(frame));
+        push_frame(&mut out, frame);
     }
     Ok(out)
 }
@@ -179,12 +185,13 @@ pub(crate) fn header_bytes(points: usize, samples: usize) -> Result<Vec<u8>> {
     Ok(out)
 }
 
-/// One sample's bytes.
-pub(crate) fn frame_bytes(frame: &[Point]) -> Vec<u8> {
-    frame
-        .iter()
-        .flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes()))
-        .collect()
+/// Appends one sample's bytes to `out`.
+pub(crate) fn push_frame(out: &mut Vec<u8>, frame: &[Point]) {
+    out.extend(
+        frame
+            .iter()
+            .flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes())),
+    );
 }
 
 #[cfg(test)]

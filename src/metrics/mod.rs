@@ -71,13 +71,7 @@ pub fn bpvf(bits: u64, vertices: usize, frames: usize) -> f64 {
 /// Compares `decoded` with `original`. Both need the same number of frames; the connectivity and
 /// vertex count may differ (then only the surface measures are given).
 pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measures> {
-    let frames = original.frame_count();
-    if decoded.frame_count() != frames {
-        return Err(Error::Usage(format!(
-            "the original has {frames} frames but the decoded animation has {}; frames must correspond",
-            decoded.frame_count()
-        )));
-    }
+    same_frame_count(original.frame_count(), decoded.frame_count())?;
     let mut comparison = Comparison::new(
         Surface {
             triangles: original.triangles(),
@@ -90,6 +84,17 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
     )?;
     comparison.add(original.frames(), decoded.frames())?;
     Ok(comparison.finish())
+}
+
+/// Refuses to compare animations whose frame counts differ: frames must correspond.
+pub fn same_frame_count(original: usize, decoded: usize) -> Result<()> {
+    if original == decoded {
+        return Ok(());
+    }
+    Err(Error::Usage(format!(
+        "the original has {original} frames but the decoded animation has {decoded}; frames must \
+         correspond"
+    )))
 }
 
 /// Per-vertex errors of two animations with corresponding vertices.

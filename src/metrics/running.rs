@@ -25,7 +25,7 @@ pub struct Comparison {
 impl Comparison {
     /// A comparison sampled where the two first frames say (every frame is measured alike).
     pub fn new(original: Surface<'_>, decoded: Surface<'_>) -> Result<Self> {
-        let diagonal = diagonal(original.positions);
+        let diagonal = crate::mesh::bbox_diagonal(original.positions);
         if diagonal.is_nan() || diagonal <= 0.0 {
             return Err(Error::Mesh(
                 "the original's first frame has a zero bounding-box diagonal, the unit of every \\
@@ -112,11 +112,4 @@ impl Comparison {
             frame_rmse: self.frame_rmse,
         }
     }
-}
-
-/// The bounding-box diagonal of a frame (as [`crate::mesh::AnimatedMesh::bbox_diagonal`]).
-fn diagonal(points: &[Point]) -> f64 {
-    let (lo, hi) = crate::mesh::bounding_box(points);
-    let d: f64 = (0..3).map(|a| (hi[a] - lo[a]) as f64).map(|x| x * x).sum();
-    d.sqrt()
 }

@@ -336,7 +336,7 @@ impl<R: Read + Seek> ContainerReader<R> {
     /// it (its entry then holds only the bytes present); `None` for a complete part.
     pub fn truncated(&self, tag: Tag) -> Option<u64> {
         self.truncated
-            .filter(|&(t, segment, _)| t == tag && (!tag.per_segment() || segment == self.selected))
+            .filter(|&(t, segment, _)| t == tag && segment == self.scope(tag))
             .map(|(.., declared)| declared)
     }
 
@@ -371,13 +371,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             .find(|p| p.tag == Tag::SEGMENT && p.segment == Some(segment))
             .copied()
             .ok_or_else(|| Error::Stream(format!("missing start of segment {segment}")))?;
-        let bytes = self.read_at(e.offset, e.len, e.tag)?;
-        if crc32fast::hash(&bytes) != e.crc {
-            return Err(Error::Stream(format!(
-                "the start of segment {segment} fails its checksum (damaged file)"
-            )));
-        }
-        Ok(bytes)
+        self.payload(&e)
     }
 
     /// The part table.
@@ -405,12 +399,18 @@ impl<R: Read + Seek> ContainerReader<R> {
         self.find(tag).is_some()
     }
 
-    fn find(&self, tag: Tag) -> Option<PartEntry> {
-        let scope = if tag.per_segment() {
+    /// Where a part of `tag` is looked for: the selected segment for a segment's part, else the
+    /// whole stream's parts.
+    fn scope(&self, tag: Tag) -> Option<u32> {
+        if tag.per_segment() {
             self.selected
         } else {
             None
-        };
+        }
+    }
+
+    fn find(&self, tag: Tag) -> Option<PartEntry> {
+        let scope = self.scope(tag);
         self.parts
             .iter()
             .find(|p| p.tag == tag && p.segment == scope)
@@ -420,10 +420,17 @@ impl<R: Read + Seek> ContainerReader<R> {
     /// A whole part's payload, verified against its CRC.
     pub fn part(&mut self, tag: Tag) -> Result<Vec<u8>> {
         let e = self.entry(tag)?;
-        let bytes = self.read_at(e.offset, e.len, tag)?;
+        self.payload(&e)
+    }
+
+    /// The payload of an entry of [`ContainerReader::parts`], verified against its CRC when one
+    /// covers it whole.
+    pub fn payload(&mut self, e: &PartEntry) -> Result<Vec<u8>> {
+        let bytes = self.read_at(e.offset, e.len, e.tag)?;
         if e.checksum == Checksum::Whole && crc32fast::hash(&bytes) != e.crc {
             return Err(Error::Stream(format!(
-                "part {tag} fails its checksum (damaged file)"
+                "part {} fails its checksum (damaged file)",
+                e.tag
             )));
         }
         Ok(bytes)

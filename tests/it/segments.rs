@@ -35,6 +35,11 @@ fn options(codec: Codec, segment_frames: Option<usize>) -> EncodeOptions {
     }
 }
 
+/// The error a damaged stream is refused with.
+fn refusal(bytes: Vec<u8>) -> String {
+    decoder(bytes).err().expect("refused").to_string()
+}
+
 fn version(bytes: &[u8]) -> u16 {
     u16::from_le_bytes([bytes[8], bytes[9]])
 }
@@ -121,36 +126,30 @@ fn missing_reordered_or_misplaced_segments_are_refused() {
         .collect();
     // The last segment dropped.
     let dropped = rebuild(all[..starts[2]].to_vec());
-    let err = decoder(dropped).err().expect("refused").to_string();
+    let err = refusal(dropped);
     assert!(err.contains("missing segment"), "{err}");
     // Segments 1 and 2 swapped.
     let mut swapped = all[..starts[1]].to_vec();
     swapped.extend_from_slice(&all[starts[2]..]);
     swapped.extend_from_slice(&all[starts[1]..starts[2]]);
-    let err = decoder(rebuild(swapped))
-        .err()
-        .expect("refused")
-        .to_string();
+    let err = refusal(rebuild(swapped));
     assert!(err.contains("out of order"), "{err}");
     // A segment's part before the first segment.
     let mut misplaced = all.clone();
     let affine = misplaced.iter().position(|p| p.0 == Tag::AFFINE).unwrap();
     let part = misplaced.remove(affine);
     misplaced.insert(1, part);
-    let err = decoder(rebuild(misplaced))
-        .err()
-        .expect("refused")
-        .to_string();
+    let err = refusal(rebuild(misplaced));
     assert!(err.contains("belongs to one"), "{err}");
     // A segment start in a stream that claims version 3.
     let mut old = bytes.clone();
     old[8..10].copy_from_slice(&VERSION.to_le_bytes());
-    let err = decoder(old).err().expect("refused").to_string();
+    let err = refusal(old);
     assert!(err.contains("cannot hold segments"), "{err}");
     // Two affine parts in one segment.
     let mut twice = all.clone();
     twice.insert(starts[1] + 1, (Tag::AFFINE, vec![0; 4], Checksum::Whole));
-    let err = decoder(rebuild(twice)).err().expect("refused").to_string();
+    let err = refusal(rebuild(twice));
     assert!(err.contains("twice"), "{err}");
 }
 

@@ -6,7 +6,7 @@ use mcgv_video::decoder::Decoder;
 use mcgv_video::error::{Error, Result};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::{AnimatedMesh, FrameSource, ReadOptions};
-use mcgv_video::metrics::{Comparison, Measures, Surface};
+use mcgv_video::metrics::{same_frame_count, Comparison, Measures, Surface};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
@@ -53,12 +53,7 @@ fn compare_stream(
     quiet: bool,
 ) -> Result<Measures> {
     let frames = original.frame_count();
-    if decoder.header().frames as usize != frames {
-        return Err(Error::Usage(format!(
-            "the original has {frames} frames but the decoded animation has {}; frames must correspond",
-            decoder.header().frames
-        )));
-    }
+    same_frame_count(frames, decoder.header().frames as usize)?;
     let bits = decoder.header().first_frame_bits;
     let same_vertices = original.first().vertex_count() == decoder.header().vertices as usize;
     let order = match decoder.header().reorder && same_vertices {
@@ -110,12 +105,7 @@ fn compare_stream(
 /// held whole).
 fn compare_sources(original: &mut FrameSource, decoded: &mut FrameSource) -> Result<Measures> {
     let frames = original.frame_count();
-    if decoded.frame_count() != frames {
-        return Err(Error::Usage(format!(
-            "the original has {frames} frames but the decoded animation has {}; frames must correspond",
-            decoded.frame_count()
-        )));
-    }
+    same_frame_count(frames, decoded.frame_count())?;
     let mut comparison = Comparison::new(first_surface(original), first_surface(decoded))?;
     let run = mcgv_video::encoder::DEFAULT_SEGMENT_FRAMES;
     for start in (0..frames).step_by(run) {
