@@ -5,13 +5,15 @@
 
 mod common;
 
-use common::{parts, rebuild, tiny_stream};
+use common::{encode_bytes, parts, rebuild, tiny_stream};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::stream::container::ContainerReader;
 use mcgv_video::stream::container::Tag;
 use mcgv_video::stream::entropy::max_symbols;
 use mcgv_video::{codec::Codec, stream::header::Header};
-use mcgv_video::{DecodeOptions, Decoder, Error, DEFAULT_MAX_POSITIONS};
+use mcgv_video::{
+    AnimatedMesh, DecodeOptions, Decoder, EncodeOptions, Error, DEFAULT_MAX_POSITIONS,
+};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::io::Cursor;
@@ -358,4 +360,38 @@ fn the_positions_limit_refuses_a_stream_past_it_and_opens_one_at_it() {
         "{msg}"
     );
     assert!(peak < SMALL, "refusing took {peak} bytes");
+}
+
+#[test]
+fn a_valid_long_unsegmented_stream_opens_in_memory_of_what_it_produces() {
+    // Four still vertices over 20 000 frames in one segment: a few hundred bytes of stream that
+    // the decoder must open holding the affine levels of every frame. Its memory follows the
+    // frames, at about the size of the positions it decodes (4 × 12 bytes a frame); the maps
+    // were stored beside the levels until 2026-11-30: 239 bytes a frame then, 143 now.
+    const FRAMES: usize = 20_000;
+    let base = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let triangles = vec![[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]];
+    let mesh = AnimatedMesh::new(triangles, vec![base.to_vec(); FRAMES]).expect("an animation");
+    let opts = EncodeOptions {
+        codec: Codec::Tdct,
+        segment_frames: None,
+        ..EncodeOptions::default()
+    };
+    let bytes = encode_bytes(&mesh, &opts);
+    let (result, peak) = peak_of(|| {
+        let mut decoder = Decoder::new(&bytes)?;
+        decoder.decode_frame(FRAMES / 2).map(|frame| frame.len())
+    });
+    eprintln!(
+        "{FRAMES} frames in {} bytes: peak {peak} bytes, {} a frame",
+        bytes.len(),
+        peak / FRAMES
+    );
+    assert_eq!(result.expect("decodes"), 4);
+    assert!(peak < 160 * FRAMES, "peak {peak} bytes");
 }

@@ -206,11 +206,16 @@ impl QuantisedAffine {
 }
 
 /// Per frame and cluster, the dequantised affine map predicting that frame from the decoded frame 0.
+///
+/// Only the levels are kept (96 bytes a frame and cluster); a frame's maps are dequantised when
+/// it is predicted, so a decoder holding a long segment's track keeps half what it would with
+/// the maps stored beside the levels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AffineTrack {
     quantised: QuantisedAffine,
     geometry: ClusterGeometry,
-    maps: Vec<AffineCoefficients>,
+    /// Per cluster, the steps of its 12 levels.
+    steps: Vec<[f64; 12]>,
 }
 
 impl AffineTrack {
@@ -308,19 +313,10 @@ impl AffineTrack {
         let steps: Vec<[f64; 12]> = (0..quantised.clusters)
             .map(|k| geometry.steps(k, step))
             .collect();
-        let maps = quantised
-            .values
-            .chunks_exact(12)
-            .enumerate()
-            .map(|(i, q)| {
-                let k = i % quantised.clusters;
-                QuantisedAffine::dequantise(q, &steps[k], geometry.centroid(k))
-            })
-            .collect();
         Ok(Self {
             quantised,
             geometry,
-            maps,
+            steps,
         })
     }
 
@@ -345,11 +341,33 @@ impl AffineTrack {
     }
 
     /// The dequantised map of `cluster` at `frame`, in the unit frame of the reference.
-    pub fn map(&self, frame: usize, cluster: usize) -> Option<&AffineCoefficients> {
+    pub fn map(&self, frame: usize, cluster: usize) -> Option<AffineCoefficients> {
         if cluster >= self.quantised.clusters {
             return None;
         }
-        self.maps.get(frame * self.quantised.clusters + cluster)
+        let start = (frame * self.quantised.clusters + cluster) * 12;
+        let levels = self.quantised.values.get(start..start + 12)?;
+        let steps = self.steps.get(cluster)?;
+        Some(QuantisedAffine::dequantise(
+            levels,
+            steps,
+            self.geometry.centroid(cluster),
+        ))
+    }
+
+    /// Every cluster's dequantised map at `frame`, cluster by cluster (none past the last frame).
+    pub fn frame_maps(&self, frame: usize) -> Vec<AffineCoefficients> {
+        (0..self.quantised.clusters)
+            .map_while(|k| self.map(frame, k))
+            .collect()
+    }
+
+    /// Every frame's maps, frame by frame, cluster by cluster: a table for fits that visit every
+    /// frame many times (96 bytes a frame and cluster).
+    pub fn maps(&self) -> Vec<AffineCoefficients> {
+        (0..self.quantised.frames)
+            .flat_map(|f| self.frame_maps(f))
+            .collect()
     }
 
     /// Predicts frame `frame` (eq. 3): each vertex of `reference` moved by its cluster's dequantised
@@ -392,10 +410,11 @@ impl AffineTrack {
     /// its reference position, and vertices beyond the partition are left out; it never panics.
     pub fn predict(&self, frame: usize, reference: &[Point], partition: &Partition) -> Vec<Point> {
         let unit = UnitFrame::of(reference);
+        let maps = self.frame_maps(frame);
         reference
             .iter()
             .zip(partition.labels())
-            .map(|(p, &k)| match self.map(frame, k as usize) {
+            .map(|(p, &k)| match maps.get(k as usize) {
                 Some(h) => unit.to_world(apply(h, unit.to_unit(p))),
                 None => *p,
             })

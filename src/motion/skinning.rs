@@ -24,7 +24,7 @@
 //! decoder predictions are bit-identical.
 
 use super::affine::AffineTrack;
-use super::fit::{apply, UnitFrame};
+use super::fit::{apply, AffineCoefficients, UnitFrame};
 use super::partition::Partition;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
@@ -190,6 +190,7 @@ impl SkinningWeights {
         }
         let neighbours = cluster_neighbours(partition, triangles);
         let unit = UnitFrame::of(reference);
+        let maps = track.maps();
         let exact: Vec<Vec<f64>> = (0..reference.len())
             .into_par_iter()
             .map(|v| {
@@ -197,7 +198,8 @@ impl SkinningWeights {
                 let problem = VertexFit {
                     frames,
                     reference,
-                    track,
+                    maps: &maps,
+                    clusters: track.cluster_count(),
                     unit,
                     ridge,
                 };
@@ -247,18 +249,19 @@ impl SkinningWeights {
         self.check(partition)?;
         let unit = UnitFrame::of(reference);
         let step = self.step();
+        let maps = track.frame_maps(frame);
         let mut offset = 0usize;
         let mut out = Vec::with_capacity(reference.len());
         for (p, &k) in reference.iter().zip(partition.labels()) {
             let x = unit.to_unit(p);
-            let own = track.map(frame, k as usize).map_or(x, |h| apply(h, x));
+            let own = maps.get(k as usize).map_or(x, |h| apply(h, x));
             let mut q = own;
             let neighbours = &self.neighbours[k as usize];
             for (&j, &w) in neighbours.iter().zip(&self.values[offset..]) {
                 if w == 0 {
                     continue;
                 }
-                let other = track.map(frame, j as usize).map_or(x, |h| apply(h, x));
+                let other = maps.get(j as usize).map_or(x, |h| apply(h, x));
                 let w = w as f64 * step;
                 for a in 0..3 {
                     q[a] += w * (other[a] - own[a]);
@@ -293,7 +296,9 @@ impl SkinningWeights {
 struct VertexFit<'a> {
     frames: &'a [Vec<Point>],
     reference: &'a [Point],
-    track: &'a AffineTrack,
+    /// The track's maps, frame by frame, `clusters` a frame.
+    maps: &'a [AffineCoefficients],
+    clusters: usize,
     unit: UnitFrame,
     ridge: f64,
 }
@@ -305,7 +310,8 @@ impl VertexFit<'_> {
         let Self {
             frames,
             reference,
-            track,
+            maps,
+            clusters,
             unit,
             ridge,
         } = *self;
@@ -318,11 +324,13 @@ impl VertexFit<'_> {
         let mut rhs = DVector::<f64>::zeros(m);
         let mut d = vec![[0f64; 3]; m];
         for (i, frame) in frames.iter().enumerate() {
-            let own = track.map(i, k).map_or(x0, |h| apply(h, x0));
+            let own = maps.get(i * clusters + k).map_or(x0, |h| apply(h, x0));
             let target = unit.to_unit(&frame[v]);
             let r = [0, 1, 2].map(|a| target[a] - own[a]);
             for (dj, &j) in d.iter_mut().zip(neighbours) {
-                let other = track.map(i, j as usize).map_or(x0, |h| apply(h, x0));
+                let other = maps
+                    .get(i * clusters + j as usize)
+                    .map_or(x0, |h| apply(h, x0));
                 *dj = [0, 1, 2].map(|a| other[a] - own[a]);
             }
             for a in 0..m {

@@ -44,7 +44,7 @@ fn decoded_maps_are_the_encoders_and_within_half_a_step_of_the_fit() {
                 let (got, want) = (decoded.map(f, k).unwrap(), exact.map(f, k).unwrap());
                 let centroid = geometry.centroid(k);
                 for (c, quantiser) in steps.iter().enumerate() {
-                    let error = (stored(got, centroid, c) - stored(want, centroid, c)).abs();
+                    let error = (stored(&got, centroid, c) - stored(&want, centroid, c)).abs();
                     assert!(
                         error <= 0.5 * quantiser * (1.0 + 1e-6) + 1e-9,
                         "step {step}, frame {f}, cluster {k}, coefficient {c}: error {error:e}, \
