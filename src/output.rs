@@ -68,14 +68,43 @@ fn folder(path: &Path) -> &Path {
 /// The temporary file's name is an internal detail: errors name the target (and, when it is
 /// missing, its folder) with the bare reason, not tempfile's "at path .mcgv-partial-…".
 fn bare(path: &Path, e: std::io::Error) -> Error {
+    let dir = folder(path);
     match e.kind() {
+        // A folder that exists can still refuse files with "not found" (/proc, /sys).
+        std::io::ErrorKind::NotFound if dir.is_dir() => Error::io(
+            path,
+            std::io::Error::new(
+                e.kind(),
+                format!("the folder {} does not take new files", dir.display()),
+            ),
+        ),
         std::io::ErrorKind::NotFound => Error::io(
             path,
             std::io::Error::new(
                 e.kind(),
-                format!("the folder {} does not exist", folder(path).display()),
+                format!("the folder {} does not exist", dir.display()),
             ),
         ),
         kind => Error::io(path, std::io::Error::from(kind)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_folder_and_one_that_takes_no_files_are_told_apart() {
+        let missing = std::env::temp_dir().join("mcgv-no-such-folder/out.mcgv");
+        let e = write_atomic(&missing, b"x")
+            .expect_err("no folder")
+            .to_string();
+        assert!(e.contains("does not exist"), "{e}");
+        // procfs answers "not found" to a new file in a folder that exists.
+        let proc = Path::new("/proc/mcgv-out.mcgv");
+        if proc.parent().is_some_and(Path::is_dir) {
+            let e = write_atomic(proc, b"x").expect_err("procfs").to_string();
+            assert!(e.contains("/proc does not take new files"), "{e}");
+        }
     }
 }
