@@ -345,8 +345,11 @@ impl AffineTrack {
         if cluster >= self.quantised.clusters {
             return None;
         }
-        let start = (frame * self.quantised.clusters + cluster) * 12;
-        let levels = self.quantised.values.get(start..start + 12)?;
+        let start = frame
+            .checked_mul(self.quantised.clusters)?
+            .checked_add(cluster)?
+            .checked_mul(12)?;
+        let levels = self.quantised.values.get(start..start.checked_add(12)?)?;
         let steps = self.steps.get(cluster)?;
         Some(QuantisedAffine::dequantise(
             levels,
