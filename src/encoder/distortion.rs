@@ -29,8 +29,12 @@ pub const RD_SLOPE: f64 = 2.0;
 /// `encoded` as the decoder reconstructs it, in model units ([`metrics::vertex_errors`], what
 /// `eval` reports as vertex RMSE before normalising).
 pub fn vertex_rmse(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<f64> {
-    let bytes = encoded.to_bytes();
-    let decoded = Decoder::new(&bytes)?.decode_all()?;
+    stream_rmse(mesh, &encoded.to_bytes())
+}
+
+/// [`vertex_rmse`] of a stream's bytes.
+pub fn stream_rmse(mesh: &AnimatedMesh, bytes: &[u8]) -> Result<f64> {
+    let decoded = Decoder::new(bytes)?.decode_all()?;
     let errors = metrics::vertex_errors(mesh, &decoded).ok_or_else(|| {
         Error::Codec(format!(
             "a trial stream decoded to {} frames of {} vertices for {} of {}",
@@ -45,7 +49,7 @@ pub fn vertex_rmse(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<f64> {
 
 /// A candidate's cost, compared between candidates (lower is better): `log2(bits)` plus
 /// `log2` of its RMS error ([`vertex_rmse`]) over [`RD_SLOPE`]. A difference of one is twice the
-/// bits at equal error. Without an error (a sampled trial), the bits alone.
+/// bits at equal error. Without an error (tdct's candidates), the bits alone.
 pub fn cost(bits: f64, rmse: Option<f64>) -> f64 {
     let rate = bits.max(1.0).log2();
     match rmse {

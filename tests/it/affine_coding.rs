@@ -39,7 +39,10 @@ fn decoded_maps_are_the_encoders_and_within_half_a_step_of_the_fit() {
         assert!(decoded.frame_maps(mesh.frame_count()).is_empty());
         assert!(decoded.map(usize::MAX, 0).is_none());
         assert!(decoded.map(0, partition.clusters()).is_none());
-        assert_eq!(decoded.maps().len(), mesh.frame_count() * partition.clusters());
+        assert_eq!(
+            decoded.maps().len(),
+            mesh.frame_count() * partition.clusters()
+        );
         let exact =
             AffineTrack::fit(mesh.frames(), reference, &partition, MIN_AFFINE_STEP).unwrap();
         let geometry = track.geometry();

@@ -284,6 +284,42 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
 }
 
 #[test]
+fn jpeg_weighs_the_error_of_each_candidates_sample_stream() {
+    // JPEG's trials on a long animation code 12 spread frames; their stream, with those frames'
+    // affine maps, is decoded and its error weighed as the whole stream's.
+    let mesh = skinned_bend();
+    let options = opts(
+        Codec::Jpeg,
+        PredictorChoice::Auto,
+        SegmentationChoice::auto(),
+    );
+    let encoded = encode(&mesh, &options).expect("encodes");
+    let choice = encoded.report.choice.clone().expect("a choice");
+    assert!(choice.trial_frames < mesh.frame_count(), "sampled trials");
+    let diagonal = mesh.bbox_diagonal();
+    let cost = |c: &Candidate| {
+        let rmse = c.vertex_rmse.expect("the sample's error");
+        distortion::cost(8.0 * c.bytes as f64, Some(rmse * diagonal))
+    };
+    let best = choice
+        .candidates
+        .iter()
+        .min_by(|a, b| cost(a).total_cmp(&cost(b)))
+        .expect("candidates");
+    assert_eq!(
+        choice.chosen,
+        format!("{}+{}", best.predictor.name(), best.segmentation)
+    );
+    // The sample's error stands for the whole stream's.
+    let measured = vertex_rmse(&mesh, &decode_all(encoded.to_bytes()).expect("decodes"));
+    let sampled = best.vertex_rmse.expect("an error");
+    assert!(
+        (0.5..2.0).contains(&(measured / sampled)),
+        "whole {measured} vs sample {sampled}"
+    );
+}
+
+#[test]
 fn progress_announces_the_trials_frames_and_reports_them_all() {
     let mesh = skinned_bend();
     let frames = mesh.frame_count() as u64;
