@@ -6,8 +6,8 @@ use crate::common::{animate, decode_all, decoder, tube, vertex_rmse, Counter};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::distortion;
 use mcgv_video::encoder::{
-    encode, encode_with_progress, Candidate, EncodeOptions, PredictorChoice, Segmentation,
-    SegmentationChoice,
+    encode, encode_with_progress, Candidate, ChoiceReport, EncodeOptions, PredictorChoice,
+    Segmentation, SegmentationChoice,
 };
 use mcgv_video::mesh::{AnimatedMesh, Point};
 use mcgv_video::motion::PredictorKind;
@@ -235,6 +235,25 @@ fn picture_codecs_try_a_sample_of_frames_then_code_the_winner_whole() {
     );
 }
 
+/// The candidate of least bits at equal error, after checking that the choice kept it; every
+/// candidate must report its error.
+fn kept_at_least_cost(choice: &ChoiceReport, diagonal: f64) -> Candidate {
+    let cost = |c: &Candidate| {
+        let rmse = c.vertex_rmse.expect("each candidate's error was weighed");
+        distortion::cost(8.0 * c.bytes as f64, Some(rmse * diagonal))
+    };
+    let best = choice
+        .candidates
+        .iter()
+        .min_by(|a, b| cost(a).total_cmp(&cost(b)))
+        .expect("candidates");
+    assert_eq!(
+        choice.chosen,
+        format!("{}+{}", best.predictor.name(), best.segmentation)
+    );
+    best.clone()
+}
+
 #[test]
 fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
     let mesh = skinned_bend();
@@ -248,22 +267,7 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
     };
     let encoded = encode(&mesh, &options).expect("encodes");
     let choice = encoded.report.choice.clone().expect("a choice");
-    let diagonal = mesh.bbox_diagonal();
-    let cost = |c: &Candidate| {
-        let rmse = c
-            .vertex_rmse
-            .expect("MPEG-4 codes every candidate whole and decodes it");
-        distortion::cost(8.0 * c.bytes as f64, Some(rmse * diagonal))
-    };
-    let best = choice
-        .candidates
-        .iter()
-        .min_by(|a, b| cost(a).total_cmp(&cost(b)))
-        .expect("candidates");
-    assert_eq!(
-        choice.chosen,
-        format!("{}+{}", best.predictor.name(), best.segmentation)
-    );
+    let best = kept_at_least_cost(&choice, mesh.bbox_diagonal());
     assert!(choice.reason.contains("equal error"), "{}", choice.reason);
     // The error the choice weighed is the decoded stream's.
     let measured = vertex_rmse(&mesh, &decode_all(encoded.to_bytes()).expect("decodes"));
@@ -296,20 +300,7 @@ fn jpeg_weighs_the_error_of_each_candidates_sample_stream() {
     let encoded = encode(&mesh, &options).expect("encodes");
     let choice = encoded.report.choice.clone().expect("a choice");
     assert!(choice.trial_frames < mesh.frame_count(), "sampled trials");
-    let diagonal = mesh.bbox_diagonal();
-    let cost = |c: &Candidate| {
-        let rmse = c.vertex_rmse.expect("the sample's error");
-        distortion::cost(8.0 * c.bytes as f64, Some(rmse * diagonal))
-    };
-    let best = choice
-        .candidates
-        .iter()
-        .min_by(|a, b| cost(a).total_cmp(&cost(b)))
-        .expect("candidates");
-    assert_eq!(
-        choice.chosen,
-        format!("{}+{}", best.predictor.name(), best.segmentation)
-    );
+    let best = kept_at_least_cost(&choice, mesh.bbox_diagonal());
     // The sample's error stands for the whole stream's.
     let measured = vertex_rmse(&mesh, &decode_all(encoded.to_bytes()).expect("decodes"));
     let sampled = best.vertex_rmse.expect("an error");
