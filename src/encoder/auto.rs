@@ -24,7 +24,7 @@ use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::{AnimatedMesh, Point};
-use crate::motion::{AffineTrack, Partition, PredictorKind, QuantisedAffine};
+use crate::motion::{Partition, PredictorKind};
 use crate::progress::Progress;
 use crate::stream::container::Part;
 use std::time::Instant;
@@ -146,13 +146,7 @@ pub(super) fn choose(
                 prediction: &prediction,
                 atlas: Some(atlas),
             };
-            let (bytes, encoded, sample_error) = trial(&shared, &analysed, &progress)?;
-            let error = match &encoded {
-                Some(encoded) if opts.codec.has_images() => {
-                    Some(distortion::vertex_rmse(mesh, encoded)?)
-                }
-                _ => sample_error,
-            };
+            let (bytes, encoded, error) = trial(&shared, &analysed, &progress)?;
             let cost = distortion::cost(8.0 * bytes as f64, error);
             let kept = match encoded {
                 Some(encoded) => Kept::Stream(Box::new(encoded)),
@@ -199,8 +193,8 @@ struct Shared<'a> {
     sample: Option<&'a Sample>,
 }
 
-/// Codes one candidate: its bytes and whole stream, or (sampled trials) its estimated bytes and
-/// the sample's error.
+/// Codes one candidate: its bytes, whole stream and (picture codecs) decoded error, or (sampled
+/// trials) its estimated bytes and the sample's error.
 fn trial(
     shared: &Shared,
     analysed: &Analysed,
@@ -219,7 +213,11 @@ fn trial(
                 progress,
                 Stopwatch::new(),
             )?;
-            Ok((encoded.report.bytes, Some(encoded), None))
+            let error = match opts.codec.has_images() {
+                true => Some(distortion::vertex_rmse(mesh, &encoded)?),
+                false => None,
+            };
+            Ok((encoded.report.bytes, Some(encoded), error))
         }
         Some(sample) => {
             let trial = (ff.decoded_positions.as_slice(), shared.leading);
@@ -363,7 +361,7 @@ impl Sample {
     ) -> Result<(u64, f64)> {
         let prediction = analysed.prediction;
         let sampled = analysis::Prediction {
-            track: sample_track(&prediction.track, &self.frames)?,
+            track: prediction.track.select(&self.frames)?,
             weights: prediction.weights.clone(),
             residuals: self
                 .frames
@@ -412,25 +410,6 @@ impl Sample {
             error,
         ))
     }
-}
-
-/// `track`'s maps of `frames` alone, as a track of their own (the sample's stream).
-fn sample_track(track: &AffineTrack, frames: &[usize]) -> Result<AffineTrack> {
-    let q = track.quantised();
-    let values = frames
-        .iter()
-        .flat_map(|&f| {
-            let start = f * q.clusters * 12;
-            q.values[start..start + q.clusters * 12].iter().copied()
-        })
-        .collect();
-    let sampled = QuantisedAffine {
-        step: q.step,
-        frames: frames.len(),
-        clusters: q.clusters,
-        values,
-    };
-    AffineTrack::from_quantised(sampled, track.geometry().clone())
 }
 
 /// Progress of one candidate's trial: its stages named after it.

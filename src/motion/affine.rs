@@ -340,22 +340,46 @@ impl AffineTrack {
         self.quantised.clusters
     }
 
+    /// The levels of every cluster at `frame`, 12 a cluster (none past the last frame).
+    fn frame_levels(&self, frame: usize) -> Option<&[i64]> {
+        let per_frame = self.quantised.clusters * 12;
+        let start = frame.checked_mul(per_frame)?;
+        self.quantised
+            .values
+            .get(start..start.checked_add(per_frame)?)
+    }
+
     /// The dequantised map of `cluster` at `frame`, in the unit frame of the reference.
     pub fn map(&self, frame: usize, cluster: usize) -> Option<AffineCoefficients> {
-        if cluster >= self.quantised.clusters {
-            return None;
-        }
-        let start = frame
-            .checked_mul(self.quantised.clusters)?
-            .checked_add(cluster)?
-            .checked_mul(12)?;
-        let levels = self.quantised.values.get(start..start.checked_add(12)?)?;
+        let levels = self
+            .frame_levels(frame)?
+            .get(cluster.checked_mul(12)?..)?
+            .get(..12)?;
         let steps = self.steps.get(cluster)?;
         Some(QuantisedAffine::dequantise(
             levels,
             steps,
             self.geometry.centroid(cluster),
         ))
+    }
+
+    /// The track of `frames` alone, in that order (a sample of a clip as a clip of its own).
+    pub fn select(&self, frames: &[usize]) -> Result<Self> {
+        let q = &self.quantised;
+        let mut values = Vec::with_capacity(frames.len() * q.clusters * 12);
+        for &f in frames {
+            let levels = self.frame_levels(f).ok_or_else(|| {
+                Error::Usage(format!("frame {f} asked of a {}-frame track", q.frames))
+            })?;
+            values.extend_from_slice(levels);
+        }
+        let selected = QuantisedAffine {
+            step: q.step,
+            frames: frames.len(),
+            clusters: q.clusters,
+            values,
+        };
+        Self::from_quantised(selected, self.geometry.clone())
     }
 
     /// Every cluster's dequantised map at `frame`, cluster by cluster (none past the last frame).
