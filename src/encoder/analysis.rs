@@ -138,18 +138,28 @@ pub fn predict_on(
             opts.weight_bits,
         )?),
     };
-    let residuals = (0..mesh.frame_count())
-        .map(|f| {
-            let predicted =
-                motion::predict_frame(&track, weights.as_ref(), f, reference, partition)?;
-            Ok(motion::residuals(mesh.frame(f), &predicted))
-        })
-        .collect::<Result<_>>()?;
+    let residuals = residuals_of(mesh, reference, partition, &track, weights.as_ref())?;
     Ok(Prediction {
         track,
         weights,
         residuals,
     })
+}
+
+/// Every frame's residual against its prediction by `track` (blended by `weights` for skinning).
+pub fn residuals_of(
+    mesh: &AnimatedMesh,
+    reference: &[Point],
+    partition: &Partition,
+    track: &AffineTrack,
+    weights: Option<&SkinningWeights>,
+) -> Result<Vec<Vec<[f32; 3]>>> {
+    (0..mesh.frame_count())
+        .map(|f| {
+            let predicted = motion::predict_frame(track, weights, f, reference, partition)?;
+            Ok(motion::residuals(mesh.frame(f), &predicted))
+        })
+        .collect()
 }
 
 /// The encoder's analysis of `original` redone with a stream's options and partition.

@@ -21,7 +21,7 @@ use crate::decoder::Decoder;
 use crate::error::{Error, Result};
 use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::{AnimatedMesh, FrameSource, Point, Triangle};
-use crate::motion::{self, AffineTrack, Partition, SkinningWeights};
+use crate::motion::{AffineTrack, Partition, SkinningWeights};
 use crate::progress::Progress;
 use crate::stream::container::{ContainerReader, ContainerWriter, Part, Tag};
 use crate::stream::header::Header;
@@ -221,18 +221,13 @@ impl SegmentedEncoder {
             &self.partition,
             self.opts.affine_step(),
         )?;
-        let residuals = (0..clip.frame_count())
-            .map(|f| {
-                let predicted = motion::predict_frame(
-                    &track,
-                    self.weights.as_ref(),
-                    f,
-                    &self.reference,
-                    &self.partition,
-                )?;
-                Ok(motion::residuals(clip.frame(f), &predicted))
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let residuals = super::analysis::residuals_of(
+            clip,
+            &self.reference,
+            &self.partition,
+            &track,
+            self.weights.as_ref(),
+        )?;
         let coded = self.opts.codec.encoder()?.encode(&ResidualInput {
             mesh: clip,
             diagonal: self.diagonal,
