@@ -60,24 +60,13 @@ fn compare_stream(
         true => input_order(original.first(), bits)?,
         false => None,
     };
-    let triangles = match &order {
-        Some(inverse) => AnimatedMesh::new(
-            decoder.triangles().to_vec(),
-            vec![decoder.reference().to_vec()],
-        )?
-        .permuted(inverse)?
-        .triangles()
-        .to_vec(),
-        None => decoder.triangles().to_vec(),
-    };
     let pb = progress::bar(frames as u64, "decode", quiet);
     let mut comparison: Option<Comparison> = None;
     for (s, range) in decoder.segments().to_vec().into_iter().enumerate() {
-        let mut decoded = decoder.decode_segment(s, &crate::progress::Reporter(&pb))?;
+        let positions = decoder.decode_segment(s, &crate::progress::Reporter(&pb))?;
+        let mut decoded = AnimatedMesh::new(decoder.triangles().to_vec(), positions)?;
         if let Some(inverse) = &order {
-            for frame in &mut decoded {
-                *frame = inverse.iter().map(|&v| frame[v as usize]).collect();
-            }
+            decoded = decoded.permuted(inverse)?;
         }
         let originals = original.read(range)?;
         let comparison = match &mut comparison {
@@ -88,12 +77,12 @@ fn compare_stream(
                     positions: &originals[0],
                 },
                 Surface {
-                    triangles: &triangles,
-                    positions: &decoded[0],
+                    triangles: decoded.triangles(),
+                    positions: decoded.frame(0),
                 },
             )?),
         };
-        comparison.add(&originals, &decoded)?;
+        comparison.add(&originals, decoded.frames())?;
     }
     pb.finish_and_clear();
     comparison
