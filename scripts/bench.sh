@@ -9,7 +9,9 @@
 #   could not take, and why), plots/SEQUENCE.png, table.md, peers.md; then temporal segments (issue
 #   20): segments-cost.csv (bits of segmenting the OBJ sequences, examples/segment_cost) and
 #   segments-memory.csv (peak RSS and time on a generated 50 000 x 2 000 clip,
-#   scripts/segments_memory.sh; SEGMENTS_V / SEGMENTS_F change its size; SKIP_SEGMENTS=1 skips both)
+#   scripts/segments_memory.sh; SEGMENTS_V / SEGMENTS_F change its size; SKIP_SEGMENTS=1 skips both);
+#   last docs/results.md, the current results page, from all of these (scripts/results_page.py and
+#   scripts/results_template.md)
 # MCGV_PYTHON is the virtualenv's python (`make bench` passes it). BENCH_VARIANTS overrides the
 # variants (scripts/sweep.sh VARIANTS); empty skips the variant sweep. JPEG_QUALITIES,
 # MPEG4_QUALITIES, TDCT_QUALITIES, HEVC_QUALITIES, HEVC_INTRA_QUALITIES, AV1_QUALITIES and
@@ -57,11 +59,15 @@ MCGV_PYTHON=$py bash scripts/peers_page.sh bench-out/peers.md bench-out/peers.sk
     echo "# Rate-distortion tables"
     echo
     echo "Written by \`make bench\` (\`scripts/rd_table.py\` over ${csvs[*]#bench-out/}, copied beside this"
-    echo "page); the narrative and older measurements are in [../results.md](../results.md). The other CSVs"
-    echo "in this folder are older measurements that results.md cites; they do not feed these tables."
+    echo "page); the current results page is [../results.md](../results.md), dated and superseded measurements"
+    echo "are in [../history.md](../history.md). Every file in this folder is written by \`make bench\`: these"
+    echo "tables come from the CSVs named above, segments-cost.csv and segments-memory.csv from its"
+    echo "temporal-segment runs; older CSVs are in ../history/."
+    echo "This copy: \`make bench\` of $(date -u +%F) at commit $(git describe --always --dirty 2>/dev/null || echo unknown)."
     echo
     cat bench-out/table.md
 } > docs/bench/tables.md
+rm -f docs/bench/sweep-variants.csv    # made again below only if this run swept the variants
 cp "${csvs[@]}" bench-out/peers.md docs/bench/
 cp bench-out/plots/*.png docs/bench/
 if [ -z "${SKIP_SEGMENTS:-}" ]; then
@@ -72,4 +78,7 @@ if [ -z "${SKIP_SEGMENTS:-}" ]; then
         bench-out/segments-memory >bench-out/segments-memory.csv
     cp bench-out/segments-cost.csv bench-out/segments-memory.csv docs/bench/
 fi
-echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md, peers.md; docs/bench/ updated"
+# The results page, from the copies in docs/bench/ (so that the command it prints is reproducible).
+"$py" scripts/results_page.py "${csvs[@]/#bench-out\//docs/bench/}" > bench-out/results.md
+cp bench-out/results.md docs/results.md
+echo "results: bench-out/motion.txt, ${csvs[*]#bench-out/}, plots/, table.md, peers.md, results.md; docs/bench/ and docs/results.md updated"
