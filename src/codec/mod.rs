@@ -14,24 +14,15 @@
 //!
 //! [`quality`] maps the one `quality` knob onto each codec's quantiser.
 
-pub mod abbreviated;
-#[cfg(feature = "mpeg4")]
-pub mod av1;
-#[cfg(feature = "mpeg4")]
-pub mod deep;
-pub mod geometry_video;
-#[cfg(feature = "mpeg4")]
-pub mod hevc;
-pub mod jpeg;
-#[cfg(feature = "mpeg4")]
-mod libav;
-#[cfg(feature = "mpeg4")]
-pub mod mpeg4;
-mod plane;
+pub mod pictures;
 pub mod quality;
 pub mod tdct;
 
-pub use plane::Plane;
+pub use pictures::{abbreviated, geometry_video, jpeg};
+#[cfg(feature = "ffmpeg")]
+pub use pictures::{av1, deep, hevc, mpeg4};
+
+pub use crate::geometry_image::Plane;
 pub use quality::{
     av1_law, hevc_law, ijg_scale_percent, jpeg_law, mpeg4_law, target_step, PictureLaw,
 };
@@ -123,20 +114,20 @@ impl Codec {
     /// Whether this build can code the codec (MPEG-4, HEVC and AV1 need the `mpeg4` feature, i.e.
     /// FFmpeg).
     pub fn available(self) -> bool {
-        !matches!(self, Codec::Mpeg4 | Codec::Hevc | Codec::Av1) || cfg!(feature = "mpeg4")
+        !matches!(self, Codec::Mpeg4 | Codec::Hevc | Codec::Av1) || cfg!(feature = "ffmpeg")
     }
 
     /// The codec's encoder.
     pub fn encoder(self) -> Result<Box<dyn ResidualEncoder>> {
         Ok(match self {
             Codec::Jpeg => Box::new(geometry_video::Encoder::new(jpeg::Pictures)),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Mpeg4 => Box::new(geometry_video::Encoder::new(mpeg4::Pictures)),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Hevc => Box::new(geometry_video::Encoder::new(hevc::PICTURES)),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Av1 => Box::new(geometry_video::Encoder::new(av1::PICTURES)),
-            #[cfg(not(feature = "mpeg4"))]
+            #[cfg(not(feature = "ffmpeg"))]
             Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
             Codec::Tdct => Box::new(tdct::Encoder),
         })
@@ -146,13 +137,13 @@ impl Codec {
     pub fn pictures(self) -> Result<Option<Box<dyn geometry_video::PictureCodec>>> {
         Ok(match self {
             Codec::Jpeg => Some(Box::new(jpeg::Pictures)),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Mpeg4 => Some(Box::new(mpeg4::Pictures)),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Hevc => Some(Box::new(hevc::PICTURES)),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Av1 => Some(Box::new(av1::PICTURES)),
-            #[cfg(not(feature = "mpeg4"))]
+            #[cfg(not(feature = "ffmpeg"))]
             Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
             Codec::Tdct => None,
         })
@@ -172,32 +163,32 @@ impl Codec {
                 stream,
                 reader,
             )?),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Mpeg4 => Box::new(geometry_video::Decoder::open(
                 mpeg4::Pictures,
                 stream,
                 reader,
             )?),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Hevc => Box::new(geometry_video::Decoder::open(
                 hevc::PICTURES,
                 stream,
                 reader,
             )?),
-            #[cfg(feature = "mpeg4")]
+            #[cfg(feature = "ffmpeg")]
             Codec::Av1 => Box::new(geometry_video::Decoder::open(
                 av1::PICTURES,
                 stream,
                 reader,
             )?),
-            #[cfg(not(feature = "mpeg4"))]
+            #[cfg(not(feature = "ffmpeg"))]
             Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
             Codec::Tdct => Box::new(tdct::Decoder::open(stream, reader, max_bands)?),
         })
     }
 }
 
-#[cfg(not(feature = "mpeg4"))]
+#[cfg(not(feature = "ffmpeg"))]
 fn unavailable() -> Error {
     Error::Codec(
         "this build has no MPEG-4, HEVC or AV1 codec (built without the `mpeg4` feature, FFmpeg)"

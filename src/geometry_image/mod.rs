@@ -5,15 +5,17 @@
 //! - [`quantise`]: the pixel step, per-frame (or per-group) offsets and the 0..255 levels around them.
 //! - [`corrections`]: the residuals that do not fit, sent apart.
 //! - [`images`]: one frame's three residual images, raw or padded.
-//! - [`tile`]: the x | y | z images side by side in one picture, and back.
+//! - [`tile`]: the x | y | z images side by side in one picture ([`Plane`]), and back.
 
 pub mod corrections;
 pub mod images;
 pub mod lattice;
+mod plane;
 pub mod quantise;
 pub mod tile;
 
 pub use corrections::{Correction, Corrections};
 pub use images::GeometryImages;
 pub use lattice::Lattice;
+pub use plane::Plane;
 pub use quantise::{AxisRange, FrameRanges, RangeMode};

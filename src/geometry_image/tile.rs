@@ -1,7 +1,7 @@
 //! The three coordinate images of a frame side by side in one picture (x | y | z), so each frame is one
 //! JPEG picture or one MPEG-4 frame: one set of headers per frame instead of three, and one video stream.
 
-use crate::codec::Plane;
+use super::plane::Plane;
 
 /// Rounds and clamps three `width × height` images (levels of `depth`-bit samples) into one
 /// `3·width × height` plane.
