@@ -172,7 +172,7 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
     let start = Instant::now();
     let reference = mesh.frame(0);
     // The affine step of a default-quality encoding.
-    let step = mcgv_video::codec::tdct::step_for_quality(mcgv_video::encoder::DEFAULT_QUALITY, 1.0)
+    let step = mcgv_video::codec::target_step(mcgv_video::encoder::DEFAULT_QUALITY, 1.0)
         * DEFAULT_AFFINE_PRECISION;
     let track = match AffineTrack::fit(mesh.frames(), reference, &partition, step) {
         Ok(t) => t,

@@ -4,12 +4,14 @@
 //!
 //! `cargo run --release --example dump_residuals -- INPUT OUT_DIR [FRAMES]` (default 24 frames, evenly
 //! spread), then `cargo run --release -p padding --example jpeg_bench -- folder --per-frame 3 OUT_DIR`.
+//!
+//! The images are a JPEG encoding's (affine predictor on k-means clusters, one segment), as
+//! `mcgv-video inspect --png DIR --original INPUT` redoes them, unannotated.
 
-use mcgv_video::codec::{geometry_video, Codec};
-use mcgv_video::encoder::{analysis, EncodeOptions, Segmentation};
-use mcgv_video::first_frame;
+use mcgv_video::codec::Codec;
+use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::mesh::read_animation;
-use mcgv_video::motion::PredictorKind;
+use mcgv_video::{encode, Decoder, PredictorKind};
 use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -21,49 +23,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let wanted: usize = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(24);
     let mesh = read_animation(&input, &Default::default())?;
     let opts = EncodeOptions {
-        codec: Codec::Jpeg,
+        codec: Codec::Jpeg.into(),
+        predictor: PredictorKind::Affine.into(),
+        segmentation: Segmentation::KMeans.into(),
+        segment_frames: None,
         ..EncodeOptions::default()
     };
-    let ff = first_frame::encode(
-        mesh.frame(0),
-        mesh.triangles(),
-        &first_frame::FirstFrameOptions {
-            bits: opts.first_frame_bits_or_default(),
-            reorder: false,
-        },
-    )?;
-    let (partition, _) = analysis::segment(&mesh, Segmentation::KMeans, opts.clusters)?;
-    let reference = &ff.decoded_positions;
-    let prediction = analysis::predict(&mesh, reference, &partition, &opts, PredictorKind::Affine)?;
-    let pictures = opts.codec.pictures()?.ok_or("the codec makes no images")?;
-    let step = geometry_video::pixel_step(pictures.as_ref(), mesh.bbox_diagonal(), &opts)?;
-    let images = geometry_video::images_of(
-        pictures.as_ref(),
-        &ff.decoded_positions,
-        mesh.triangles(),
-        &partition,
-        &prediction.residuals,
-        &opts,
-        step,
-    )?;
-    let (w, h) = (images.lattice.0 as u32, images.lattice.1 as u32);
-    let mask: Vec<u8> = images
-        .atlas
-        .fixed_mask()
-        .iter()
-        .map(|&f| if f { 255 } else { 0 })
-        .collect();
-    std::fs::create_dir_all(&out)?;
+    let bytes = encode(&mesh, &opts)?.to_bytes();
+    let decoder = Decoder::new(&bytes)?;
+    let pictures = decoder.describe().and_then(|d| d.pictures);
+    let (w, h) = pictures.ok_or("a JPEG stream has pictures")?.lattice;
+    let (w, h) = (u32::from(w), u32::from(h));
     let frames = mesh.frame_count();
-    for i in 0..wanted.min(frames) {
-        let f = i * frames / wanted.min(frames);
-        for (a, c) in ["x", "y", "z"].iter().enumerate() {
-            let levels = images.level_image(&prediction.residuals[f], f, a)?;
+    let count = wanted.clamp(1, frames);
+    let chosen: Vec<usize> = (0..count).map(|i| i * frames / count).collect();
+    std::fs::create_dir_all(&out)?;
+    for images in mcgv_video::inspect::encoder_images(&decoder, &mesh, &chosen)? {
+        let mask: Vec<u8> = images
+            .fixed
+            .iter()
+            .map(|&f| if f { 255 } else { 0 })
+            .collect();
+        for (levels, c) in images.raw.iter().zip(["x", "y", "z"]) {
             let grey: Vec<u16> = levels
                 .iter()
                 .map(|&v| (v.clamp(0.0, 255.0) * 257.0).round() as u16)
                 .collect();
-            let stem = format!("{f:04}_{c}");
+            let stem = format!("{:04}_{c}", images.frame);
             image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, grey)
                 .ok_or("image size")?
                 .save(out.join(format!("{stem}.png")))?;
@@ -72,10 +58,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .save(out.join(format!("{stem}_mask.png")))?;
         }
     }
-    eprintln!(
-        "{} frames of {input} written to {}",
-        wanted.min(frames),
-        out.display()
-    );
+    eprintln!("{count} frames of {input} written to {}", out.display());
     Ok(())
 }

@@ -13,6 +13,7 @@
 //! HEVC_GOP (HEVC's gop, 1 for all-intra); EXTRA_PREDICTOR=skinning for the skinning predictor.
 //! The mesh is read and the rows appended once per input; encodings run in this one process.
 
+use mcgv_video::codec::{CodecConfig, DeepConfig, JpegConfig, Mpeg4Config};
 use mcgv_video::{encode, read_animation, Codec, Decoder, EncodeOptions, ReadOptions};
 use std::error::Error;
 use std::io::Write;
@@ -78,7 +79,7 @@ fn main() -> Res<()> {
         let mut runs: Vec<(EncodeOptions, String)> = Vec::new();
         for &q in &tdct {
             let o = EncodeOptions {
-                codec: Codec::Tdct,
+                codec: Codec::Tdct.into(),
                 quality: q,
                 ..base.clone()
             };
@@ -87,18 +88,22 @@ fn main() -> Res<()> {
         for &s in &steps {
             for &j in &jpeg {
                 let o = EncodeOptions {
-                    codec: Codec::Jpeg,
+                    codec: CodecConfig::Jpeg(JpegConfig {
+                        quality: Some(j),
+                        ..JpegConfig::default()
+                    }),
                     step: Some(s),
-                    jpeg_quality: Some(j),
                     ..base.clone()
                 };
                 runs.push((o, format!("jpeg,{s},{j},")));
             }
             for &q in &qscales {
                 let o = EncodeOptions {
-                    codec: Codec::Mpeg4,
+                    codec: CodecConfig::Mpeg4(Mpeg4Config {
+                        qscale: Some(q),
+                        ..Mpeg4Config::default()
+                    }),
                     step: Some(s),
-                    qscale: Some(q),
                     ..base.clone()
                 };
                 runs.push((o, format!("mpeg4,{s},{q},")));
@@ -107,11 +112,13 @@ fn main() -> Res<()> {
         for &s in &hevc_steps {
             for &q in &hevc_qps {
                 let o = EncodeOptions {
-                    codec: Codec::Hevc,
+                    codec: CodecConfig::Hevc(DeepConfig {
+                        qp: Some(q),
+                        bit_depth,
+                        gop: hevc_gop.unwrap_or(mcgv_video::DEFAULT_GOP),
+                        ..DeepConfig::default()
+                    }),
                     step: Some(s),
-                    qscale: Some(q),
-                    bit_depth,
-                    gop: hevc_gop.unwrap_or(base.gop),
                     ..base.clone()
                 };
                 runs.push((o, format!("hevc,{s},{q},")));

@@ -62,7 +62,7 @@ fn main() -> Res<()> {
                 .find(|c| c.name() == codec)
                 .ok_or(format!("unknown codec {codec}"))?;
             let opts = |segment_frames| EncodeOptions {
-                codec,
+                codec: codec.into(),
                 quality: quality.unwrap_or(mcgv_video::encoder::DEFAULT_QUALITY),
                 segment_frames,
                 ..EncodeOptions::default()

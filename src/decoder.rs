@@ -4,8 +4,7 @@
 //! from its group's key frame).
 
 use crate::codec::geometry_video::ImageLayout;
-use crate::codec::tdct::Bands;
-use crate::codec::{Codec, Plane, ResidualDecoder, StreamLayout};
+use crate::codec::{Codec, Description, Plane, ResidualDecoder, StreamLayout};
 use crate::error::{Error, Result};
 use crate::first_frame;
 use crate::geometry_image::FrameRanges;
@@ -14,7 +13,7 @@ use crate::mesh::{AnimatedMesh, Attributes, Point, Triangle};
 use crate::motion::{predict_frame, AffineTrack, Partition, PredictorKind, SkinningWeights};
 use crate::progress::{Progress, Silent};
 use crate::stream::attributes::decode_attributes;
-use crate::stream::container::{ContainerReader, Tag};
+use crate::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
 use crate::stream::frame_index::ChunkEntry;
 use crate::stream::header::Header;
 use crate::stream::segments;
@@ -47,6 +46,7 @@ impl Default for DecodeOptions {
 pub struct Decoder<R> {
     reader: ContainerReader<R>,
     header: Header,
+    codec: Codec,
     triangles: Vec<Triangle>,
     reference: Vec<Point>,
     partition: Partition,
@@ -94,6 +94,7 @@ impl<R: Read + Seek> Decoder<R> {
     /// and of a segmented stream, the first segment's.
     pub fn from_container(mut reader: ContainerReader<R>, options: &DecodeOptions) -> Result<Self> {
         let header = Header::from_bytes(&reader.part(Tag::HEADER)?)?;
+        let codec = Codec::from_id(header.codec)?;
         limits::check_stream(header.vertices, header.frames, options.max_positions)?;
         let (v, f) = (header.vertices as usize, header.frames as usize);
         let (triangles, reference) = first_frame::decode(&reader.part(Tag::FIRST_FRAME)?)?;
@@ -116,12 +117,18 @@ impl<R: Read + Seek> Decoder<R> {
             &triangles,
         )?;
         let partition = Partition::from_labels(labels, header.clusters as usize)?;
-        if options.max_bands.is_some() && header.codec != Codec::Tdct {
+        if options.max_bands.is_some() && !codec.has_bands() {
+            let banded: Vec<&str> = Codec::ALL
+                .iter()
+                .filter(|c| c.has_bands())
+                .map(|c| c.name())
+                .collect();
             return Err(Error::option(
                 "max_bands",
                 format!(
-                    "applies to tdct streams; this one is {}",
-                    header.codec.name()
+                    "applies to {} streams; this one is {}",
+                    banded.join(" and "),
+                    codec.name()
                 ),
             ));
         }
@@ -129,6 +136,7 @@ impl<R: Read + Seek> Decoder<R> {
         let segments = segments::read_ranges(&mut reader, f)?;
         let shared = Shared {
             header: &header,
+            codec,
             triangles: &triangles,
             reference: &reference,
             partition: &partition,
@@ -141,6 +149,7 @@ impl<R: Read + Seek> Decoder<R> {
         Ok(Self {
             reader,
             header,
+            codec,
             triangles,
             reference,
             partition,
@@ -155,6 +164,11 @@ impl<R: Read + Seek> Decoder<R> {
     /// The stream header.
     pub fn header(&self) -> &Header {
         &self.header
+    }
+
+    /// The residual codec.
+    pub fn codec(&self) -> Codec {
+        self.codec
     }
 
     /// Texture coordinates and materials, in the decoder's order (empty when the stream has none).
@@ -182,9 +196,23 @@ impl<R: Read + Seek> Decoder<R> {
         self.weights.as_ref()
     }
 
-    /// The part table, for bit budgets.
-    pub fn container(&self) -> &ContainerReader<R> {
-        &self.reader
+    /// The stream's length in bytes.
+    pub fn file_len(&self) -> u64 {
+        self.reader.file_len()
+    }
+
+    /// Bytes each part takes in the file (its part header included), by part name in file order,
+    /// after the file header; the parts of one kind in a segmented stream are summed.
+    pub fn part_bytes(&self) -> Vec<(String, u64)> {
+        let mut parts = vec![("file header".to_string(), FILE_HEADER_LEN as u64)];
+        for p in self.reader.parts() {
+            let bytes = p.len + PART_HEADER_LEN as u64;
+            match parts.iter_mut().find(|(name, _)| name == p.tag.name()) {
+                Some((_, total)) => *total += bytes,
+                None => parts.push((p.tag.name().to_string(), bytes)),
+            }
+        }
+        parts
     }
 
     /// The frames of each temporal segment, in order (one segment for a stream not cut into them).
@@ -192,11 +220,17 @@ impl<R: Read + Seek> Decoder<R> {
         &self.segments
     }
 
-    /// The segment whose parts are read, if any: the one [`Decoder::images`], [`Decoder::bands`]
-    /// and the figures built on them describe. A stream of one segment opens it with the stream;
+    /// The segment whose parts are read, if any: the one [`Decoder::describe`] and the figures
+    /// built on it describe. A stream of one segment opens it with the stream;
     /// a segmented one opens none until a frame is asked for or [`Decoder::seek_segment`].
     pub fn open_segment(&self) -> Option<usize> {
         self.open.as_ref().map(|o| o.index)
+    }
+
+    /// The open segment's affine base step (a fraction of the bounding-box diagonal).
+    pub(crate) fn affine_step(&self) -> Option<f64> {
+        let open = self.open.as_ref()?;
+        Some(f64::from(open.track.quantised().step))
     }
 
     /// Reads segment `s`'s affine maps and residual parts (the segment's alone), unless open.
@@ -212,6 +246,7 @@ impl<R: Read + Seek> Decoder<R> {
         }
         let shared = Shared {
             header: &self.header,
+            codec: self.codec,
             triangles: &self.triangles,
             reference: &self.reference,
             partition: &self.partition,
@@ -223,36 +258,16 @@ impl<R: Read + Seek> Decoder<R> {
         Ok(())
     }
 
+    /// What the residual codec stored (of the open segment): its settings, and its bands or
+    /// pictures. `None` until a segment is open (a segmented stream opens none until a frame is
+    /// asked for or [`Decoder::seek_segment`]).
+    pub fn describe(&self) -> Option<Description> {
+        self.open.as_ref().map(|o| o.residuals.describe())
+    }
+
     /// The geometry-image side of the open segment (`None` for codecs without images).
-    pub fn images(&self) -> Option<&ImageLayout> {
+    pub(crate) fn images(&self) -> Option<&ImageLayout> {
         self.open.as_ref().and_then(|o| o.residuals.images())
-    }
-
-    /// The open segment's temporal-DCT bands (`None` for codecs without bands).
-    pub fn bands(&self) -> Option<&Bands> {
-        self.open.as_ref().and_then(|o| o.residuals.bands())
-    }
-
-    /// Temporal-DCT bands decoded in the open segment (all of them for a complete stream, fewer
-    /// for a truncated one or a preview); 0 for image codecs.
-    pub fn bands_decoded(&self) -> usize {
-        self.bands().map_or(0, |b| b.decoded.len())
-    }
-
-    /// Temporal-DCT bands in the open segment (one per frame); 0 for image codecs.
-    pub fn bands_total(&self) -> usize {
-        self.bands().map_or(0, |b| b.lengths.len())
-    }
-
-    /// Byte length of every temporal-DCT band of the open segment, low to high frequency (empty
-    /// for image codecs).
-    pub fn band_lengths(&self) -> &[u64] {
-        self.bands().map_or(&[], |b| &b.lengths)
-    }
-
-    /// The temporal-DCT quantiser step in the mesh's units (`None` for image codecs).
-    pub fn band_step(&self) -> Option<f32> {
-        self.bands().map(|b| b.step)
     }
 
     /// Whether the file ends inside the temporal-DCT coefficients (of the last segment: the bands
@@ -283,8 +298,8 @@ impl<R: Read + Seek> Decoder<R> {
     pub fn frame_entry(&self, f: usize) -> Result<ChunkEntry> {
         let Some(images) = self.images() else {
             return Err(Error::Usage(format!(
-                "a {} stream has no images: its residuals are temporal-DCT bands",
-                self.header.codec.name()
+                "a {} stream has no pictures",
+                self.codec.name()
             )));
         };
         match self.open_segment().map(|s| &self.segments[s]) {
@@ -403,6 +418,7 @@ fn finite(f: usize, frame: &[Point]) -> Result<()> {
 /// What every segment is decoded against: the parts the whole stream shares.
 struct Shared<'a> {
     header: &'a Header,
+    codec: Codec,
     triangles: &'a [Triangle],
     reference: &'a [Point],
     partition: &'a Partition,
@@ -439,7 +455,7 @@ impl Shared<'_> {
         let affine = reader.part(Tag::AFFINE)?;
         let (partition, reference) = (self.partition, self.reference);
         side_info::check_affine(&affine, frames.len(), partition, reference)?;
-        let residuals = header
+        let residuals = self
             .codec
             .open_decoder(&layout, reader, self.options.max_bands)?;
         let track = side_info::decode_checked_affine(&affine, frames.len(), partition, reference)?;

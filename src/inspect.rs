@@ -1,27 +1,15 @@
-//! Looking inside a stream: its bit budget per part, and the residual images its encoder made
-//! (redone from the original animation by the encoder's own analysis and image code, so what is
-//! shown is what was coded).
+//! Looking inside a stream: the residual images its encoder made, redone from the original
+//! animation by the encoder's own analysis and image code, so that what is shown is what was
+//! coded. (The bit budget per part is [`Decoder::part_bytes`], what the codec stored
+//! [`Decoder::describe`].)
 
+use crate::codec::pictures::geometry_video;
 use crate::decoder::Decoder;
-use crate::encoder::{analysis, EncodeOptions};
+use crate::encoder::analysis::{self, StreamChoices};
 use crate::error::{Error, Result};
+use crate::first_frame::FirstFrameOptions;
 use crate::mesh::AnimatedMesh;
-use crate::stream::container::{FILE_HEADER_LEN, PART_HEADER_LEN};
 use std::io::{Read, Seek};
-
-/// Bytes each part of an opened stream takes in the file (its part header included), in file
-/// order, after the file header; the parts of one kind in a segmented stream are summed.
-pub fn part_bytes<R: Read + Seek>(decoder: &Decoder<R>) -> Vec<(String, u64)> {
-    let mut parts = vec![("file header".to_string(), FILE_HEADER_LEN as u64)];
-    for p in decoder.container().parts() {
-        let bytes = p.len + PART_HEADER_LEN as u64;
-        match parts.iter_mut().find(|(name, _)| name == p.tag.name()) {
-            Some((_, total)) => *total += bytes,
-            None => parts.push((p.tag.name().to_string(), bytes)),
-        }
-    }
-    parts
-}
 
 /// One frame's residual images as the encoder made them: levels in `0..=255`, x, y, z.
 pub struct EncoderImages {
@@ -31,6 +19,8 @@ pub struct EncoderImages {
     pub raw: [Vec<f32>; 3],
     /// After padding: what the picture codec was given.
     pub padded: [Vec<f32>; 3],
+    /// The pixels that carry data (the vertices' and the charts' interiors); the others are padding.
+    pub fixed: Vec<bool>,
 }
 
 /// The residual images the encoder made for `frames` of a geometry-video stream, redone from the
@@ -48,12 +38,10 @@ pub fn encoder_images<R: Read + Seek>(
                 .into(),
         ));
     }
-    let pictures = header.codec.pictures()?.ok_or_else(|| {
-        Error::Usage(format!(
-            "a {} stream has no geometry images",
-            header.codec.name()
-        ))
-    })?;
+    let codec = decoder.codec();
+    let pictures = codec
+        .pictures()?
+        .ok_or_else(|| Error::Usage(format!("a {} stream has no geometry images", codec.name())))?;
     if original.vertex_count() != header.vertices as usize
         || original.frame_count() != header.frames as usize
     {
@@ -71,24 +59,34 @@ pub fn encoder_images<R: Read + Seek>(
             header.frames - 1
         )));
     }
-    let opts = EncodeOptions::from_header(header, decoder.weights().map(|w| w.bits))?;
-    let redone = analysis::redo(original, &opts, decoder.partition())?;
-    let residuals = &redone.prediction.residuals;
     let layout = decoder
         .images()
         .ok_or_else(|| Error::Usage("the stream has no geometry images".into()))?;
-    // The stream's own step, ranges and corrections: the encoder's option (`step`) is not recorded.
-    let mut images = crate::codec::geometry_video::images_of(
-        pictures.as_ref(),
-        &redone.reference,
-        &redone.triangles,
+    let choices = StreamChoices {
+        first_frame: FirstFrameOptions {
+            bits: header.first_frame_bits,
+            reorder: header.reorder,
+        },
+        partition: decoder.partition(),
+        predictor: header.predictor,
+        affine_step: decoder.affine_step().ok_or_else(closed)?,
+        weight_bits: decoder
+            .weights()
+            .map_or(crate::motion::WEIGHT_BITS, |w| w.bits),
+    };
+    let redone = analysis::redo(original, &choices)?;
+    let residuals = &redone.prediction.residuals;
+    let plan = layout.setup.plan(codec);
+    // The stream's own step, ranges and corrections.
+    let shape = (
+        redone.reference.as_slice(),
+        redone.triangles.as_slice(),
         decoder.partition(),
-        residuals,
-        &opts,
-        layout.pixel_step,
-    )?;
+    );
+    let codec = (pictures, &plan);
+    let mut images = geometry_video::images(codec, layout.pixel_step, shape, residuals, None)?;
     images.ranges = layout.ranges.clone();
-    images.depth = layout.depth;
+    images.depth = layout.depth();
     images.corrections = layout.corrections.clone();
     frames
         .iter()
@@ -97,7 +95,13 @@ pub fn encoder_images<R: Read + Seek>(
                 frame: f,
                 raw: images.raw(&residuals[f], f)?,
                 padded: images.padded_alone(residuals, f)?,
+                fixed: images.atlas.fixed_mask(),
             })
         })
         .collect()
+}
+
+/// The error of a figure asked of a stream with no open segment.
+fn closed() -> Error {
+    Error::Stream("no segment is open".into())
 }

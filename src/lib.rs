@@ -21,7 +21,7 @@
 //!     .collect();
 //! let mesh = AnimatedMesh::new(triangles, frames)?;
 //!
-//! let options = EncodeOptions { codec: Codec::Tdct, quality: 60, clusters: 2, ..Default::default() };
+//! let options = EncodeOptions { codec: Codec::Tdct.into(), quality: 60, clusters: 2, ..Default::default() };
 //! let bytes = encode(&mesh, &options)?.to_bytes();
 //!
 //! let mut decoder = Decoder::new(&bytes)?;
@@ -50,6 +50,7 @@ pub mod output;
 pub mod progress;
 pub mod stream;
 
+pub use codec::pictures::DEFAULT_GOP;
 pub use codec::Codec;
 pub use decoder::{DecodeOptions, Decoder};
 pub use encoder::{
@@ -61,4 +62,6 @@ pub use geometry_image::Lattice;
 pub use limits::DEFAULT_MAX_POSITIONS;
 pub use mesh::{read_animation, AnimatedMesh, Attributes, FrameSource, ReadOptions};
 pub use motion::PredictorKind;
+/// How free pixels of the geometry images are filled (the `padding` crate's methods).
+pub use padding::Method as PaddingMethod;
 pub use progress::{Progress, Silent};

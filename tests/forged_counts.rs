@@ -378,7 +378,7 @@ fn a_valid_long_unsegmented_stream_opens_in_memory_of_what_it_produces() {
     let triangles = vec![[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]];
     let mesh = AnimatedMesh::new(triangles, vec![base.to_vec(); FRAMES]).expect("an animation");
     let opts = EncodeOptions {
-        codec: Codec::Tdct,
+        codec: Codec::Tdct.into(),
         segment_frames: None,
         ..EncodeOptions::default()
     };

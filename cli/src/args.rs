@@ -153,9 +153,6 @@ pub struct EncodeArgs {
     /// coarser maps).
     #[arg(long)]
     pub affine_precision: Option<f64>,
-    /// Retired: the affine coefficients now follow the quality's step (see --affine-precision).
-    #[arg(long, hide = true)]
-    pub affine_bits: Option<u8>,
     /// Geometry-image lattice: WIDTHxHEIGHT (multiples of 16), or `auto` for the smallest square
     /// the charts fit, tried from about 2 pixels per vertex upwards (the fewest bits at equal
     /// error on the media sequences).
@@ -196,10 +193,6 @@ pub struct EncodeArgs {
     /// [default: 128].
     #[arg(long, value_name = "N")]
     pub segment_frames: Option<u64>,
-    /// Retired with stream version 2 (the step now follows --quality, not each frame's range);
-    /// kept hidden so that old scripts get a clear error rather than "unexpected argument".
-    #[arg(long, hide = true)]
-    pub range_floor: Option<String>,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,

@@ -2,7 +2,6 @@
 //! (`tests/fuzz_regressions.rs`) includes this file by path and replays crashers through the same code.
 
 use mcgv_video::codec::tdct::index::BandIndex;
-use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::{parse_gltf, parse_obj, parse_pc2, AnimatedMesh, Summary, Triangle};
@@ -54,7 +53,7 @@ fn check_alone(
     f: usize,
     alone: &[[f32; 3]],
 ) {
-    if decoder.header().codec == Codec::Tdct {
+    if decoder.codec().has_bands() {
         // The frame alone sums the bands' basis functions directly, the whole sequence goes
         // through the fast inverse DCT: equal up to rounding, of the order of the coordinates'.
         let scale = mesh

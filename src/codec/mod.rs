@@ -1,43 +1,42 @@
 //! Residual coders: how the motion the predictor leaves over is stored.
 //!
-//! Every codec implements one interface, [`ResidualEncoder`] and [`ResidualDecoder`], and the only
-//! place that knows which codecs exist is [`Codec`] ([`Codec::encoder`], [`Codec::open_decoder`]):
-//! a new codec is one new module and one variant.
+//! Every codec implements one interface, [`ResidualEncoder`] and [`ResidualDecoder`], owns its
+//! options (a variant of [`CodecConfig`], its type in the codec's own file) and its quality law
+//! (turning the caller's rate into a [`RatePlan`]), and writes its own parts. The places that know
+//! which codecs exist are [`Codec`] and [`CodecConfig`]: a new codec is one new module and one
+//! variant of each (docs/design.md, "The codec interface").
 //!
-//! - [`jpeg`] and [`mpeg4`] are the paper's geometry video: the residuals are splatted onto a
-//!   multi-chart atlas ([`geometry_video`]), padded, and coded as pictures — one JPEG per frame
-//!   (any frame decodes alone) or MPEG-4 Part 2 I- and P-frames through FFmpeg (cargo feature
-//!   `mpeg4`). [`hevc`] and [`av1`] code the same pictures at 10 or 12 bits a sample with libx265
-//!   and libaom (same feature: they need FFmpeg too; their shared part is [`deep`]).
+//! - [`pictures`] is the papers' geometry video: the residuals are splatted onto a multi-chart
+//!   atlas, padded, and coded as pictures — one JPEG per frame (any frame decodes alone), or
+//!   through FFmpeg (cargo feature `ffmpeg`) MPEG-4 Part 2 I- and P-frames and HEVC and AV1 at 10
+//!   or 12 bits a sample.
 //! - [`tdct`] is the follow-up paper's temporal DCT: each vertex's residual trajectory transformed
 //!   over all frames and coded band by band, no images.
-//!
-//! [`quality`] maps the one `quality` knob onto each codec's quantiser.
 
+mod interface;
 pub mod pictures;
-pub mod quality;
+mod rate;
 pub mod tdct;
 
-pub use pictures::{abbreviated, geometry_video, jpeg};
+pub use interface::{BandsDescription, Description, PicturesDescription};
+pub(crate) use interface::{
+    CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput, StreamLayout,
+};
+pub use pictures::deep::DeepConfig;
+pub use pictures::jpeg::JpegConfig;
+pub use pictures::mpeg4::Mpeg4Config;
+pub use pictures::{abbreviated, geometry_video, jpeg, PictureOptions, Plane};
 #[cfg(feature = "ffmpeg")]
 pub use pictures::{av1, deep, hevc, mpeg4};
+pub(crate) use rate::Rate;
+pub use rate::{ijg_scale_percent, target_step, PictureLaw, RatePlan};
+pub use tdct::TdctConfig;
 
-pub use crate::geometry_image::Plane;
-pub use quality::{
-    av1_law, hevc_law, ijg_scale_percent, jpeg_law, mpeg4_law, target_step, PictureLaw,
-};
-
-use crate::encoder::EncodeOptions;
 use crate::error::{Error, Result};
-use crate::mesh::{AnimatedMesh, Point, Triangle};
-use crate::motion::Partition;
-use crate::progress::Progress;
-use crate::stream::container::{ContainerReader, Part};
-use crate::stream::header::Header;
+use crate::stream::container::{ContainerReader, Tag};
+use pictures::PictureCodec;
+use rate::CoderPlan;
 use std::io::{Read, Seek};
-
-/// The stream id of the first temporal-DCT format (bands without spatial prediction), refused.
-const RETIRED_TDCT_ID: u8 = 2;
 
 /// The residual codec recorded in the stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -68,8 +67,7 @@ impl Codec {
         Codec::Av1,
     ];
 
-    /// The codec's id in the stream header. The temporal DCT's is 3 since its bands are coded with
-    /// spatial prediction (issue 18): id 2 was the format before, which this build refuses.
+    /// The codec's id in the stream header.
     pub fn id(self) -> u8 {
         match self {
             Codec::Jpeg => 0,
@@ -82,13 +80,6 @@ impl Codec {
 
     /// The codec of a stream id.
     pub fn from_id(id: u8) -> Result<Self> {
-        if id == RETIRED_TDCT_ID {
-            return Err(Error::Stream(format!(
-                "codec id {id} is the temporal-DCT format from before spatial prediction of the \
-                 bands, which this version of mcgv-video no longer decodes: re-encode the animation \
-                 (`--codec tdct`) from its source"
-            )));
-        }
         Codec::ALL
             .into_iter()
             .find(|c| c.id() == id)
@@ -106,195 +97,186 @@ impl Codec {
         }
     }
 
+    /// The codec's options with every default.
+    pub fn default_config(self) -> CodecConfig {
+        match self {
+            Codec::Jpeg => CodecConfig::Jpeg(JpegConfig::default()),
+            Codec::Mpeg4 => CodecConfig::Mpeg4(Mpeg4Config::default()),
+            Codec::Tdct => CodecConfig::Tdct(TdctConfig::default()),
+            Codec::Hevc => CodecConfig::Hevc(DeepConfig::default()),
+            Codec::Av1 => CodecConfig::Av1(DeepConfig::default()),
+        }
+    }
+
     /// Whether the codec codes geometry images on a lattice (and so has an atlas).
     pub fn has_images(self) -> bool {
         !matches!(self, Codec::Tdct)
     }
 
-    /// Whether this build can code the codec (MPEG-4, HEVC and AV1 need the `mpeg4` feature, i.e.
-    /// FFmpeg).
+    /// Whether the codec codes frequency bands, so that a stream cut short, or decoded up to a
+    /// band, still gives every frame (coarser).
+    pub fn has_bands(self) -> bool {
+        matches!(self, Codec::Tdct)
+    }
+
+    /// Whether its residual coder is cheap next to the segmentation and codes at exactly the
+    /// plan's step: the automatic choice may then try more candidates (a k-means ladder, coarser
+    /// first frames) and compare them by bytes alone.
+    pub(crate) fn cheap_exact_trials(self) -> bool {
+        matches!(self, Codec::Tdct)
+    }
+
+    /// Whether the automatic choice may estimate a candidate from a sample of frames: the frames
+    /// are coded each on its own (measured on JPEG; spread frames misrank P-frames).
+    pub(crate) fn sampled_trials(self) -> bool {
+        matches!(self, Codec::Jpeg)
+    }
+
+    /// Whether this build can code the codec (MPEG-4, HEVC and AV1 need the `ffmpeg` feature).
     pub fn available(self) -> bool {
         !matches!(self, Codec::Mpeg4 | Codec::Hevc | Codec::Av1) || cfg!(feature = "ffmpeg")
     }
 
-    /// The codec's encoder.
-    pub fn encoder(self) -> Result<Box<dyn ResidualEncoder>> {
-        Ok(match self {
-            Codec::Jpeg => Box::new(geometry_video::Encoder::new(jpeg::Pictures)),
-            #[cfg(feature = "ffmpeg")]
-            Codec::Mpeg4 => Box::new(geometry_video::Encoder::new(mpeg4::Pictures)),
-            #[cfg(feature = "ffmpeg")]
-            Codec::Hevc => Box::new(geometry_video::Encoder::new(hevc::PICTURES)),
-            #[cfg(feature = "ffmpeg")]
-            Codec::Av1 => Box::new(geometry_video::Encoder::new(av1::PICTURES)),
-            #[cfg(not(feature = "ffmpeg"))]
-            Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
-            Codec::Tdct => Box::new(tdct::Encoder),
-        })
-    }
-
     /// The picture codec of a geometry-video codec (`None` for codecs without images).
-    pub fn pictures(self) -> Result<Option<Box<dyn geometry_video::PictureCodec>>> {
+    pub(crate) fn pictures(self) -> Result<Option<&'static dyn PictureCodec>> {
         Ok(match self {
-            Codec::Jpeg => Some(Box::new(jpeg::Pictures)),
+            Codec::Jpeg => Some(&pictures::jpeg::Pictures),
             #[cfg(feature = "ffmpeg")]
-            Codec::Mpeg4 => Some(Box::new(mpeg4::Pictures)),
+            Codec::Mpeg4 => Some(&pictures::mpeg4::Pictures),
             #[cfg(feature = "ffmpeg")]
-            Codec::Hevc => Some(Box::new(hevc::PICTURES)),
+            Codec::Hevc => Some(&pictures::hevc::PICTURES),
             #[cfg(feature = "ffmpeg")]
-            Codec::Av1 => Some(Box::new(av1::PICTURES)),
+            Codec::Av1 => Some(&pictures::av1::PICTURES),
             #[cfg(not(feature = "ffmpeg"))]
-            Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
+            Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable(self)),
             Codec::Tdct => None,
         })
     }
 
     /// Reads the codec's parts of a stream (everything but the coded residuals themselves, which
     /// a decoder reads on demand, or for tdct the bands, read here) and returns its decoder.
-    pub fn open_decoder<R: Read + Seek>(
+    pub(crate) fn open_decoder<R: Read + Seek>(
         self,
         stream: &StreamLayout,
         reader: &mut ContainerReader<R>,
         max_bands: Option<usize>,
     ) -> Result<Box<dyn ResidualDecoder<R>>> {
-        Ok(match self {
-            Codec::Jpeg => Box::new(geometry_video::Decoder::open(
-                jpeg::Pictures,
+        let setup = reader.part(Tag::CODEC_SETUP)?;
+        Ok(match self.pictures()? {
+            Some(pictures) => Box::new(geometry_video::Decoder::open(
+                (self, pictures),
+                &setup,
                 stream,
                 reader,
             )?),
-            #[cfg(feature = "ffmpeg")]
-            Codec::Mpeg4 => Box::new(geometry_video::Decoder::open(
-                mpeg4::Pictures,
-                stream,
-                reader,
-            )?),
-            #[cfg(feature = "ffmpeg")]
-            Codec::Hevc => Box::new(geometry_video::Decoder::open(
-                hevc::PICTURES,
-                stream,
-                reader,
-            )?),
-            #[cfg(feature = "ffmpeg")]
-            Codec::Av1 => Box::new(geometry_video::Decoder::open(
-                av1::PICTURES,
-                stream,
-                reader,
-            )?),
-            #[cfg(not(feature = "ffmpeg"))]
-            Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable()),
-            Codec::Tdct => Box::new(tdct::Decoder::open(stream, reader, max_bands)?),
+            None => Box::new(tdct::Decoder::open(&setup, stream, reader, max_bands)?),
         })
     }
 }
 
 #[cfg(not(feature = "ffmpeg"))]
-fn unavailable() -> Error {
-    Error::Codec(
-        "this build has no MPEG-4, HEVC or AV1 codec (built without the `mpeg4` feature, FFmpeg)"
-            .into(),
-    )
+fn unavailable(codec: Codec) -> Error {
+    Error::Codec(format!(
+        "this build has no {} codec (built without the `ffmpeg` feature)",
+        codec.name()
+    ))
 }
 
-/// What the encoder hands a residual coder: the animation, the decoder's reference frame and
-/// partition, and every frame's residual against the quantised predictor.
-pub struct ResidualInput<'a> {
-    /// The animation (vertices in the stream's order): the clip, or one temporal segment of it.
-    pub mesh: &'a AnimatedMesh,
-    /// The clip's first-frame bounding-box diagonal, which steps are fractions of (a segment's
-    /// own first frame is not the clip's).
-    pub diagonal: f64,
-    /// The decoded first frame, which the decoder will have.
-    pub reference: &'a [Point],
-    /// The motion clusters.
-    pub partition: &'a Partition,
-    /// `residuals[f][v]`: frame f's residual of vertex v against the quantised predictor.
-    pub residuals: &'a [Vec<[f32; 3]>],
-    /// The encoding's options.
-    pub options: &'a EncodeOptions,
-    /// Where to report frames done.
-    pub progress: &'a dyn Progress,
-    /// Codecs with an atlas: the atlas of `reference` and `partition` if already built, else
-    /// where to keep it (encodings sharing one partition share it); `None` builds it afresh.
-    pub atlas: Option<&'a crate::geometry_image::lattice::AtlasCache>,
+/// A residual codec and its own options: what an encoding codes its residuals with.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum CodecConfig {
+    /// The temporal DCT (the default: the fewest bits at equal error).
+    Tdct(TdctConfig),
+    /// One JPEG picture per frame.
+    Jpeg(JpegConfig),
+    /// MPEG-4 Part 2 pictures.
+    Mpeg4(Mpeg4Config),
+    /// HEVC pictures at 10 or 12 bits a sample.
+    Hevc(DeepConfig),
+    /// AV1 pictures at 10 or 12 bits a sample.
+    Av1(DeepConfig),
 }
 
-/// The codec's fields of the stream header.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct CodecParams {
-    /// Geometry-image lattice, (0, 0) without images.
-    pub lattice: (u16, u16),
-    /// The picture codec's own quantiser: MPEG-4 qscale, JPEG quality, HEVC QP, AV1 `crf`
-    /// (0 without pictures).
-    pub qscale: u8,
-    /// Frames per group of pictures (1 for intra codecs).
-    pub gop: u32,
-    /// The padding method's name (`none` without images).
-    pub padding: String,
+impl Default for CodecConfig {
+    fn default() -> Self {
+        CodecConfig::Tdct(TdctConfig::default())
+    }
 }
 
-/// What a residual coder produced: its header fields and its parts, in file order.
-pub struct CodedResiduals {
-    /// The codec's fields of the header.
-    pub params: CodecParams,
-    /// The atlas's figures, for codecs with an atlas.
-    pub atlas: Option<atlas::AtlasStats>,
-    /// Parts written before the predictor's (geometry video: the lattice coordinates).
-    pub before_predictor: Vec<Part>,
-    /// Parts written after the predictor's.
-    pub after_predictor: Vec<Part>,
-    /// Seconds per stage of the coder.
-    pub stage_seconds: Vec<(String, f64)>,
+impl From<Codec> for CodecConfig {
+    fn from(codec: Codec) -> Self {
+        codec.default_config()
+    }
 }
 
-/// The encoding half of a residual codec.
-pub trait ResidualEncoder {
-    /// Codes every frame's residuals.
-    fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals>;
-}
-
-/// What every residual decoder may need of the stream, read before it.
-pub struct StreamLayout<'a> {
-    /// The stream header.
-    pub header: &'a Header,
-    /// The shared connectivity.
-    pub triangles: &'a [Triangle],
-}
-
-/// The decoding half of a residual codec: adds the coded residuals to the decoder's prediction.
-pub trait ResidualDecoder<R> {
-    /// Adds frame `f`'s residuals to its prediction, reading no more of the stream than `f` needs.
-    fn add_frame(
-        &mut self,
-        reader: &mut ContainerReader<R>,
-        f: usize,
-        frame: &mut [Point],
-    ) -> Result<()>;
-
-    /// Adds every frame's residuals to the predictions, in order.
-    fn add_all(
-        &mut self,
-        reader: &mut ContainerReader<R>,
-        frames: &mut [Vec<Point>],
-        progress: &dyn Progress,
-    ) -> Result<()>;
-
-    /// The geometry-image side of the stream, for codecs that code images.
-    fn images(&self) -> Option<&geometry_video::ImageLayout> {
-        None
+impl CodecConfig {
+    /// Which codec.
+    pub fn codec(&self) -> Codec {
+        match self {
+            CodecConfig::Tdct(_) => Codec::Tdct,
+            CodecConfig::Jpeg(_) => Codec::Jpeg,
+            CodecConfig::Mpeg4(_) => Codec::Mpeg4,
+            CodecConfig::Hevc(_) => Codec::Hevc,
+            CodecConfig::Av1(_) => Codec::Av1,
+        }
     }
 
-    /// Frame `f`'s decoded picture (x | y | z residual images side by side, samples of the stream's
-    /// depth), for codecs that code images.
-    fn picture(&mut self, _reader: &mut ContainerReader<R>, _f: usize) -> Result<Plane<u16>> {
-        Err(Error::Usage(
-            "a tdct stream has no images: its residuals are temporal-DCT bands".into(),
-        ))
+    /// The lattice and padding options of a picture codec (`None` for codecs without pictures).
+    pub fn pictures_mut(&mut self) -> Option<&mut PictureOptions> {
+        match self {
+            CodecConfig::Tdct(_) => None,
+            CodecConfig::Jpeg(c) => Some(&mut c.pictures),
+            CodecConfig::Mpeg4(c) => Some(&mut c.pictures),
+            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(&mut c.pictures),
+        }
     }
 
-    /// The temporal-DCT bands, for codecs that code them.
-    fn bands(&self) -> Option<&tdct::Bands> {
-        None
+    /// The frames per group of pictures of a video codec (`None` for codecs that code every frame
+    /// alone or no pictures).
+    pub fn gop_mut(&mut self) -> Option<&mut usize> {
+        match self {
+            CodecConfig::Tdct(_) | CodecConfig::Jpeg(_) => None,
+            CodecConfig::Mpeg4(c) => Some(&mut c.gop),
+            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(&mut c.gop),
+        }
+    }
+
+    /// Fails, naming the option, when one is out of range.
+    pub(crate) fn check(&self) -> Result<()> {
+        match self {
+            CodecConfig::Tdct(_) => Ok(()),
+            CodecConfig::Jpeg(c) => c.check(),
+            CodecConfig::Mpeg4(c) => c.check(),
+            CodecConfig::Hevc(c) => pictures::hevc::check(c),
+            CodecConfig::Av1(c) => pictures::av1::check(c),
+        }
+    }
+
+    /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`, by the codec's law.
+    pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
+        match self {
+            CodecConfig::Tdct(c) => c.plan(rate, diagonal),
+            CodecConfig::Jpeg(c) => c.plan(rate, diagonal),
+            CodecConfig::Mpeg4(c) => c.plan(rate, diagonal),
+            CodecConfig::Hevc(c) => pictures::hevc::plan(c, rate, diagonal),
+            CodecConfig::Av1(c) => pictures::av1::plan(c, rate, diagonal),
+        }
+    }
+}
+
+impl RatePlan {
+    /// The residual encoder with this plan's settings.
+    pub(crate) fn encoder(&self) -> Result<Box<dyn ResidualEncoder>> {
+        Ok(match &self.coder {
+            CoderPlan::Tdct => Box::new(tdct::Encoder { step: self.step }),
+            CoderPlan::Pictures(plan) => {
+                let codec = plan.codec.pictures()?.ok_or_else(|| {
+                    Error::Codec(format!("{} codes no pictures", plan.codec.name()))
+                })?;
+                Box::new(geometry_video::Encoder::new(codec, plan.clone(), self.step))
+            }
+        })
     }
 }
 
@@ -303,12 +285,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn stream_ids_round_trip_and_the_old_tdct_format_is_refused() {
+    fn stream_ids_round_trip() {
         for codec in Codec::ALL {
             assert_eq!(Codec::from_id(codec.id()).unwrap(), codec);
+            assert_eq!(codec.default_config().codec(), codec);
         }
-        let old = Codec::from_id(RETIRED_TDCT_ID).unwrap_err().to_string();
-        assert!(old.contains("re-encode"), "{old}");
+        assert!(Codec::from_id(2).is_err());
         assert!(Codec::from_id(6).is_err());
     }
 }

@@ -2,7 +2,7 @@
 //! segmentation, and the quantised predictor with every frame's residual against it. `inspect`
 //! redoes it on a stream's own partition to show the images the encoder coded.
 
-use super::options::{EncodeOptions, PredictorChoice, Segmentation};
+use super::options::{EncodeOptions, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::{self, EncodedFirstFrame, FirstFrameOptions};
 use crate::mesh::{AnimatedMesh, Point};
@@ -94,35 +94,38 @@ pub fn segment(
     Ok((partition, report))
 }
 
-/// The quantised predictor `kind` (affine track, skinning weights) and every frame's residuals
-/// against it, as the decoder will rebuild them: closed loop.
+/// The quantised predictor `kind` (affine track at base step `affine_step`, skinning weights of
+/// `weight_bits`) and every frame's residuals against it, as the decoder will rebuild them:
+/// closed loop.
 pub fn predict(
     mesh: &AnimatedMesh,
     reference: &[Point],
     partition: &Partition,
-    opts: &EncodeOptions,
+    (affine_step, weight_bits): (f64, u8),
     kind: PredictorKind,
 ) -> Result<Prediction> {
-    let track = fit_track(mesh, reference, partition, opts)?;
-    predict_on(mesh, reference, partition, opts, kind, track)
+    let track = fit_track(mesh, reference, partition, affine_step)?;
+    predict_on(mesh, reference, partition, weight_bits, kind, track)
 }
 
-/// The quantised affine track every predictor builds on (skinning blends its maps).
+/// The quantised affine track every predictor builds on (skinning blends its maps), at base step
+/// `affine_step` (a fraction of the first frame's bounding-box diagonal).
 pub fn fit_track(
     mesh: &AnimatedMesh,
     reference: &[Point],
     partition: &Partition,
-    opts: &EncodeOptions,
+    affine_step: f64,
 ) -> Result<AffineTrack> {
-    AffineTrack::fit(mesh.frames(), reference, partition, opts.affine_step())
+    AffineTrack::fit(mesh.frames(), reference, partition, affine_step)
 }
 
-/// [`predict`] on an affine track already fitted to `partition` ([`fit_track`]).
+/// [`predict`] on an affine track already fitted to `partition` ([`fit_track`]), skinning weights
+/// of `weight_bits`.
 pub fn predict_on(
     mesh: &AnimatedMesh,
     reference: &[Point],
     partition: &Partition,
-    opts: &EncodeOptions,
+    weight_bits: u8,
     kind: PredictorKind,
     track: AffineTrack,
 ) -> Result<Prediction> {
@@ -135,7 +138,7 @@ pub fn predict_on(
             mesh.triangles(),
             &track,
             motion::DEFAULT_RIDGE,
-            opts.weight_bits,
+            weight_bits,
         )?),
     };
     let residuals = residuals_of(mesh, reference, partition, &track, weights.as_ref())?;
@@ -162,7 +165,7 @@ pub fn residuals_of(
         .collect()
 }
 
-/// The encoder's analysis of `original` redone with a stream's options and partition.
+/// The encoder's analysis of `original` redone with a stream's choices and partition.
 pub struct Redone {
     /// The decoded first frame.
     pub reference: Vec<Point>,
@@ -172,15 +175,34 @@ pub struct Redone {
     pub prediction: Prediction,
 }
 
-/// Redoes the encoder's analysis of `original` with a stream's options and partition: the
-/// residuals the stream's codec was given, in the stream's vertex order.
-pub fn redo(
-    original: &AnimatedMesh,
-    opts: &EncodeOptions,
-    partition: &Partition,
-) -> Result<Redone> {
-    let (ff, permuted) = first_frame(original, opts)?;
+/// What a stream records of the choices its encoder made, which redoing its analysis needs.
+pub struct StreamChoices<'a> {
+    /// The first frame's precision and vertex order.
+    pub first_frame: FirstFrameOptions,
+    /// The motion clusters.
+    pub partition: &'a Partition,
+    /// The predictor.
+    pub predictor: PredictorKind,
+    /// The affine track's base step (a fraction of the bounding-box diagonal).
+    pub affine_step: f64,
+    /// Bits per skinning weight.
+    pub weight_bits: u8,
+}
+
+/// Redoes the encoder's analysis of `original` with a stream's recorded choices: the residuals
+/// the stream's codec was given, in the stream's vertex order.
+pub fn redo(original: &AnimatedMesh, choices: &StreamChoices) -> Result<Redone> {
+    let ff = first_frame::encode(
+        original.frame(0),
+        original.triangles(),
+        &choices.first_frame,
+    )?;
+    let permuted = match &ff.permutation {
+        Some(perm) => Some(original.permuted(perm)?),
+        None => None,
+    };
     let mesh = permuted.as_ref().unwrap_or(original);
+    let partition = choices.partition;
     if partition.labels().len() != mesh.vertex_count() {
         return Err(Error::Usage(format!(
             "the original has {} vertices; the stream's partition {}",
@@ -188,12 +210,10 @@ pub fn redo(
             partition.labels().len()
         )));
     }
-    let PredictorChoice::Fixed(kind) = opts.predictor else {
-        return Err(Error::Usage(
-            "redoing an encoding needs the stream's predictor, not an automatic choice".into(),
-        ));
-    };
-    let prediction = predict(mesh, &ff.decoded_positions, partition, opts, kind)?;
+    let reference = &ff.decoded_positions;
+    let track = fit_track(mesh, reference, partition, choices.affine_step)?;
+    let (bits, kind) = (choices.weight_bits, choices.predictor);
+    let prediction = predict_on(mesh, reference, partition, bits, kind, track)?;
     Ok(Redone {
         triangles: mesh.triangles().to_vec(),
         reference: ff.decoded_positions,

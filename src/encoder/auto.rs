@@ -17,9 +17,9 @@
 //! estimate 7 % below skinning on 70 decimation clusters); coded whole, it had 2.5× the error
 //! (vertex RMSE 4.99e-3 against 2.02e-3) and 10 % more bytes.
 
-use super::{analysis, assemble, code, distortion, header, Analysed, Encoded, Stopwatch};
-use crate::codec::{Codec, ResidualInput};
-use crate::encoder::{EncodeOptions, MotionModel, Segmentation};
+use super::{analysis, assemble, code, distortion, header, Analysed, Encoded, Settings, Stopwatch};
+use crate::codec::ResidualInput;
+use crate::encoder::{MotionModel, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::AtlasCache;
@@ -93,12 +93,12 @@ pub(super) fn choose(
     mesh: &AnimatedMesh,
     ff: &EncodedFirstFrame,
     leading: Vec<Part>,
-    opts: &EncodeOptions,
+    settings: Settings,
     models: &[MotionModel],
     progress: &dyn Progress,
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
-    let sample = Sample::of(mesh, opts)?;
+    let sample = Sample::of(mesh, settings)?;
     let frames = mesh.frame_count();
     let trial_frames = sample.as_ref().map_or(frames, |s| s.frames.len());
     let final_frames = if sample.is_some() { frames } else { 0 };
@@ -107,7 +107,7 @@ pub(super) fn choose(
         mesh,
         ff,
         leading: &leading,
-        opts,
+        settings,
         sample: sample.as_ref(),
     };
     let reference = &ff.decoded_positions;
@@ -127,7 +127,7 @@ pub(super) fn choose(
         };
         progress.stage(&stage);
         let (partition, segmented) = analysis::segment(mesh, segmentation, k)?;
-        let track = analysis::fit_track(mesh, reference, &partition, opts)?;
+        let track = analysis::fit_track(mesh, reference, &partition, settings.plan.affine_step)?;
         clock.lap(&stage);
         let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);
         for &model in models.iter().filter(same) {
@@ -138,7 +138,8 @@ pub(super) fn choose(
             };
             progress.stage("motion");
             let (kind, track) = (model.predictor, track.clone());
-            let prediction = analysis::predict_on(mesh, reference, &partition, opts, kind, track)?;
+            let bits = settings.opts.weight_bits;
+            let prediction = analysis::predict_on(mesh, reference, &partition, bits, kind, track)?;
             let analysed = Analysed {
                 model,
                 partition: &partition,
@@ -189,7 +190,7 @@ struct Shared<'a> {
     mesh: &'a AnimatedMesh,
     ff: &'a EncodedFirstFrame,
     leading: &'a [Part],
-    opts: &'a EncodeOptions,
+    settings: Settings<'a>,
     sample: Option<&'a Sample>,
 }
 
@@ -200,7 +201,9 @@ fn trial(
     analysed: &Analysed,
     progress: &dyn Progress,
 ) -> Result<(u64, Option<Encoded>, Option<f64>)> {
-    let Shared { mesh, ff, opts, .. } = *shared;
+    let Shared {
+        mesh, ff, settings, ..
+    } = *shared;
     match shared.sample {
         None => {
             let leading = shared.leading.to_vec();
@@ -208,12 +211,13 @@ fn trial(
                 mesh,
                 ff,
                 leading,
-                opts,
+                settings,
                 analysed,
                 progress,
                 Stopwatch::new(),
             )?;
-            let error = match opts.codec.has_images() {
+            // A picture codec's step may widen where residuals outgrow the samples: errors differ.
+            let error = match settings.opts.codec.codec().has_images() {
                 true => Some(distortion::vertex_rmse(mesh, &encoded)?),
                 false => None,
             };
@@ -221,7 +225,7 @@ fn trial(
         }
         Some(sample) => {
             let trial = (ff.decoded_positions.as_slice(), shared.leading);
-            let (bytes, error) = sample.estimate(mesh, trial, opts, analysed, progress)?;
+            let (bytes, error) = sample.estimate(mesh, trial, settings, analysed, progress)?;
             Ok((bytes, None, Some(error)))
         }
     }
@@ -251,9 +255,11 @@ fn keep(
                 prediction: &prediction,
                 atlas: Some(atlas),
             };
-            let Shared { mesh, ff, opts, .. } = *shared;
+            let Shared {
+                mesh, ff, settings, ..
+            } = *shared;
             let leading = shared.leading.to_vec();
-            code(mesh, ff, leading, opts, &analysed, progress, clock)
+            code(mesh, ff, leading, settings, &analysed, progress, clock)
         }
     }
 }
@@ -325,16 +331,11 @@ struct Sample {
 }
 
 impl Sample {
-    /// `None` when every candidate is coded whole: tdct (cheap), MPEG-4 (its P-frames predict
-    /// from the frame before, so spread frames misrank the candidates: Fox q50 kept a stream 20 %
-    /// larger than the smallest), HEVC and AV1 (P-frames too; their sampled trials were not measured), or a
-    /// short animation.
-    fn of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Option<Self>> {
+    /// `None` when every candidate is coded whole: a codec without sampled trials
+    /// ([`crate::codec::Codec`]'s `sampled_trials`), or a short animation.
+    fn of(mesh: &AnimatedMesh, settings: Settings) -> Result<Option<Self>> {
         let count = mesh.frame_count();
-        let whole = matches!(
-            opts.codec,
-            Codec::Tdct | Codec::Mpeg4 | Codec::Hevc | Codec::Av1
-        );
+        let whole = !settings.opts.codec.codec().sampled_trials();
         if whole || count <= 2 * TRIAL_FRAMES {
             return Ok(None);
         }
@@ -355,7 +356,7 @@ impl Sample {
         &self,
         mesh: &AnimatedMesh,
         (reference, leading): (&[Point], &[Part]),
-        opts: &EncodeOptions,
+        settings: Settings,
         analysed: &Analysed,
         progress: &dyn Progress,
     ) -> Result<(u64, f64)> {
@@ -369,23 +370,18 @@ impl Sample {
                 .map(|&f| prediction.residuals[f].clone())
                 .collect(),
         };
-        let coded = opts.codec.encoder()?.encode(&ResidualInput {
+        let coded = settings.plan.encoder()?.encode(&ResidualInput {
             mesh: &self.mesh,
-            diagonal: self.mesh.bbox_diagonal(),
             reference,
             partition: analysed.partition,
             residuals: &sampled.residuals,
-            options: opts,
             progress,
             atlas: analysed.atlas,
         })?;
         let partition = analysed.partition;
-        let header_of = |m: &AnimatedMesh| {
-            let atlas = coded.atlas.as_ref();
-            header(m, opts, analysed.model, partition, &coded.params, atlas)
-        };
+        let header_of = |m: &AnimatedMesh| header(m, settings, analysed.model, partition);
         let per_frame: usize = coded.after_predictor.iter().map(|p| p.bytes.len()).sum();
-        let parts = (coded.before_predictor, coded.after_predictor);
+        let parts = coded.into_parts();
         let sample_stream = assemble(
             &header_of(&self.mesh),
             leading.to_vec(),

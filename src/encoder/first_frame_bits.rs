@@ -10,7 +10,7 @@
 //! the other precisions are coded with it fixed: the model follows the motion, the precision the
 //! first frame's shape.
 
-use super::{encode_once, EncodeOptions, Encoded, PredictorChoice};
+use super::{encode_once, EncodeOptions, Encoded, PredictorChoice, Settings};
 use crate::error::Result;
 use crate::mesh::AnimatedMesh;
 use crate::progress::Progress;
@@ -32,9 +32,10 @@ pub struct FirstFrameTrial {
 /// trials.
 pub(super) fn choose(
     mesh: &AnimatedMesh,
-    opts: &EncodeOptions,
+    settings: Settings,
     progress: &dyn Progress,
 ) -> Result<Encoded> {
+    let opts = settings.opts;
     let [default, others @ ..] = FIRST_FRAME_BITS_TRIED;
     let frames = mesh.frame_count() as u64;
     let progress = Ahead {
@@ -47,7 +48,9 @@ pub(super) fn choose(
         first_frame_bits: Some(bits),
         ..base.clone()
     };
-    let mut best = encode_once(mesh, &at(default, opts), &progress, None)?;
+    let first = at(default, opts);
+    let plan = settings.plan;
+    let mut best = encode_once(mesh, Settings { opts: &first, plan }, &progress, None)?;
     let model = EncodeOptions {
         predictor: PredictorChoice::Fixed(best.model.predictor),
         segmentation: best.model.segmentation.into(),
@@ -63,7 +66,9 @@ pub(super) fn choose(
     }];
     for bits in others {
         progress.stage(&format!("first frame at {bits} bits"));
-        let encoded = encode_once(mesh, &at(bits, &model), &progress, known.clone())?;
+        let opts = at(bits, &model);
+        let settings = Settings { opts: &opts, plan };
+        let encoded = encode_once(mesh, settings, &progress, known.clone())?;
         trials.push(FirstFrameTrial {
             bits,
             bytes: encoded.report.bytes,

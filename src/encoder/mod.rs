@@ -14,13 +14,12 @@ pub use analysis::{Prediction, SegmentationReport};
 pub use auto::{Candidate, ChoiceReport};
 pub use first_frame_bits::FirstFrameTrial;
 pub use options::{
-    default_affine_precision, kmeans_ladder, EncodeOptions, MotionModel, PredictorChoice,
-    Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS, DEFAULT_QUALITY,
-    DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
+    kmeans_ladder, EncodeOptions, MotionModel, PredictorChoice, Segmentation, SegmentationChoice,
+    DEFAULT_FIRST_FRAME_BITS, DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
 pub use segments::{encode_source, SegmentedEncoder};
 
-use crate::codec::{CodecParams, ResidualInput};
+use crate::codec::{Codec, RatePlan, ResidualInput};
 use crate::error::Result;
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::AtlasCache;
@@ -38,6 +37,8 @@ use std::time::Instant;
 pub struct EncodeReport {
     /// The stream header.
     pub header: Header,
+    /// The residual codec.
+    pub codec: Codec,
     /// Bytes per part, in file order.
     pub parts: Vec<(String, u64)>,
     /// Total file bytes.
@@ -99,7 +100,8 @@ pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Encoded> {
 
 /// Encodes an animation, telling `progress` each stage and each frame coded. With an automatic
 /// predictor or segmentation, every candidate is tried ([`auto`]) and the smallest stream kept;
-/// so are tdct's first-frame precisions when `first_frame_bits` is open ([`first_frame_bits`]).
+/// so are the first-frame precisions when `first_frame_bits` is open and the codec's trials are
+/// cheap ([`first_frame_bits`]).
 pub fn encode_with_progress(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
@@ -109,20 +111,34 @@ pub fn encode_with_progress(
     if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
         return segments::encode(mesh, opts, length, progress);
     }
-    match (opts.first_frame_bits, opts.codec) {
-        (None, crate::codec::Codec::Tdct) => first_frame_bits::choose(mesh, opts, progress),
-        _ => encode_once(mesh, opts, progress, None),
+    let plan = opts.plan(mesh.bbox_diagonal())?;
+    let settings = Settings { opts, plan: &plan };
+    let trials = opts.codec.codec().cheap_exact_trials();
+    match opts.first_frame_bits {
+        None if trials => first_frame_bits::choose(mesh, settings, progress),
+        _ => encode_once(mesh, settings, progress, None),
     }
+}
+
+/// What every stage of one encoding reads: the caller's options and the rate plan resolved from
+/// them once.
+#[derive(Clone, Copy)]
+pub(crate) struct Settings<'a> {
+    /// The caller's options.
+    pub opts: &'a EncodeOptions,
+    /// Every step and codec setting.
+    pub plan: &'a RatePlan,
 }
 
 /// Encodes an animation at one first-frame precision (the default if `opts` leaves it open); a
 /// single motion model's segmentation is `known` when a trial before found it.
 fn encode_once(
     mesh: &AnimatedMesh,
-    opts: &EncodeOptions,
+    settings: Settings,
     progress: &dyn Progress,
     known: Option<(Partition, SegmentationReport)>,
 ) -> Result<Encoded> {
+    let opts = settings.opts;
     let mut clock = Stopwatch::new();
     progress.stage("first frame");
     let (ff, permuted) = analysis::first_frame(mesh, opts)?;
@@ -131,7 +147,7 @@ fn encode_once(
     clock.lap("first frame");
     let models = opts.motion_models();
     let [model] = models[..] else {
-        return auto::choose(mesh, &ff, leading, opts, &models, progress, clock);
+        return auto::choose(mesh, &ff, leading, settings, &models, progress, clock);
     };
     progress.total(mesh.frame_count() as u64);
     progress.stage("segmentation");
@@ -142,7 +158,8 @@ fn encode_once(
     clock.lap("segmentation");
     progress.stage("motion");
     let reference = &ff.decoded_positions;
-    let prediction = analysis::predict(mesh, reference, &partition, opts, model.predictor)?;
+    let steps = (settings.plan.affine_step, opts.weight_bits);
+    let prediction = analysis::predict(mesh, reference, &partition, steps, model.predictor)?;
     clock.lap("motion");
     let analysed = Analysed {
         model,
@@ -151,7 +168,7 @@ fn encode_once(
         prediction: &prediction,
         atlas: None,
     };
-    code(mesh, &ff, leading, opts, &analysed, progress, clock)
+    code(mesh, &ff, leading, settings, &analysed, progress, clock)
 }
 
 /// The first frame's part and, for inputs with texture coordinates, the attributes'.
@@ -184,28 +201,26 @@ fn code(
     mesh: &AnimatedMesh,
     ff: &EncodedFirstFrame,
     leading: Vec<Part>,
-    opts: &EncodeOptions,
+    settings: Settings,
     analysed: &Analysed,
     progress: &dyn Progress,
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
     let (partition, prediction) = (analysed.partition, analysed.prediction);
-    let coded = opts.codec.encoder()?.encode(&ResidualInput {
+    let coded = settings.plan.encoder()?.encode(&ResidualInput {
         mesh,
-        diagonal: mesh.bbox_diagonal(),
         reference: &ff.decoded_positions,
         partition,
         residuals: &prediction.residuals,
-        options: opts,
         progress,
         atlas: analysed.atlas,
     })?;
-    clock.stages.extend(coded.stage_seconds);
+    clock.stages.extend(coded.stage_seconds.iter().cloned());
     clock.restart();
-    let atlas = coded.atlas;
+    let atlas = coded.atlas.clone();
     let model = analysed.model;
-    let header = header(mesh, opts, model, partition, &coded.params, atlas.as_ref());
-    let parts = (coded.before_predictor, coded.after_predictor);
+    let header = header(mesh, settings, model, partition);
+    let parts = coded.into_parts();
     let container = assemble(&header, leading, mesh, partition, prediction, parts)?;
     clock.lap("side information");
     let report = EncodeReport {
@@ -213,6 +228,7 @@ fn code(
         bytes: container.len(),
         bpvf: container.len() as f64 * 8.0 / (mesh.vertex_count() * mesh.frame_count()) as f64,
         header,
+        codec: settings.opts.codec.codec(),
         charts: atlas.as_ref().map_or(0, |s| s.charts),
         packing_efficiency: atlas.as_ref().map_or(0.0, |s| s.packing_efficiency),
         moved_vertices: atlas.as_ref().map_or(0, |s| s.moved_vertices),
@@ -260,41 +276,33 @@ impl Stopwatch {
 /// The stream header of an encoding.
 fn header(
     mesh: &AnimatedMesh,
-    opts: &EncodeOptions,
+    Settings { opts, plan }: Settings,
     model: MotionModel,
     partition: &Partition,
-    params: &CodecParams,
-    atlas: Option<&atlas::AtlasStats>,
 ) -> Header {
     Header {
         vertices: mesh.vertex_count() as u32,
         frames: mesh.frame_count() as u32,
         triangles: mesh.triangles().len() as u32,
         clusters: partition.clusters() as u32,
-        lattice_width: params.lattice.0,
-        lattice_height: params.lattice.1,
-        codec: opts.codec,
-        quality: opts.quality,
-        qscale: params.qscale,
-        gop: params.gop,
-        affine_precision: opts.affine_precision_code(),
+        codec: opts.codec.codec().id(),
+        quality: plan.quality,
+        affine_precision: plan.affine_precision,
         first_frame_bits: opts.first_frame_bits_or_default(),
-        padding: params.padding.clone(),
         // Decimation asks for no K: the header then records the K it found.
         requested_clusters: match model.segmentation {
             Segmentation::KMeans => model.clusters as u32,
             Segmentation::Decimation { .. } => partition.clusters() as u32,
         },
         reorder: opts.reorder,
-        charts: atlas.map_or(0, |s| s.charts as u32),
-        chart_pixels: atlas.map_or(0, |s| s.chart_pixels as u32),
         frame_rate: mesh.frame_rate().map_or(0.0, |r| r as f32),
         predictor: model.predictor,
     }
 }
 
-/// The container in file order: header, first frame (and attributes), partition, the codec's leading parts, the
-/// predictor (affine track, skinning weights), the codec's other parts.
+/// The container in file order: header, first frame (and attributes), partition, the codec's
+/// set-up and whole-stream parts, the predictor (affine track, skinning weights), the codec's
+/// segment parts.
 fn assemble(
     header: &Header,
     leading: Vec<Part>,

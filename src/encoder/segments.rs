@@ -16,7 +16,7 @@
 //! [`SegmentedEncoder::finish`]), e.g. from a reader that never holds the whole clip.
 
 use super::{EncodeOptions, EncodeReport, Encoded, MotionModel, PredictorChoice};
-use crate::codec::{CodecParams, ResidualInput};
+use crate::codec::{RatePlan, ResidualInput};
 use crate::decoder::Decoder;
 use crate::error::{Error, Result};
 use crate::geometry_image::lattice::AtlasCache;
@@ -44,8 +44,8 @@ pub struct SegmentedEncoder {
     weights: Option<SkinningWeights>,
     /// First-frame coder's vertex order (stream index → input index), when it reordered.
     permutation: Option<Vec<u32>>,
-    /// The first frame's bounding-box diagonal, which the quality's steps are fractions of.
-    diagonal: f64,
+    /// Every step and codec setting, resolved on the first frame (the whole clip's).
+    plan: RatePlan,
     atlas: AtlasCache,
     header: Header,
     shared: Vec<Part>,
@@ -83,6 +83,7 @@ impl SegmentedEncoder {
         let bytes = encoded.to_bytes();
         let decoder = Decoder::new(&bytes)?;
         let header = decoder.header().clone();
+        let plan = opts.plan(analysis.bbox_diagonal())?;
         // Every segment repeats the analysis clip's choices instead of making its own.
         let opts = EncodeOptions {
             predictor: PredictorChoice::Fixed(header.predictor),
@@ -105,7 +106,7 @@ impl SegmentedEncoder {
             partition: decoder.partition().clone(),
             weights: decoder.weights().cloned(),
             permutation: encoded.report.permutation.clone(),
-            diagonal: analysis.bbox_diagonal(),
+            plan,
             atlas: AtlasCache::default(),
             header,
             shared,
@@ -219,7 +220,7 @@ impl SegmentedEncoder {
             clip.frames(),
             &self.reference,
             &self.partition,
-            self.opts.affine_step(),
+            self.plan.affine_step,
         )?;
         let residuals = super::analysis::residuals_of(
             clip,
@@ -228,47 +229,38 @@ impl SegmentedEncoder {
             &track,
             self.weights.as_ref(),
         )?;
-        let coded = self.opts.codec.encoder()?.encode(&ResidualInput {
+        let coded = self.plan.encoder()?.encode(&ResidualInput {
             mesh: clip,
-            diagonal: self.diagonal,
             reference: &self.reference,
             partition: &self.partition,
             residuals: &residuals,
-            options: &self.opts,
             progress,
             atlas: Some(&self.atlas),
         })?;
-        self.check_shared(&coded.params, &coded.before_predictor)?;
+        let (before, after) = coded.into_parts();
+        self.check_shared(&before)?;
         let mut parts = vec![
             SegmentStart::part(range)?,
             Part::whole(Tag::AFFINE, side_info::encode_affine(&track)?),
         ];
-        parts.extend(coded.after_predictor);
+        parts.extend(after);
         Ok(parts)
     }
 
-    /// A segment's codec must have made the analysis clip's lattice and settings: the header and
-    /// the lattice part are the whole stream's.
-    fn check_shared(&self, params: &CodecParams, before: &[Part]) -> Result<()> {
-        let h = &self.header;
-        let shared_params = CodecParams {
-            lattice: (h.lattice_width, h.lattice_height),
-            qscale: h.qscale,
-            gop: h.gop,
-            padding: h.padding.clone(),
-        };
-        let same_parts = before.iter().all(|p| {
+    /// A segment's codec must have made the analysis clip's set-up and whole-stream parts (its
+    /// lattice and settings): those are the whole stream's.
+    fn check_shared(&self, before: &[Part]) -> Result<()> {
+        let same = before.iter().all(|p| {
             self.shared
                 .iter()
                 .any(|s| s.tag == p.tag && s.bytes == p.bytes)
         });
-        if *params != shared_params || !same_parts {
+        if !same {
             return Err(Error::Codec(format!(
-                "segment from frame {}: the {} coder did not reproduce the analysis clip's \
-                 lattice and settings ({params:?} against {:?})",
+                "segment from frame {}: the {} coder did not reproduce the analysis clip's set-up \
+                 and lattice",
                 self.frames,
-                self.opts.codec.name(),
-                shared_params
+                self.opts.codec.codec().name(),
             )));
         }
         Ok(())

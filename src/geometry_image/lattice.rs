@@ -6,9 +6,10 @@ use crate::mesh::Point;
 use crate::motion::Partition;
 
 /// The size of the geometry-image lattice.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Lattice {
     /// Sized from the vertex count (see [`auto_side`]), grown until the charts fit.
+    #[default]
     Auto,
     /// Exactly this width and height.
     Fixed(u16, u16),
@@ -36,12 +37,16 @@ pub fn auto_side(vertices: usize) -> u16 {
 }
 
 fn round_up_16(x: f64) -> u16 {
-    ((x / 16.0).ceil() * 16.0).min(4096.0) as u16
+    ((x / 16.0).ceil() * 16.0).min(f64::from(MAX_LATTICE_SIDE)) as u16
 }
+
+/// Largest lattice side the encoder makes (and a decoder accepts): a forged stream cannot make the
+/// picture decoders allocate pictures of 3 × 65535 × 65535 samples.
+pub const MAX_LATTICE_SIDE: u16 = 4096;
 
 /// Fails unless `w`×`h` is a lattice the stream can carry.
 pub fn check(w: u16, h: u16) -> Result<()> {
-    let max = crate::stream::header::MAX_LATTICE_SIDE;
+    let max = MAX_LATTICE_SIDE;
     if w == 0 || h == 0 || w % 16 != 0 || h % 16 != 0 || w > max || h > max {
         return Err(Error::option(
             "lattice",
@@ -111,7 +116,7 @@ pub fn build_atlas(
             }
             Err(e) => return Err(e.into()),
         };
-        if side >= 4096 {
+        if side >= MAX_LATTICE_SIDE {
             return Err(Error::Mesh(format!(
                 "atlas: the charts do not fit even a {side}x{side} lattice"
             )));

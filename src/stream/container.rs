@@ -17,15 +17,10 @@ use std::path::Path;
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
-/// The container version this build writes and reads. 2: one error law for every codec (issue 15);
-/// 3: the temporal-DCT coder's magnitude and sign contexts (issue 18), which a version-2 reader
-/// would decode to a wrong animation without noticing.
-pub const VERSION: u16 = 3;
-
-/// The version of a stream cut into temporal segments ([`Tag::SEGMENT`] parts, issue 20). Only
-/// such streams carry it, so a clip of one segment keeps version 3's bytes, and a reader that
-/// predates segments says "update" instead of misreading them.
-pub const VERSION_SEGMENTED: u16 = 4;
+/// The container version this build writes and reads: 5, the header holds what every codec shares
+/// and each codec its own fields in its set-up part (docs/history.md lists the versions before).
+/// A reader refuses any other version, so an older reader says "update" instead of misreading.
+pub const VERSION: u16 = 5;
 
 /// Bytes of a part header: tag, checksum kind, length, CRC.
 pub const PART_HEADER_LEN: usize = 17;
@@ -42,7 +37,7 @@ pub(super) const MAX_PARTS: u32 = 1 << 20;
 pub struct Tag(pub [u8; 4]);
 
 impl Tag {
-    /// Stream parameters (V, F, K, lattice, codec, quantisation).
+    /// Stream parameters (V, F, K, codec, quality, predictor).
     pub const HEADER: Tag = Tag(*b"HEAD");
     /// First frame: connectivity and geometry.
     pub const FIRST_FRAME: Tag = Tag(*b"MESH");
@@ -58,7 +53,8 @@ impl Tag {
     pub const WEIGHTS: Tag = Tag(*b"SKIN");
     /// Residual quantisation ranges.
     pub const RANGES: Tag = Tag(*b"RANG");
-    /// Codec set-up shared by all frames (e.g. JPEG tables).
+    /// The residual codec's own set-up, shared by every segment and frame: its version and
+    /// settings (e.g. the lattice, quantiser, GOP and JPEG tables of a picture codec).
     pub const CODEC_SETUP: Tag = Tag(*b"CSET");
     /// Offset, length, checksum and key flag of each frame chunk.
     pub const FRAME_INDEX: Tag = Tag(*b"INDX");
@@ -94,11 +90,12 @@ impl Tag {
     }
 
     /// Whether a part belongs to one temporal segment (its frames' predictor and residuals) rather
-    /// than to the whole stream (header, first frame, partition, atlas, skinning weights).
+    /// than to the whole stream (header, first frame, partition, codec set-up, atlas, skinning
+    /// weights).
     pub fn per_segment(self) -> bool {
         matches!(
             &self.0,
-            b"AFFN" | b"RANG" | b"CSET" | b"INDX" | b"FRMS" | b"TDIX" | b"TDCT"
+            b"AFFN" | b"RANG" | b"INDX" | b"FRMS" | b"TDIX" | b"TDCT"
         )
     }
 }
@@ -218,14 +215,9 @@ impl ContainerWriter {
 
     /// The whole file as bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let segmented = self.parts.iter().any(|(tag, ..)| *tag == Tag::SEGMENT);
         let mut w = ByteWriter::new();
         w.raw(&MAGIC)
-            .u16(if segmented {
-                VERSION_SEGMENTED
-            } else {
-                VERSION
-            })
+            .u16(VERSION)
             .u16(0)
             .u32(self.parts.len() as u32);
         for (tag, payload, checksum) in &self.parts {
@@ -296,7 +288,7 @@ impl<R: Read + Seek> ContainerReader<R> {
     pub fn new(mut source: R) -> Result<Self> {
         let file_len = source.seek(SeekFrom::End(0)).map_err(table_io)?;
         source.seek(SeekFrom::Start(0)).map_err(table_io)?;
-        let (version, count) = read_file_header(&mut source)?;
+        let count = read_file_header(&mut source)?;
         let fit = file_len.saturating_sub(FILE_HEADER_LEN as u64) / PART_HEADER_LEN as u64;
         let mut parts = Vec::with_capacity((count as u64).min(fit) as usize);
         let mut pos = 16u64;
@@ -315,7 +307,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             pos = part.end;
             source.seek(SeekFrom::Start(pos)).map_err(table_io)?;
         }
-        check_scopes(&parts, version)?;
+        check_scopes(&parts)?;
         if pos != file_len {
             return Err(Error::Stream(format!(
                 "{} bytes after the last part (file damaged or concatenated?)",

@@ -2,7 +2,7 @@
 //! (the whole stream's, or a temporal segment's). [`super::container::ContainerReader`] does this
 //! at open, before any payload is read.
 
-use super::container::{Checksum, PartEntry, Tag, MAGIC, MAX_PARTS, VERSION, VERSION_SEGMENTED};
+use super::container::{Checksum, PartEntry, Tag, MAGIC, MAX_PARTS, VERSION};
 use crate::error::{Error, Result};
 use crate::stream::bytes::ByteReader;
 use std::io::Read;
@@ -12,21 +12,11 @@ pub(super) fn table_io(e: std::io::Error) -> Error {
     Error::Stream(format!("reading the part table: {e}"))
 }
 
-/// Checks where each part lies: a version-3 stream has no segments; a segmented one has its
-/// segments' parts after their start markers and the whole stream's before the first; no part
-/// appears twice in one place (a damaged tag could otherwise shadow another part).
-pub(super) fn check_scopes(parts: &[PartEntry], version: u16) -> Result<()> {
+/// Checks where each part lies: a segmented stream has its segments' parts after their start
+/// markers and the whole stream's before the first; no part appears twice in one place (a damaged
+/// tag could otherwise shadow another part).
+pub(super) fn check_scopes(parts: &[PartEntry]) -> Result<()> {
     let segmented = parts.iter().any(|p| p.tag == Tag::SEGMENT);
-    if segmented != (version == VERSION_SEGMENTED) {
-        return Err(Error::Stream(format!(
-            "stream version {version} {} segments (damaged file?)",
-            if segmented {
-                "cannot hold"
-            } else {
-                "must hold"
-            }
-        )));
-    }
     let mut seen = rustc_hash::FxHashSet::default();
     for p in parts {
         if segmented && p.tag != Tag::SEGMENT && p.tag.per_segment() != p.segment.is_some() {
@@ -52,9 +42,8 @@ pub(super) fn check_scopes(parts: &[PartEntry], version: u16) -> Result<()> {
     Ok(())
 }
 
-/// Reads and checks the 16-byte file header (magic, version); returns the version and the part
-/// count.
-pub(super) fn read_file_header<R: Read>(source: &mut R) -> Result<(u16, u32)> {
+/// Reads and checks the 16-byte file header (magic, version); returns the part count.
+pub(super) fn read_file_header<R: Read>(source: &mut R) -> Result<u32> {
     let mut head = [0u8; 16];
     read_exact_or(source, &mut head, "the file header")?;
     let mut r = ByteReader::new(&head, "file header");
@@ -70,10 +59,10 @@ pub(super) fn read_file_header<R: Read>(source: &mut R) -> Result<(u16, u32)> {
              reads stream version {VERSION} only: re-encode the animation from its source"
         )));
     }
-    if version > VERSION_SEGMENTED {
+    if version > VERSION {
         return Err(Error::Stream(format!(
-            "stream version {version} is newer than this build reads (versions {VERSION} and \
-             {VERSION_SEGMENTED}): update mcgv-video"
+            "stream version {version} is newer than this build reads (version {VERSION}): update \
+             mcgv-video"
         )));
     }
     let _reserved = r.u16()?;
@@ -83,7 +72,7 @@ pub(super) fn read_file_header<R: Read>(source: &mut R) -> Result<(u16, u32)> {
             "header claims {count} parts (at most {MAX_PARTS})"
         )));
     }
-    Ok((version, count))
+    Ok(count)
 }
 
 /// One part header as read by [`read_part_entry`].

@@ -5,12 +5,12 @@
 //! Each test binary uses only part of it, so unused items are not warnings here.
 #![allow(dead_code)]
 
-use mcgv_video::codec::Codec;
+use mcgv_video::codec::{Codec, CodecConfig};
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, Point, ReadOptions, Triangle};
 use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
-use mcgv_video::Lattice;
+use mcgv_video::{Lattice, PaddingMethod};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -60,6 +60,24 @@ pub fn decode_all(bytes: Vec<u8>) -> mcgv_video::Result<AnimatedMesh> {
     decoder(bytes)?.decode_all()
 }
 
+/// `codec`'s default options with, where the codec has them, this lattice, padding and GOP.
+pub fn config(
+    codec: Codec,
+    lattice: Option<Lattice>,
+    padding: Option<PaddingMethod>,
+    gop: Option<usize>,
+) -> CodecConfig {
+    let mut config = CodecConfig::from(codec);
+    if let Some(pictures) = config.pictures_mut() {
+        pictures.lattice = lattice.unwrap_or(pictures.lattice);
+        pictures.padding = padding.or(pictures.padding);
+    }
+    if let (Some(g), Some(gop)) = (config.gop_mut(), gop) {
+        *g = gop;
+    }
+    config
+}
+
 /// A real two-frame stream of a square (two triangles, one cluster), small enough to forge quickly
 /// (a 16 × 16 lattice for the image codecs).
 pub fn tiny_stream(codec: Codec) -> Vec<u8> {
@@ -73,19 +91,17 @@ pub fn tiny_stream(codec: Codec) -> Vec<u8> {
     };
     let mesh = AnimatedMesh::new(vec![[0, 1, 2], [0, 2, 3]], vec![square(0.0), square(0.1)])
         .expect("a valid animation");
-    let opts = EncodeOptions {
+    // Only the image codecs have a lattice to pad.
+    let config = config(
         codec,
+        Some(Lattice::Fixed(16, 16)),
+        Some(PaddingMethod::Cg),
+        None,
+    );
+    let opts = EncodeOptions {
+        codec: config,
         clusters: 1,
         ..EncodeOptions::default()
-    };
-    // Only the image codecs have a lattice to pad.
-    let opts = match codec.has_images() {
-        true => EncodeOptions {
-            lattice: Lattice::Fixed(16, 16),
-            padding: Some(padding::Method::Cg),
-            ..opts
-        },
-        false => opts,
     };
     encode(&mesh, &opts).expect("encodes").to_bytes()
 }

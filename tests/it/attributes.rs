@@ -91,7 +91,7 @@ fn a_stream_keeps_uvs_and_material_groups_with_and_without_reordering() {
     ] {
         let mesh = read_media(name);
         let options = EncodeOptions {
-            codec: Codec::Tdct,
+            codec: Codec::Tdct.into(),
             reorder,
             ..EncodeOptions::default()
         };
@@ -118,7 +118,7 @@ fn inputs_without_attributes_get_no_part_and_a_corrupt_part_is_an_error() {
     let (triangles, frames) = mesh.clone().into_parts();
     let bare = AnimatedMesh::new(triangles, frames).unwrap();
     let options = EncodeOptions {
-        codec: Codec::Tdct,
+        codec: Codec::Tdct.into(),
         ..EncodeOptions::default()
     };
     let bytes = encode_bytes(&bare, &options);

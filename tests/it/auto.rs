@@ -2,7 +2,7 @@
 //! the quality's step and keeps the smallest stream (tdct) or the fewest bits at equal error
 //! (picture codecs, whose errors at one step differ), saying so in its report.
 
-use crate::common::{animate, decode_all, decoder, tube, vertex_rmse, Counter};
+use crate::common::{animate, config, decode_all, decoder, tube, vertex_rmse, Counter};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::distortion;
 use mcgv_video::encoder::{
@@ -11,6 +11,7 @@ use mcgv_video::encoder::{
 };
 use mcgv_video::mesh::{AnimatedMesh, Point};
 use mcgv_video::motion::PredictorKind;
+use mcgv_video::PaddingMethod;
 use std::sync::atomic::Ordering;
 
 /// A tube bent at its middle by linear-blend skinning over two bones, the blend spread over half
@@ -49,12 +50,11 @@ fn opts(
     segmentation: SegmentationChoice,
 ) -> EncodeOptions {
     EncodeOptions {
-        codec,
+        codec: config(codec, None, Some(PaddingMethod::Cg), None),
         clusters: 2,
         first_frame_bits: Some(12),
         predictor,
         segmentation,
-        padding: (codec != Codec::Tdct).then_some(padding::Method::Cg),
         ..EncodeOptions::default()
     }
 }
@@ -279,8 +279,7 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
     );
     // tdct's candidates share one step and are ranked by bytes alone.
     let tdct = EncodeOptions {
-        codec: Codec::Tdct,
-        padding: None,
+        codec: Codec::Tdct.into(),
         ..options
     };
     let choice = encode(&mesh, &tdct).expect("encodes").report.choice;

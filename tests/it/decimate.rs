@@ -1,13 +1,13 @@
 //! Segmentation by decimation (skinning paper §3.1) on synthetic animations with a known answer.
 
-use crate::common::{canonical, decoder, rand_index, read_media, tube};
+use crate::common::{canonical, config, decoder, rand_index, read_media, tube};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::topology::ManifoldReport;
 use mcgv_video::mesh::{Point, Triangle};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{decimate, DecimateOptions, Decimation};
-use mcgv_video::AnimatedMesh;
+use mcgv_video::{AnimatedMesh, PaddingMethod};
 
 const FRAMES: usize = 10;
 const RING_SIZE: usize = 12;
@@ -281,10 +281,9 @@ fn the_cap_continues_collapsing_past_e0() {
 fn decimation_round_trips_through_the_stream() {
     let mesh = read_media("RiggedSimple.glb");
     let opts = EncodeOptions {
-        codec: Codec::Jpeg,
-        segmentation: Segmentation::Decimation { e0: 0.003 }.into(),
         // The paper's padding keeps this debug-build test fast.
-        padding: Some(padding::Method::Cg),
+        codec: config(Codec::Jpeg, None, Some(PaddingMethod::Cg), None),
+        segmentation: Segmentation::Decimation { e0: 0.003 }.into(),
         ..EncodeOptions::default()
     };
     let encoded = encode(&mesh, &opts).expect("encodes");

@@ -110,7 +110,7 @@ fn the_trials_are_announced_once_and_picture_codecs_do_not_try() {
     // 8 model candidates at 12 bits, then the kept model at 10 (and 8) bits.
     assert!([9, 10].contains(&(total / frames)), "{total}");
     let jpeg = EncodeOptions {
-        codec: Codec::Jpeg,
+        codec: Codec::Jpeg.into(),
         ..tdct(50)
     };
     let encoded = encode(&mesh, &jpeg).expect("encodes");

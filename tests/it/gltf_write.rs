@@ -100,7 +100,7 @@ fn primitives_sharing_a_material_come_back_apart() {
     assert_eq!(mesh.attributes().materials, [0, 1]);
     assert_eq!(mesh.attributes().material_names, ["skin", "skin"]);
     let opts = EncodeOptions {
-        codec: Codec::Tdct,
+        codec: Codec::Tdct.into(),
         clusters: 1,
         ..Default::default()
     };

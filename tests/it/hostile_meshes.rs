@@ -5,13 +5,13 @@
 //! Case counts are low so that `make test` stays fast; `PROPTEST_CASES=256 cargo test --test
 //! hostile_meshes` runs more.
 
-use crate::common::canonical;
+use crate::common::{canonical, config};
 use mcgv_video::codec::Codec;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{AnimatedMesh, Point, Triangle};
 use mcgv_video::stream::entropy::{self, BitModel, IntModel, SymbolCoder, SymbolModel, UIntModel};
-use mcgv_video::Lattice;
+use mcgv_video::{Lattice, PaddingMethod};
 use proptest::prelude::*;
 
 /// Cases per property unless `PROPTEST_CASES` says otherwise.
@@ -108,20 +108,12 @@ fn odd_mesh(grids: &[(usize, usize)], odd: &Oddities, frames: usize, seed: u64) 
 /// Small-lattice settings that keep one encode well under a second in a debug build (the temporal
 /// DCT has no images: it takes only the quality and the clusters).
 fn small(codec: Codec) -> EncodeOptions {
-    let base = EncodeOptions {
-        codec,
+    let lattice = Some(Lattice::Fixed(64, 64));
+    EncodeOptions {
+        codec: config(codec, lattice, Some(PaddingMethod::Cg), Some(3)),
         quality: 90,
         clusters: 3,
         ..EncodeOptions::default()
-    };
-    if codec == Codec::Tdct {
-        return base;
-    }
-    EncodeOptions {
-        lattice: Lattice::Fixed(64, 64),
-        gop: 3,
-        padding: Some(padding::Method::Cg),
-        ..base
     }
 }
 
@@ -210,10 +202,10 @@ fn a_thousand_frames_of_three_vertices_round_trip() {
         .collect();
     let mesh = AnimatedMesh::new(vec![[0, 1, 2]], frames).unwrap();
     for codec in [Codec::Jpeg, Codec::Mpeg4] {
+        let lattice = Some(Lattice::Fixed(16, 16));
         let opts = EncodeOptions {
+            codec: config(codec, lattice, Some(PaddingMethod::Cg), Some(50)),
             clusters: 1,
-            lattice: Lattice::Fixed(16, 16),
-            gop: 50,
             ..small(codec)
         };
         round_trip(&mesh, &opts, 0.05);

@@ -1,12 +1,13 @@
 //! End-to-end: encode media samples with both codecs, decode, and check connectivity, error bounds,
 //! random access and the handling of damaged streams.
 
-use crate::common::{canonical, decode_all, decoder, encode_bytes, read_media};
-use mcgv_video::codec::Codec;
+use crate::common::{canonical, config, decode_all, decoder, encode_bytes, read_media};
+use mcgv_video::codec::{Codec, CodecConfig, Mpeg4Config, PictureOptions};
 use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::PredictorKind;
 use mcgv_video::stream::container::{ContainerReader, Tag};
+use mcgv_video::PaddingMethod;
 use std::io::Cursor;
 
 /// Test settings: CG padding (the paper's) keeps these debug-build tests fast; the default padding
@@ -15,10 +16,8 @@ use std::io::Cursor;
 /// smallest stream at the step, not the least error: RiggedSimple's JPEG error doubles with it).
 fn opts(codec: Codec, quality: u8) -> EncodeOptions {
     EncodeOptions {
-        codec,
+        codec: config(codec, None, Some(PaddingMethod::Cg), Some(10)),
         quality,
-        gop: 10,
-        padding: Some(padding::Method::Cg),
         predictor: PredictorKind::Affine.into(),
         segmentation: Segmentation::KMeans.into(),
         ..EncodeOptions::default()
@@ -63,7 +62,14 @@ fn mpeg4_round_trip_keeps_connectivity_and_bounds_error() {
     let bytes = encode_bytes(
         &mesh,
         &EncodeOptions {
-            qscale: Some(4),
+            codec: CodecConfig::Mpeg4(Mpeg4Config {
+                qscale: Some(4),
+                gop: 10,
+                pictures: PictureOptions {
+                    padding: Some(PaddingMethod::Cg),
+                    ..PictureOptions::default()
+                },
+            }),
             ..opts(Codec::Mpeg4, 75)
         },
     );
@@ -84,7 +90,7 @@ fn jpeg_frame_decodes_alone_when_every_other_frame_is_destroyed() {
     let bytes = encode_bytes(
         &mesh,
         &EncodeOptions {
-            padding: None,
+            codec: Codec::Jpeg.into(),
             ..opts(Codec::Jpeg, 75)
         },
     );
@@ -159,10 +165,10 @@ fn deep_codecs_round_trip_random_access_and_determinism() {
     let mesh = read_media("RiggedFigure.glb");
     for codec in [Codec::Hevc, Codec::Av1] {
         for depth in [10u8, 12] {
-            let options = EncodeOptions {
-                bit_depth: Some(depth),
-                ..opts(codec, 75)
-            };
+            let mut options = opts(codec, 75);
+            if let CodecConfig::Hevc(deep) | CodecConfig::Av1(deep) = &mut options.codec {
+                deep.bit_depth = Some(depth);
+            }
             let bytes = encode_bytes(&mesh, &options);
             let what = format!("{} at {depth} bits", codec.name());
             assert_eq!(bytes, encode_bytes(&mesh, &options), "{what}");
@@ -187,7 +193,7 @@ fn all_intra_deep_codec_frame_decodes_alone() {
         let bytes = encode_bytes(
             &mesh,
             &EncodeOptions {
-                gop: 1,
+                codec: config(codec, None, Some(PaddingMethod::Cg), Some(1)),
                 ..opts(codec, 75)
             },
         );

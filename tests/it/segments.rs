@@ -2,9 +2,9 @@
 //! by frame alike, a frame reads its own segment only, and damaged or reordered segments are
 //! refused.
 
-use crate::common::{animate, decoder, encode_bytes, harness, parts, rebuild, tube};
+use crate::common::{animate, config, decoder, encode_bytes, harness, parts, rebuild, tube};
 use mcgv_video::encoder::segments::{analysis_frames, CodedSegment, SegmentedEncoder};
-use mcgv_video::stream::container::{Checksum, Tag, VERSION, VERSION_SEGMENTED};
+use mcgv_video::stream::container::{Checksum, Tag, VERSION};
 use mcgv_video::{encode, AnimatedMesh, Codec, EncodeOptions, Lattice, PredictorChoice, Silent};
 use mcgv_video::{PredictorKind, SegmentationChoice};
 
@@ -19,17 +19,13 @@ fn clip(frames: usize) -> AnimatedMesh {
 }
 
 fn options(codec: Codec, segment_frames: Option<usize>) -> EncodeOptions {
+    let gop = if codec == Codec::Mpeg4 { 4 } else { 50 };
     EncodeOptions {
-        codec,
+        codec: config(codec, Some(Lattice::Fixed(32, 32)), None, Some(gop)),
         quality: 60,
         clusters: 2,
         segmentation: SegmentationChoice::Fixed(mcgv_video::Segmentation::KMeans),
         predictor: PredictorChoice::Fixed(PredictorKind::Affine),
-        lattice: match codec {
-            Codec::Tdct => Lattice::Auto,
-            _ => Lattice::Fixed(32, 32),
-        },
-        gop: if codec == Codec::Mpeg4 { 4 } else { 50 },
         segment_frames,
         ..EncodeOptions::default()
     }
@@ -49,7 +45,7 @@ fn segmented_streams_decode_whole_and_frame_by_frame_alike() {
     let mesh = clip(23);
     for codec in [Codec::Tdct, Codec::Jpeg, Codec::Mpeg4] {
         let bytes = encode_bytes(&mesh, &options(codec, Some(8)));
-        assert_eq!(version(&bytes), VERSION_SEGMENTED, "{codec:?}");
+        assert_eq!(version(&bytes), VERSION, "{codec:?}");
         let mut dec = decoder(bytes).unwrap();
         assert_eq!(dec.segments(), &[0..8, 8..16, 16..23], "{codec:?}");
         let all = dec.decode_all().unwrap();
@@ -141,11 +137,11 @@ fn missing_reordered_or_misplaced_segments_are_refused() {
     misplaced.insert(1, part);
     let err = refusal(rebuild(misplaced));
     assert!(err.contains("belongs to one"), "{err}");
-    // A segment start in a stream that claims version 3.
+    // A stream that claims an older version.
     let mut old = bytes.clone();
-    old[8..10].copy_from_slice(&VERSION.to_le_bytes());
+    old[8..10].copy_from_slice(&(VERSION - 1).to_le_bytes());
     let err = refusal(old);
-    assert!(err.contains("cannot hold segments"), "{err}");
+    assert!(err.contains("older mcgv-video"), "{err}");
     // Two affine parts in one segment.
     let mut twice = all.clone();
     twice.insert(starts[1] + 1, (Tag::AFFINE, vec![0; 4], Checksum::Whole));

@@ -1,21 +1,22 @@
 //! End-to-end tests of the skinning predictor (`--predictor skinning`): round trips through both
 //! image codecs, the stream recording the choice, and damaged or inconsistent weights parts.
 
-use crate::common::{canonical, decode_all, decoder, encode_bytes, parts, read_media, rebuild};
-use mcgv_video::codec::Codec;
+use crate::common::{
+    canonical, config, decode_all, decoder, encode_bytes, parts, read_media, rebuild,
+};
+use mcgv_video::codec::{Codec, CodecConfig, Mpeg4Config, PictureOptions};
 use mcgv_video::encoder::{analysis, EncodeOptions, Segmentation};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{self, PredictorKind};
 use mcgv_video::stream::container::{Checksum, ContainerReader, Tag};
+use mcgv_video::PaddingMethod;
 use std::io::Cursor;
 
 /// As in `tests/roundtrip.rs`: CG padding keeps the debug-build tests fast.
 fn opts(codec: Codec, quality: u8, predictor: PredictorKind) -> EncodeOptions {
     EncodeOptions {
-        codec,
+        codec: config(codec, None, Some(PaddingMethod::Cg), Some(10)),
         quality,
-        gop: 10,
-        padding: Some(padding::Method::Cg),
         predictor: predictor.into(),
         // The bounds below were measured on k-means clusters.
         segmentation: Segmentation::KMeans.into(),
@@ -54,7 +55,14 @@ fn mpeg4_skinning_round_trip_keeps_connectivity_and_bounds_error() {
     let bytes = encode_bytes(
         &mesh,
         &EncodeOptions {
-            qscale: Some(4),
+            codec: CodecConfig::Mpeg4(Mpeg4Config {
+                qscale: Some(4),
+                gop: 10,
+                pictures: PictureOptions {
+                    padding: Some(PaddingMethod::Cg),
+                    ..PictureOptions::default()
+                },
+            }),
             ..opts(Codec::Mpeg4, 75, PredictorKind::Skinning)
         },
     );
@@ -141,7 +149,11 @@ fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
         let options = opts(Codec::Jpeg, 50, predictor);
         let (partition, _) =
             analysis::segment(&mesh, Segmentation::KMeans, options.clusters).unwrap();
-        let a = analysis::predict(&mesh, &reference, &partition, &options, predictor).unwrap();
+        let steps = (
+            options.plan(mesh.bbox_diagonal()).unwrap().affine_step,
+            options.weight_bits,
+        );
+        let a = analysis::predict(&mesh, &reference, &partition, steps, predictor).unwrap();
         assert_eq!(a.weights.is_some(), predictor == PredictorKind::Skinning);
         a.residuals.iter().map(|r| motion::energy(r)).sum::<f64>()
     };

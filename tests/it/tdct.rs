@@ -2,20 +2,21 @@
 //! both segmentations, progressive decoding of a band prefix or a truncated file, random access,
 //! and damaged or forged streams.
 
-use crate::common::{encode_bytes, read_media, vertex_rmse};
+use crate::common::{config, encode_bytes, read_media, vertex_rmse};
 use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::{AnimatedMesh, Triangle};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::PredictorKind;
 use mcgv_video::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
+use mcgv_video::PaddingMethod;
 use mcgv_video::{codec::Codec, stream::header::Header};
 use std::collections::BTreeSet;
 use std::io::Cursor;
 
 fn tdct(quality: u8) -> EncodeOptions {
     EncodeOptions {
-        codec: Codec::Tdct,
+        codec: Codec::Tdct.into(),
         quality,
         ..EncodeOptions::default()
     }
@@ -68,17 +69,19 @@ fn round_trip_keeps_connectivity_and_bounds_error() {
             Tag::FIRST_FRAME,
             Tag::ATTRIBUTES,
             Tag::PARTITION,
+            Tag::CODEC_SETUP,
             Tag::AFFINE,
             Tag::TDCT_INDEX,
             Tag::TDCT
         ]
     );
     let mut dec = decoder(bytes, None).unwrap();
-    let h = dec.header().clone();
-    assert_eq!((h.lattice_width, h.lattice_height, h.charts), (0, 0, 0));
-    assert_eq!((h.codec, h.padding.as_str()), (Codec::Tdct, "none"));
-    assert_eq!(dec.bands_total(), mesh.frame_count());
-    assert_eq!(dec.bands_decoded(), mesh.frame_count());
+    assert_eq!(dec.header().codec, Codec::Tdct.id());
+    let stored = dec.describe().expect("an open segment");
+    assert_eq!((stored.codec, stored.pictures), (Codec::Tdct, None));
+    let bands = stored.bands.expect("bands");
+    assert_eq!(bands.lengths.len(), mesh.frame_count());
+    assert_eq!(bands.decoded, mesh.frame_count());
     assert!(!dec.truncated());
     let decoded = dec.decode_all().unwrap();
     assert_eq!(decoded.vertex_count(), mesh.vertex_count());
@@ -124,6 +127,12 @@ fn skinning_predictor_and_decimation_round_trip() {
     assert!(e < 1.4e-4, "decimation: vertex RMSE {e}");
 }
 
+/// Bands decoded and bands in the stream.
+fn decoded_bands<R: std::io::Read + std::io::Seek>(dec: &Decoder<R>) -> (usize, usize) {
+    let bands = dec.describe().and_then(|d| d.bands).expect("bands");
+    (bands.decoded, bands.lengths.len())
+}
+
 #[test]
 fn error_falls_as_more_bands_are_decoded() {
     let mesh = read_media("RiggedFigure.glb");
@@ -133,7 +142,7 @@ fn error_falls_as_more_bands_are_decoded() {
         .iter()
         .map(|&n| {
             let dec = decoder(bytes.clone(), Some(n)).unwrap();
-            assert_eq!(dec.bands_decoded(), n);
+            assert_eq!(decoded_bands(&dec), (n, f));
             assert!(!dec.truncated());
             vertex_rmse(&mesh, &decode_all(bytes.clone(), Some(n)).unwrap())
         })
@@ -151,16 +160,13 @@ fn a_stream_cut_inside_the_coefficients_decodes_coarser() {
     let cut = bytes[..offset + len / 2].to_vec();
     let dec = decoder(cut.clone(), None).unwrap();
     assert!(dec.truncated());
-    assert!(
-        dec.bands_decoded() < dec.bands_total(),
-        "{}",
-        dec.bands_decoded()
-    );
+    let (decoded, total) = decoded_bands(&dec);
+    assert!(decoded < total, "{decoded}");
     let coarse = vertex_rmse(&mesh, &decode_all(cut, None).unwrap());
     assert!(coarse > full, "cut {coarse} vs full {full}");
     // No coefficient bytes at all: the prediction alone, still a decodable animation.
     let bare = decoder(bytes[..offset].to_vec(), None).unwrap();
-    assert_eq!(bare.bands_decoded(), 0);
+    assert_eq!(decoded_bands(&bare).0, 0);
 }
 
 #[test]
@@ -240,8 +246,7 @@ fn forged_counts_are_refused_before_allocating() {
     let jpeg = encode_bytes(
         &mesh,
         &EncodeOptions {
-            codec: Codec::Jpeg,
-            padding: Some(padding::Method::Cg),
+            codec: config(Codec::Jpeg, None, Some(PaddingMethod::Cg), None),
             ..EncodeOptions::default()
         },
     );
@@ -285,7 +290,7 @@ fn step_overrides_quality_and_is_checked() {
     }
     // The step is every codec's since the error law (issue 15): the image codecs' pixel step.
     let jpeg = EncodeOptions {
-        codec: Codec::Jpeg,
+        codec: Codec::Jpeg.into(),
         step: Some(0.001),
         ..EncodeOptions::default()
     };

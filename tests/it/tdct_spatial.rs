@@ -28,11 +28,15 @@ pub fn coefficients_of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<Vec<f64
     )
     .unwrap();
     let (partition, _) = segment(mesh, Segmentation::KMeans, opts.clusters).unwrap();
+    let steps = (
+        opts.plan(mesh.bbox_diagonal()).unwrap().affine_step,
+        opts.weight_bits,
+    );
     let residuals = predict(
         mesh,
         &ff.decoded_positions,
         &partition,
-        opts,
+        steps,
         PredictorKind::Affine,
     )
     .unwrap()
@@ -47,7 +51,7 @@ pub fn coefficients_of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<Vec<f64
 #[ignore = "measurement, not a check"]
 fn measure_spatial() {
     let opts = EncodeOptions {
-        codec: Codec::Tdct,
+        codec: Codec::Tdct.into(),
         ..EncodeOptions::default()
     };
     let samples = [
@@ -86,7 +90,7 @@ fn coefficient_bytes(mesh: &AnimatedMesh, levels: &[Vec<i64>], candidates: &[Spa
 fn spatial_prediction_on_a_cloth_round_trips() {
     let mesh = cloth(24, 32);
     let opts = EncodeOptions {
-        codec: Codec::Tdct,
+        codec: Codec::Tdct.into(),
         quality: 50,
         ..EncodeOptions::default()
     };

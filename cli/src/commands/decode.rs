@@ -34,12 +34,14 @@ where
             "mcgv-video: warning: stream truncated inside its last segment's temporal-DCT bands: \
              that segment decodes coarser"
         );
-    } else if decoder.truncated() {
-        eprintln!(
-            "mcgv-video: warning: stream truncated: decoded {} of {} temporal-DCT bands, a coarser animation",
-            decoder.bands_decoded(),
-            decoder.bands_total()
-        );
+    } else if let Some(bands) = decoder.describe().and_then(|d| d.bands) {
+        if decoder.truncated() {
+            eprintln!(
+                "mcgv-video: warning: stream truncated: decoded {} of {} temporal-DCT bands, a coarser animation",
+                bands.decoded,
+                bands.lengths.len()
+            );
+        }
     }
 }
 

@@ -2,7 +2,9 @@
 
 use crate::args::{BitDepth, CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
-use mcgv_video::codec::Codec;
+use mcgv_video::codec::{
+    Codec, CodecConfig, DeepConfig, JpegConfig, Mpeg4Config, PictureOptions, TdctConfig,
+};
 use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
 use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
 use mcgv_video::error::{Error, Result};
@@ -15,29 +17,6 @@ use std::time::Instant;
 
 /// Parses the encode arguments into encoder options, rejecting nonsense with a clear message.
 pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions> {
-    let lattice = parse_lattice(&args.lattice)?;
-    let codec = match args.codec {
-        CodecChoice::Jpeg => Codec::Jpeg,
-        CodecChoice::Mpeg4 => Codec::Mpeg4,
-        CodecChoice::Tdct => Codec::Tdct,
-        CodecChoice::Hevc => Codec::Hevc,
-        CodecChoice::Av1 => Codec::Av1,
-    };
-    check_codec_options(args, codec, lattice)?;
-    if args.affine_bits.is_some() {
-        return Err(Error::option(
-            "affine_bits",
-            "was retired: the affine coefficients are now quantised by the residual step that \
-             --quality (or --step) sets; --affine-precision K scales their step (default 0.25; 1/16 for mpeg4)",
-        ));
-    }
-    let padding = match &args.padding {
-        Some(name) => Some(
-            name.parse::<padding::Method>()
-                .map_err(|e| Error::option("padding", format!("{name}: {e}")))?,
-        ),
-        None => None,
-    };
     let e0 = args.e0.unwrap_or(mcgv_video::motion::DEFAULT_E0);
     let segmentation = match args.segmentation {
         SegmentationChoice::Kmeans => {
@@ -62,23 +41,11 @@ pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions>
     };
     let defaults = EncodeOptions::default();
     Ok(EncodeOptions {
-        codec,
+        codec: codec_config(args)?,
         quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
-        // One field for the video codecs' quantisers; check_codec_options lets one through.
-        qscale: args.qscale.or(args.qp),
-        bit_depth: match args.bit_depth {
-            BitDepth::Auto => None,
-            BitDepth::Bits(bits) => Some(bits),
-        },
-        jpeg_quality: args.jpeg_quality,
         clusters: args.clusters.unwrap_or(defaults.clusters),
         segmentation,
         affine_precision: args.affine_precision,
-        lattice,
-        padding,
-        gop: args
-            .gop
-            .map_or(defaults.gop, |g| usize::try_from(g).unwrap_or(usize::MAX)),
         reorder: args.reorder,
         first_frame_bits: args.first_frame_bits,
         predictor: match args.predictor {
@@ -99,15 +66,56 @@ pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions>
     })
 }
 
+/// The codec and its own options from the flags: the one place that knows which flag belongs to
+/// which codec (another codec's flag is a usage error naming the codecs it belongs to).
+fn codec_config(args: &EncodeArgs) -> Result<CodecConfig> {
+    let lattice = parse_lattice(&args.lattice)?;
+    let codec = match args.codec {
+        CodecChoice::Jpeg => Codec::Jpeg,
+        CodecChoice::Mpeg4 => Codec::Mpeg4,
+        CodecChoice::Tdct => Codec::Tdct,
+        CodecChoice::Hevc => Codec::Hevc,
+        CodecChoice::Av1 => Codec::Av1,
+    };
+    check_codec_options(args, codec, lattice)?;
+    let padding = match &args.padding {
+        Some(name) => Some(
+            name.parse::<mcgv_video::PaddingMethod>()
+                .map_err(|e| Error::option("padding", format!("{name}: {e}")))?,
+        ),
+        None => None,
+    };
+    let pictures = PictureOptions { lattice, padding };
+    let gop = args.gop.map_or(mcgv_video::DEFAULT_GOP, |g| {
+        usize::try_from(g).unwrap_or(usize::MAX)
+    });
+    let deep = DeepConfig {
+        qp: args.qp,
+        gop,
+        bit_depth: match args.bit_depth {
+            BitDepth::Auto => None,
+            BitDepth::Bits(bits) => Some(bits),
+        },
+        pictures,
+    };
+    Ok(match codec {
+        Codec::Tdct => CodecConfig::Tdct(TdctConfig::default()),
+        Codec::Jpeg => CodecConfig::Jpeg(JpegConfig {
+            quality: args.jpeg_quality,
+            pictures,
+        }),
+        Codec::Mpeg4 => CodecConfig::Mpeg4(Mpeg4Config {
+            qscale: args.qscale,
+            gop,
+            pictures,
+        }),
+        Codec::Hevc => CodecConfig::Hevc(deep),
+        Codec::Av1 => CodecConfig::Av1(deep),
+    })
+}
+
 /// One rule for options of another codec: a usage error naming the codec(s) they belong to.
 fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Result<()> {
-    if args.range_floor.is_some() {
-        return Err(Error::option(
-            "range_floor",
-            "was retired: --quality now sets one quantisation step for every frame, so frames \
-             with small residuals already cost few bits; leave it out",
-        ));
-    }
     let images: &[Codec] = &[Codec::Jpeg, Codec::Mpeg4, Codec::Hevc, Codec::Av1];
     let deep: &[Codec] = &[Codec::Hevc, Codec::Av1];
     let given: [(&'static str, bool, &[Codec]); 7] = [

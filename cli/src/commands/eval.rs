@@ -21,7 +21,7 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
         let mut decoder =
             Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;
         super::decode::warn_if_truncated(&decoder);
-        let bits = decoder.container().file_len() * 8;
+        let bits = decoder.file_len() * 8;
         compare_stream(&mut original, &mut decoder, quiet)
             .map_err(|e| super::in_file(path, e))?
             .with_bits(bits)

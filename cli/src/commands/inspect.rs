@@ -2,11 +2,12 @@
 
 use crate::annotate;
 use crate::args::InspectArgs;
+use mcgv_video::codec::Description;
 use mcgv_video::codec::Plane;
 use mcgv_video::decoder::Decoder;
 use mcgv_video::error::{Error, Result};
 use mcgv_video::geometry_image::{tile, FrameRanges};
-use mcgv_video::{codec::Codec, stream::header::Header};
+use mcgv_video::stream::header::Header;
 use std::path::Path;
 
 /// Runs `inspect`.
@@ -19,53 +20,58 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
     decoder
         .seek_segment(0)
         .map_err(|e| super::in_file(&args.input, e))?;
+    let stored = decoder
+        .describe()
+        .ok_or_else(|| Error::Stream("no segment is open".into()))?;
     let header = decoder.header().clone();
-    let total = decoder.container().file_len();
-    let parts = mcgv_video::inspect::part_bytes(&decoder);
+    let total = decoder.file_len();
+    let parts = decoder.part_bytes();
     let vf = header.vertices as f64 * header.frames as f64;
     let bpvf = total as f64 * 8.0 / vf;
     if let Some(dir) = &args.png {
-        if !header.codec.has_images() {
+        let Some(pictures) = &stored.pictures else {
             return Err(Error::Usage(format!(
-                "--png: a {} stream has no geometry images to write (its residuals are \
-                 temporal-DCT bands; the band table is in the plain and --json output)",
-                header.codec.name()
+                "--png: a {} stream has no geometry images to write (its figures are in the \
+                 plain and --json output)",
+                stored.codec.name()
             )));
-        }
-        write_pngs(&mut decoder, args, dir, quiet)?;
+        };
+        write_pngs(&mut decoder, pictures.lattice, args, dir, quiet)?;
     }
-    let bands = decoder.band_lengths().to_vec();
+    let bands = stored.bands.as_ref();
     if args.json {
         let parts_obj: serde_json::Map<String, serde_json::Value> = parts
             .iter()
             .map(|(n, b)| (n.clone(), serde_json::json!(b * 8)))
             .collect();
-        let value = serde_json::json!({
+        let pictures = stored.pictures.as_ref();
+        let mut value = serde_json::json!({
             "vertices": header.vertices,
             "frames": header.frames,
             "faces": header.triangles,
-            "codec": header.codec.name(),
+            "codec": stored.codec.name(),
             "quality": header.quality,
-            "qscale": header.qscale,
-            "gop": header.gop,
-            "bit_depth": decoder.images().map(|i| i.depth),
+            "bit_depth": pictures.map(|p| p.bit_depth),
             "clusters": header.clusters,
             "predictor": header.predictor.name(),
             "weight_bits": decoder.weights().map(|w| w.bits),
-            "charts": header.charts,
-            "lattice": [header.lattice_width, header.lattice_height],
-            "packing_efficiency": header.packing_efficiency(),
-            "padding": header.padding,
+            "charts": pictures.map_or(0, |p| p.charts),
+            "lattice": pictures.map_or((0, 0), |p| p.lattice),
+            "packing_efficiency": pictures.map_or(0.0, |p| p.packing_efficiency),
+            "padding": pictures.map(|p| p.padding),
             "bytes": total,
             "bpvf": bpvf,
             "parts": parts_obj,
             "segments": segments.len(),
-            "band_bytes": (!bands.is_empty()).then_some(&bands),
-            "step": decoder.band_step(),
+            "band_bytes": bands.map(|b| &b.lengths),
+            "step": bands.map(|b| b.step),
         });
+        for (name, setting) in &stored.settings {
+            value[*name] = serde_json::json!(setting);
+        }
         return outln!("{value}");
     }
-    outln!("{}", summary(&header, &args.input))?;
+    outln!("{}", summary(&header, &stored, &args.input))?;
     if segments.len() > 1 {
         outln!(
             "{} temporal segments of up to {} frames (parts of a kind summed; bands of the first)",
@@ -99,8 +105,8 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
         100.0,
         bpvf
     )?;
-    if !bands.is_empty() {
-        out!("{}", band_table(&bands, decoder.bands_decoded()))?;
+    if let Some(bands) = bands {
+        out!("{}", band_table(&bands.lengths, bands.decoded))?;
     }
     Ok(())
 }
@@ -153,41 +159,40 @@ fn band_table(bands: &[u64], decoded: usize) -> String {
     s
 }
 
-fn summary(h: &Header, path: &Path) -> String {
-    let codec = match h.codec {
-        Codec::Jpeg => format!("jpeg quality {} (pictures at {})", h.quality, h.qscale),
-        Codec::Mpeg4 => format!(
-            "mpeg4 quality {} qscale {} gop {}",
-            h.quality, h.qscale, h.gop
+/// One line: the animation, the codec and its settings, the motion model, and the pictures'
+/// lattice and atlas (or bands).
+fn summary(h: &Header, stored: &Description, path: &Path) -> String {
+    let settings: Vec<String> = stored
+        .settings
+        .iter()
+        .map(|(name, value)| format!("{name} {value}"))
+        .collect();
+    let settings = match settings.is_empty() {
+        true => String::new(),
+        false => format!(" ({})", settings.join(", ")),
+    };
+    let residuals = match (&stored.pictures, &stored.bands) {
+        (Some(p), _) => format!(
+            "{} charts in {}x{} (packing {:.1}%), padding {}",
+            p.charts,
+            p.lattice.0,
+            p.lattice.1,
+            100.0 * p.packing_efficiency,
+            p.padding
         ),
-        Codec::Hevc => format!("hevc quality {} qp {} gop {}", h.quality, h.qscale, h.gop),
-        Codec::Av1 => format!("av1 quality {} crf {} gop {}", h.quality, h.qscale, h.gop),
-        Codec::Tdct => {
-            return format!(
-                "{}: {} vertices x {} frames, {} faces; tdct quality {}; {} clusters, {} predictor, no atlas",
-                path.display(),
-                h.vertices,
-                h.frames,
-                h.triangles,
-                h.quality,
-                h.clusters,
-                h.predictor.name()
-            )
-        }
+        (None, Some(b)) => format!("{} frequency bands, no atlas", b.lengths.len()),
+        (None, None) => "no atlas".into(),
     };
     format!(
-        "{}: {} vertices x {} frames, {} faces; {codec}; {} clusters, {} predictor, {} charts in {}x{} (packing {:.1}%), padding {}",
+        "{}: {} vertices x {} frames, {} faces; {} quality {}{settings}; {} clusters, {} predictor; {residuals}",
         path.display(),
         h.vertices,
         h.frames,
         h.triangles,
+        stored.codec.name(),
+        h.quality,
         h.clusters,
         h.predictor.name(),
-        h.charts,
-        h.lattice_width,
-        h.lattice_height,
-        100.0 * h.packing_efficiency(),
-        h.padding
     )
 }
 
@@ -214,13 +219,14 @@ fn save_residuals(
         .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
 }
 
-/// The atlas as the decoder sees it, with a legend of the cluster colours.
-fn write_atlas<R: std::io::Read + std::io::Seek>(decoder: &Decoder<R>, path: &Path) -> Result<()> {
+/// The atlas of a `lattice` as the decoder sees it, with a legend of the cluster colours.
+fn write_atlas<R: std::io::Read + std::io::Seek>(
+    decoder: &Decoder<R>,
+    lattice: (u16, u16),
+    path: &Path,
+) -> Result<()> {
     let header = decoder.header();
-    let (w, h) = (
-        header.lattice_width as usize,
-        header.lattice_height as usize,
-    );
+    let (w, h) = (usize::from(lattice.0), usize::from(lattice.1));
     // The atlas as the decoder sees it: each vertex pixel in its cluster's colour, the 8×8 grid dimmed.
     let mut atlas_rgb = vec![0u8; w * h * 3];
     for y in 0..h {
@@ -244,15 +250,16 @@ fn write_atlas<R: std::io::Read + std::io::Seek>(decoder: &Decoder<R>, path: &Pa
 
 fn write_pngs<R: std::io::Read + std::io::Seek>(
     decoder: &mut Decoder<R>,
+    lattice: (u16, u16),
     args: &InspectArgs,
     dir: &Path,
     quiet: bool,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let header = decoder.header().clone();
-    let w = header.lattice_width as usize;
+    let w = usize::from(lattice.0);
     let frames = selected_frames(args, header.frames)?;
-    write_atlas(decoder, &dir.join("atlas.png"))?;
+    write_atlas(decoder, lattice, &dir.join("atlas.png"))?;
     crate::render::render_partition_png(
         decoder.reference(),
         decoder.triangles(),
@@ -274,7 +281,7 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
     }
 
     if let Some(original) = &args.original {
-        write_encoder_pngs(decoder, args, original, dir, &frames, quiet)?;
+        write_encoder_pngs(decoder, lattice, args, (original, dir), &frames, quiet)?;
     }
     if !quiet {
         eprintln!("images written to {}", dir.display());
@@ -301,14 +308,13 @@ fn selected_frames(args: &InspectArgs, stream_frames: u32) -> Result<Vec<usize>>
 /// The residual images the encoder made (raw and padded) for `frames`, redone from `original`.
 fn write_encoder_pngs<R: std::io::Read + std::io::Seek>(
     decoder: &Decoder<R>,
+    lattice: (u16, u16),
     args: &InspectArgs,
-    original: &str,
-    dir: &Path,
+    (original, dir): (&str, &Path),
     frames: &[usize],
     quiet: bool,
 ) -> Result<()> {
-    let w = decoder.header().lattice_width as usize;
-    let h = decoder.header().lattice_height as usize;
+    let (w, h) = (usize::from(lattice.0), usize::from(lattice.1));
     let mesh = super::read_input(original, &(&args.input_args).into(), quiet)?;
     let ranges = decoder.ranges().to_vec();
     for images in mcgv_video::inspect::encoder_images(decoder, &mesh, frames)? {

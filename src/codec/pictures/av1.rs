@@ -1,6 +1,5 @@
 //! AV1 at 10 or 12 bits a sample: FFmpeg's `libaom-av1` encoder and its preferred AV1 decoder
-//! (`libdav1d` in Debian's libavcodec 59), through `ffmpeg-next` (cargo feature `mpeg4`, which
-//! brings FFmpeg); the encoder, decoder and set-up part are [`super::deep`]'s, shared with HEVC.
+//! (`libdav1d` in Debian's libavcodec 59), through `ffmpeg-next` (cargo feature `ffmpeg`); the encoder, decoder and set-up part are [`super::deep`]'s, shared with HEVC.
 //!
 //! The x | y | z picture is the three planes of a 4:4:4 picture, as for HEVC: profile 1 at 10 bits,
 //! profile 2 at 12 (libaom picks the profile from the pixel format). The quantiser is libaom's
@@ -12,9 +11,16 @@
 //!
 //! `cpu-used` [`CPU_USED`] trades compression for speed (docs/results.md, "AV1").
 
-use super::deep::{self, Flavour};
-use super::{Codec, PictureLaw};
-use ffmpeg_next::{codec, Dictionary};
+use super::deep::DeepConfig;
+use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
+use crate::codec::Codec;
+use crate::error::Result;
+use crate::motion::DEFAULT_AFFINE_PRECISION;
+
+#[cfg(feature = "ffmpeg")]
+pub use coder::Libaom;
+#[cfg(feature = "ffmpeg")]
+pub(crate) use coder::PICTURES;
 
 /// The largest quantiser (`crf`) libaom takes.
 pub const MAX_QP: u8 = 63;
@@ -32,67 +38,204 @@ pub const LAG_IN_FRAMES: u8 = 19;
 /// 0, no filtering (docs/results.md, "AV1 tuning").
 pub const ARNR_STRENGTH: u8 = 0;
 
-/// libaom's encoder and FFmpeg's AV1 decoder.
-#[derive(Debug, Clone, Copy)]
-pub struct Libaom;
+/// Fails, naming the option, when one of `config` is out of range for AV1.
+pub(crate) fn check(config: &DeepConfig) -> Result<()> {
+    config.check(Codec::Av1, MAX_QP)
+}
 
-/// AV1 as the geometry-video picture codec.
-pub const PICTURES: deep::Pictures<Libaom> = deep::Pictures(Libaom);
+/// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: [`av1_law`]; affine
+/// maps at a quarter of the residual step all-intra, at 1/16 in P-frame groups, whose prediction
+/// coarser maps spoil (docs/design.md, "Affine precision per codec").
+pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
+    let affine_precision = match config.gop {
+        1 => DEFAULT_AFFINE_PRECISION,
+        _ => 1.0 / 16.0,
+    };
+    let law = (av1_law as fn(u8, u8) -> PictureLaw, affine_precision);
+    config.plan(Codec::Av1, law, rate, diagonal)
+}
 
-impl Flavour for Libaom {
-    fn name(&self) -> &'static str {
-        "av1"
-    }
+/// AV1's law at 10 bits a sample, made as HEVC's: a pixel step of [`AV1_STEP_FACTOR`] × the target
+/// step and the quantiser (libaom's `crf` 0..63, AV1's quantiser index over 4) whose quantiser step
+/// follows the target step ([`AV1_QP_AT_50`] at quality 50), between [`AV1_MIN_QP`] and
+/// [`AV1_MAX_QP`]; beyond them the pixel step takes the rest. Unlike HEVC's QP, AV1's quantiser
+/// index does not double its step at a fixed pace (about linear up to index 96, then about 9.5
+/// `crf` per doubling), so the law reads the step off [`AV1_AC_STEPS`]. Measured on CesiumMan
+/// (docs/results.md, "AV1"): quality 50 lands on HEVC's error at quality 50 (RMSE 3.80e-4 at
+/// 2.72 bpvf, HEVC 3.81e-4 at 2.79); at equal error the rate hardly depends on how pixel step
+/// and `crf` share it (pixel step 5e-5 `crf` 32, 1e-4 `crf` 20, 2e-4 `crf` 8: 3.82, 3.71, 4.36
+/// bpvf at RMSE 2.45, 2.54, 2.20e-4) up to `crf` 32, above which libaom's constant-quality mode
+/// keeps its key frames' quantiser and the error stops growing (5e-5: `crf` 32–56 all 2.45e-4).
+/// Those figures are on the former automatic lattice, where the factor was 0.1; on the smallest
+/// lattice that fits it was 0.04, scaled as [`HEVC_STEP_FACTOR`] (docs/results.md, "Quality laws
+/// on the smallest lattice"); the alternate references of P-frame groups (docs/results.md, "AV1
+/// tuning") then raised the error at quality 50 by 1.3× (CesiumMan 2.75e-4 against MPEG-4's
+/// 2.12e-4) and 1.6× (horse-gallop 3.27e-4 against 2.03e-4), hence 0.028.
+pub const AV1_STEP_FACTOR: f64 = 0.028;
+/// libaom's `crf` at quality 50 at 10 bits a sample.
+pub const AV1_QP_AT_50: u8 = 32;
+/// The highest `crf` the law uses (the error stops following `crf` above it).
+pub const AV1_MAX_QP: u8 = 32;
+/// The lowest `crf` the law uses. Not 0: with no quantiser deltas `crf` 0 is lossless coding.
+/// It was 8, which capped P-frame groups at the top (horse-collapse: quality 90 and 97 both at
+/// RMSE 1.27e-4, 5.6 bpvf, as there the pixel step cannot go finer than the group's residual range
+/// allows at 12 bits); `crf` 1 lets the error keep falling up to quality 97 (horse-collapse: 3.8e-5
+/// at 11.8 bpvf, 1.06e-5 at 21.7; docs/results.md, "AV1 and HEVC padding").
+pub const AV1_MIN_QP: u8 = 1;
+/// AV1's AC quantiser step at 10 and 12 bits a sample (the specification's `ac_qlookup_10` and
+/// `ac_qlookup_12` tables, libaom's `ac_qlookup_10_QTX` and `ac_qlookup_12_QTX`) at quantiser
+/// index 4 × `crf` for `crf` 0, 1, 2, 3, 4, 8, …, 60, and at index 255 (`crf` 63): the law
+/// interpolates log-linearly between these. From `crf` 8 up the 12-bit step is about 4 × the
+/// 10-bit one (the step is relative to the sample range, as HEVC's QP); below it the 12-bit step
+/// is finer (0.55 × at `crf` 1), hence both columns.
+pub const AV1_AC_STEPS: [(u8, u16, u16); 20] = [
+    (0, 4, 4),
+    (1, 16, 35),
+    (2, 27, 75),
+    (3, 40, 126),
+    (4, 55, 183),
+    (8, 122, 456),
+    (12, 195, 753),
+    (16, 267, 1049),
+    (20, 337, 1335),
+    (24, 409, 1627),
+    (28, 539, 2150),
+    (32, 700, 2798),
+    (36, 922, 3684),
+    (40, 1218, 4871),
+    (44, 1631, 6522),
+    (48, 2199, 8795),
+    (52, 2971, 11885),
+    (56, 4028, 16110),
+    (60, 5476, 21902),
+    (63, 7312, 29247),
+];
 
-    fn codec(&self) -> Codec {
-        Codec::Av1
-    }
-
-    fn encoder_name(&self) -> &'static str {
-        "libaom-av1"
-    }
-
-    fn decoder_id(&self) -> codec::Id {
-        codec::Id::AV1
-    }
-
-    fn max_qp(&self) -> u8 {
-        MAX_QP
-    }
-
-    fn law(&self, quality: u8, depth: u8) -> PictureLaw {
-        super::av1_law(quality, depth)
-    }
-
-    /// Constant quality at `crf` = the quantiser, key frames exactly every `gop` frames
-    /// (`keyint_min` = `g`), one tile, no row threads; P-frame groups look ahead and code hidden
-    /// alternate-reference frames, all-intra streams do not.
-    fn settings(&self, options: &deep::Options, gop: u32) -> Dictionary<'static> {
-        let mut dict = Dictionary::new();
-        dict.set("usage", "good");
-        dict.set("cpu-used", &CPU_USED.to_string());
-        dict.set("crf", &options.qp.to_string());
-        // libaom's constant-quality mode gives key frames a finer quantiser than `crf`, as x265's
-        // fixed QP does (its I/P ratio); pinning every frame to `crf` (`qmin` = `qmax`) measured
-        // 30 % more bits at equal error (CesiumMan, pixel step 5e-5: 5.06 bpvf at RMSE 2.43e-4
-        // with `crf` 12 pinned, 3.82 at 2.45e-4 with `crf` 32 free). These are libaom's own
-        // bounds: FFmpeg's generic defaults (2..31, MPEG-4's qscale range) would clamp every `crf`
-        // above 31 to 31 (measured: CesiumMan's rate and error stop changing from `crf` 32 up).
-        dict.set("qmin", "0");
-        dict.set("qmax", &MAX_QP.to_string());
-        dict.set("keyint_min", &gop.to_string());
-        let (lag, alt_ref) = if gop > 1 {
-            (LAG_IN_FRAMES, "1")
+/// log2 of AV1's AC step at a (fractional) `crf` 0..=63 at `depth` bits, from [`AV1_AC_STEPS`], in
+/// 10-bit units (the 12-bit step over 4).
+fn av1_log2_step(crf: f64, depth: u8) -> f64 {
+    let log2_at = |&(_, s10, s12): &(u8, u16, u16)| {
+        if depth >= 12 {
+            f64::from(s12).log2() - 2.0
         } else {
-            (0, "0")
-        };
-        dict.set("lag-in-frames", &lag.to_string());
-        dict.set("auto-alt-ref", alt_ref);
-        dict.set("arnr-strength", &ARNR_STRENGTH.to_string());
-        dict.set("row-mt", "0");
-        dict.set("tune", "psnr");
-        dict.set("aq-mode", "none");
-        dict
+            f64::from(s10).log2()
+        }
+    };
+    let i = AV1_AC_STEPS
+        .iter()
+        .rposition(|&(c, _, _)| f64::from(c) <= crf)
+        .unwrap_or(0)
+        .min(AV1_AC_STEPS.len() - 2);
+    let (a, b) = (&AV1_AC_STEPS[i], &AV1_AC_STEPS[i + 1]);
+    let t = (crf - f64::from(a.0)) / f64::from(b.0 - a.0);
+    let (l0, l1) = (log2_at(a), log2_at(b));
+    l0 + t * (l1 - l0)
+}
+
+/// The (fractional) `crf` whose AC step at `depth` bits has log2 `log2_step` (in 10-bit units, as
+/// [`av1_log2_step`]), clamped to 0..=63.
+fn av1_crf_of(log2_step: f64, depth: u8) -> f64 {
+    let logs = AV1_AC_STEPS.map(|(c, _, _)| (f64::from(c), av1_log2_step(f64::from(c), depth)));
+    if log2_step <= logs[0].1 {
+        return 0.0;
+    }
+    match logs.windows(2).find(|w| log2_step <= w[1].1) {
+        Some(w) => w[0].0 + (log2_step - w[0].1) / (w[1].1 - w[0].1) * (w[1].0 - w[0].0),
+        None => 63.0,
+    }
+}
+
+/// AV1's pixel step factor and `crf` for a user quality 1..100 at `depth` bits a sample: the `crf`
+/// whose quantiser step is the one of [`AV1_QP_AT_50`] scaled as the target step; a deeper sample
+/// wants a step a quarter as large per 2 bits (the same step in model units, finer rounding), down
+/// to [`AV1_MIN_QP`], below which the pixel step takes the rest.
+pub fn av1_law(quality: u8, depth: u8) -> PictureLaw {
+    let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
+    let deeper = f64::from(depth) - 10.0;
+    let want = av1_log2_step(f64::from(AV1_QP_AT_50), 10) + scale.log2() - deeper;
+    // The floor is a `crf`, not a step, at either depth (measured: quality 90 at 12 bits with a
+    // floor two bits lower than 10 bits' went to `crf` 3 and 159 bpvf on CesiumMan).
+    let floor = av1_log2_step(f64::from(AV1_MIN_QP), depth);
+    let ceiling = av1_log2_step(f64::from(AV1_MAX_QP), depth);
+    let crf = av1_crf_of(want.clamp(floor, ceiling), depth).round();
+    // Beyond the floor or the ceiling the pixel step takes what the quantiser cannot.
+    let beyond = if (floor..=ceiling).contains(&want) {
+        0.0
+    } else {
+        want - av1_log2_step(crf, depth)
+    };
+    PictureLaw {
+        step_factor: AV1_STEP_FACTOR * 2f64.powf(beyond),
+        quantiser: crf as u8,
+    }
+}
+
+/// libaom as a [`deep::Flavour`].
+#[cfg(feature = "ffmpeg")]
+mod coder {
+    use super::super::deep::{self, Flavour};
+    use super::{ARNR_STRENGTH, CPU_USED, LAG_IN_FRAMES, MAX_QP};
+    use crate::codec::Codec;
+    use ffmpeg_next::{codec, Dictionary};
+
+    /// libaom's encoder and FFmpeg's AV1 decoder.
+    #[derive(Debug, Clone, Copy)]
+    pub struct Libaom;
+
+    /// AV1 as the geometry-video picture codec.
+    pub(crate) const PICTURES: deep::Pictures<Libaom> = deep::Pictures(Libaom);
+
+    impl Flavour for Libaom {
+        fn name(&self) -> &'static str {
+            "av1"
+        }
+
+        fn codec(&self) -> Codec {
+            Codec::Av1
+        }
+
+        fn encoder_name(&self) -> &'static str {
+            "libaom-av1"
+        }
+
+        fn decoder_id(&self) -> codec::Id {
+            codec::Id::AV1
+        }
+
+        fn max_qp(&self) -> u8 {
+            MAX_QP
+        }
+
+        /// Constant quality at `crf` = the quantiser, key frames exactly every `gop` frames
+        /// (`keyint_min` = `g`), one tile, no row threads; P-frame groups look ahead and code hidden
+        /// alternate-reference frames, all-intra streams do not.
+        fn settings(&self, options: &deep::Options, gop: u32) -> Dictionary<'static> {
+            let mut dict = Dictionary::new();
+            dict.set("usage", "good");
+            dict.set("cpu-used", &CPU_USED.to_string());
+            dict.set("crf", &options.qp.to_string());
+            // libaom's constant-quality mode gives key frames a finer quantiser than `crf`, as x265's
+            // fixed QP does (its I/P ratio); pinning every frame to `crf` (`qmin` = `qmax`) measured
+            // 30 % more bits at equal error (CesiumMan, pixel step 5e-5: 5.06 bpvf at RMSE 2.43e-4
+            // with `crf` 12 pinned, 3.82 at 2.45e-4 with `crf` 32 free). These are libaom's own
+            // bounds: FFmpeg's generic defaults (2..31, MPEG-4's qscale range) would clamp every `crf`
+            // above 31 to 31 (measured: CesiumMan's rate and error stop changing from `crf` 32 up).
+            dict.set("qmin", "0");
+            dict.set("qmax", &MAX_QP.to_string());
+            dict.set("keyint_min", &gop.to_string());
+            let (lag, alt_ref) = if gop > 1 {
+                (LAG_IN_FRAMES, "1")
+            } else {
+                (0, "0")
+            };
+            dict.set("lag-in-frames", &lag.to_string());
+            dict.set("auto-alt-ref", alt_ref);
+            dict.set("arnr-strength", &ARNR_STRENGTH.to_string());
+            dict.set("row-mt", "0");
+            dict.set("tune", "psnr");
+            dict.set("aq-mode", "none");
+            dict
+        }
     }
 }
 
@@ -101,31 +244,79 @@ mod tests {
     use super::*;
 
     #[test]
-    fn deep_planes_round_trip_with_key_frames_every_gop() {
-        // crf 4 (qindex 16) is a step of about one level of an 8-bit picture.
-        deep::testing::round_trip(&Libaom, 4, 4);
-    }
-
-    #[test]
     fn the_automatic_depth_is_12_bits_from_quality_90() {
-        use crate::codec::geometry_video::PictureCodec;
-        use crate::encoder::EncodeOptions;
         let at = |quality, bit_depth| {
-            let opts = EncodeOptions {
-                codec: Codec::Av1,
-                quality,
+            let config = DeepConfig {
                 bit_depth,
-                ..EncodeOptions::default()
+                ..DeepConfig::default()
+            };
+            let rate = Rate {
+                quality,
+                step: None,
+                affine_precision: None,
+            };
+            let depth = |plan: RatePlan| match plan.coder {
+                crate::codec::rate::CoderPlan::Pictures(p) => p.depth,
+                crate::codec::rate::CoderPlan::Tdct => 0,
             };
             (
-                PICTURES.depth(&opts),
-                super::super::hevc::PICTURES.depth(&opts),
+                depth(plan(&config, &rate, 1.0).unwrap()),
+                depth(super::super::hevc::plan(&config, &rate, 1.0).unwrap()),
             )
         };
         assert_eq!(at(89, None), (10, 10));
         assert_eq!(at(90, None), (12, 12));
         assert_eq!(at(97, Some(10)), (10, 10));
         assert_eq!(at(50, Some(12)), (12, 12));
+    }
+
+    #[test]
+    fn the_crf_of_a_step_inverts_the_step_of_a_crf() {
+        for depth in [10, 12] {
+            for crf in 0..=63 {
+                let c = f64::from(crf);
+                let back = av1_crf_of(av1_log2_step(c, depth), depth);
+                assert!((back - c).abs() < 1e-9, "{crf} at {depth} bits");
+            }
+        }
+    }
+
+    #[test]
+    fn av1_quantiser_keeps_falling_up_to_quality_97_at_12_bits() {
+        // The former floor (`crf` 8) held every quality from 90 up at one `crf`.
+        let crfs: Vec<u8> = (90..=97).map(|q| av1_law(q, 12).quantiser).collect();
+        assert!(crfs[0] < 8, "{crfs:?}");
+        assert!(crfs[7] < crfs[0], "{crfs:?}");
+        assert!(crfs.iter().all(|&c| c >= AV1_MIN_QP), "{crfs:?}");
+    }
+
+    #[test]
+    fn affine_maps_are_finer_in_p_frame_groups_only() {
+        let rate = Rate {
+            quality: 50,
+            step: None,
+            affine_precision: None,
+        };
+        let code = |gop| {
+            let config = DeepConfig {
+                gop,
+                ..DeepConfig::default()
+            };
+            plan(&config, &rate, 1.0).unwrap().affine_precision
+        };
+        assert_eq!((code(1), code(50)), (4, 1));
+    }
+}
+
+#[cfg(all(test, feature = "ffmpeg"))]
+mod ffmpeg_tests {
+    use super::coder::*;
+    use crate::codec::pictures::deep;
+
+    #[test]
+    fn deep_planes_round_trip_with_key_frames_every_gop() {
+        // crf 4 (qindex 16) is a step of about one level of an 8-bit picture.
+        deep::testing::round_trip(&Libaom, 4, 4);
     }
 
     #[test]

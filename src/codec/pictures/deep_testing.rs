@@ -1,7 +1,9 @@
 //! What hevc's and av1's unit tests share: a smooth moving test pattern, a coder of planes and
 //! the checks both codecs pass.
 
-use super::*;
+use super::coder::*;
+use crate::codec::pictures::{PictureCodec, PictureSetup};
+use crate::geometry_image::{quantise, Plane};
 
 /// A smooth pattern moving with `t`, spanning most of the `depth`-bit range.
 pub fn ramp(width: u32, height: u32, t: u32, depth: u8) -> Plane<u16> {
@@ -99,10 +101,23 @@ pub fn bad_settings_are_errors<F: Flavour>(flavour: F, qp: u8) {
     assert!(encoder.encode(&Plane::filled(96, 32, 1024)).is_err());
     assert!(encoder.encode(&Plane::filled(48, 32, 0)).is_err());
     let name = flavour.name();
+    assert!(read_planes(name, &[]).is_err());
+    assert!(read_planes(name, &[2]).is_err());
+    assert!(read_planes(name, &[1, 0]).is_err());
+    assert_eq!(read_planes(name, &[1]).unwrap(), Planes::Yuv444);
+    assert_eq!(read_planes(name, &[0]).unwrap(), Planes::Mono);
+    let setup = |depth, codec_data| PictureSetup {
+        lattice: (32, 32),
+        quantiser: qp,
+        gop: 50,
+        depth,
+        padding: padding::Method::Cg,
+        charts: 1,
+        chart_pixels: 0,
+        codec_data,
+    };
     let pictures = Pictures(flavour);
-    assert!(pictures.depth_of_setup(&[]).is_err());
-    assert!(pictures.depth_of_setup(&[10]).is_err());
-    assert!(pictures.depth_of_setup(&[9, 0]).is_err());
-    assert!(pictures.depth_of_setup(&[10, 2]).is_err());
-    assert_eq!(read_setup(name, &[12, 1]).unwrap(), (12, Planes::Yuv444));
+    assert!(pictures.decoder(96, 32, &setup(12, vec![1])).is_ok());
+    assert!(pictures.decoder(96, 32, &setup(9, vec![1])).is_err());
+    assert!(pictures.decoder(96, 32, &setup(10, vec![2])).is_err());
 }

@@ -2,19 +2,20 @@
 //!
 //! Encoding builds the atlas on the decoded first frame, splats each frame's quantised residuals
 //! onto it, pads the free pixels, tiles x | y | z into one picture and hands the pictures to a
-//! [`PictureCodec`] (JPEG, MPEG-4). Its parts, in file order: the lattice coordinates (before the
-//! predictor's), then the residual ranges (pixel step, per-frame shifts and offsets, the
-//! correction list), the codec set-up, the frame index and the coded frames.
+//! [`PictureCodec`]. Its parts, in file order: the set-up ([`PictureSetup`]) and the lattice
+//! coordinates (the whole stream's, before the predictor's), then a segment's residual ranges
+//! (pixel step, per-frame shifts and offsets, the correction list), frame index and coded frames.
 //! Decoding reads the frames from the last key frame before the one asked for.
 
-use super::{Codec, StreamLayout};
-use super::{CodecParams, CodedResiduals, Plane, ResidualDecoder, ResidualEncoder, ResidualInput};
-use crate::encoder::EncodeOptions;
+use super::setup::PictureSetup;
+use super::{PictureCodec, PictureDecoder, PicturePlan, Plane};
+use crate::codec::{BandsDescription, Codec, Description, PicturesDescription};
+use crate::codec::{CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput, StreamLayout};
 use crate::error::{Error, Result};
-use crate::geometry_image::{
-    lattice, quantise, tile, Corrections, FrameRanges, GeometryImages, RangeMode,
-};
+use crate::geometry_image::lattice::AtlasCache;
+use crate::geometry_image::{lattice, quantise, tile, Corrections, FrameRanges, GeometryImages};
 use crate::mesh::Point;
+use crate::motion::Partition;
 use crate::progress::Progress;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
@@ -24,147 +25,63 @@ use rayon::prelude::*;
 use std::io::{Read, Seek};
 use std::time::Instant;
 
-/// What a picture codec (one file per codec) tells the geometry-video coder. `Sync`: groups of
-/// pictures are coded on several threads at once.
-pub trait PictureCodec: Sync {
-    /// The codec's stream id.
-    fn codec(&self) -> Codec;
-    /// How residual ranges are shared between frames.
-    fn range_mode(&self, opts: &EncodeOptions) -> RangeMode;
-    /// The padding this codec measured best with for an encoding with `opts` (its GOP).
-    fn default_padding(&self, opts: &EncodeOptions) -> padding::Method;
-    /// The pixel step as a multiple of the target step of `opts.quality`.
-    fn step_factor(&self, opts: &EncodeOptions) -> f64;
-    /// The picture codec's own quantiser (MPEG-4 qscale, JPEG quality, HEVC QP), recorded in the header.
-    fn quantiser(&self, opts: &EncodeOptions) -> u8;
-    /// Frames per group of pictures (1 for intra codecs).
-    fn gop(&self, opts: &EncodeOptions) -> u32;
-    /// Bits a sample of the pictures an encoding with `opts` makes (8 unless the codec codes deeper
-    /// samples).
-    fn depth(&self, _opts: &EncodeOptions) -> u8 {
-        8
-    }
-    /// Bits a sample of a stream's pictures, read from its codec set-up part.
-    fn depth_of_setup(&self, _setup: &[u8]) -> Result<u8> {
-        Ok(8)
-    }
-    /// An encoder for `width`×`height` pictures whose first picture is frame `first_frame` of the
-    /// sequence (a key frame: every group of pictures gets its own encoder).
-    fn encoder(
-        &self,
-        width: u32,
-        height: u32,
-        first_frame: usize,
-        opts: &EncodeOptions,
-    ) -> Result<Box<dyn PictureEncoder>>;
-    /// A decoder for `width`×`height` pictures; `setup` is the stream's codec set-up part.
-    fn decoder(&self, width: u32, height: u32, setup: &[u8]) -> Result<Box<dyn PictureDecoder>>;
-}
-
-/// Codes pictures in frame order.
-pub trait PictureEncoder {
-    /// Codes the next frame's picture (samples of the codec's depth).
-    fn push(&mut self, plane: &Plane<u16>) -> Result<()>;
-    /// Ends the sequence: the codec set-up part and one chunk per frame.
-    fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)>;
-}
-
-/// Decodes pictures, starting at a key frame and continuing in order.
-pub trait PictureDecoder {
-    /// Decodes frame `f` from its chunk.
-    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane<u16>>;
-}
-
-/// The padding an encoding uses: the option's, else the picture codec's measured best.
-pub fn padding_method(codec: &dyn PictureCodec, opts: &EncodeOptions) -> padding::Method {
-    opts.padding.unwrap_or(codec.default_padding(opts))
-}
-
-/// The residual images an encoding with `codec` makes of `input`'s residuals.
-pub fn images(codec: &dyn PictureCodec, input: &ResidualInput) -> Result<GeometryImages> {
-    let step = pixel_step(codec, input.diagonal, input.options)?;
-    let (reference, triangles) = (input.reference, input.mesh.triangles());
-    let build =
-        || lattice::build_atlas(reference, triangles, input.partition, input.options.lattice);
-    let atlas = match input.atlas {
+/// The residual images `plan` makes of `residuals` at pixel step `pixel_step` on the atlas of
+/// `reference`, `triangles` and `partition`, built afresh or taken from `atlas`.
+pub(crate) fn images(
+    (codec, plan): (&dyn PictureCodec, &PicturePlan),
+    pixel_step: f32,
+    (reference, triangles, partition): (&[Point], &[[u32; 3]], &Partition),
+    residuals: &[Vec<[f32; 3]>],
+    atlas: Option<&AtlasCache>,
+) -> Result<GeometryImages> {
+    let build = || lattice::build_atlas(reference, triangles, partition, plan.lattice);
+    let (size, atlas) = match atlas {
         Some(cache) => cache.get_or_build(build)?,
         None => build()?,
     };
-    Ok(images_on(
-        codec,
-        atlas,
-        input.residuals,
-        input.options,
-        step,
-    ))
-}
-
-/// One grey level of an encoding in model units: `opts.step` (a fraction of the first frame's
-/// bounding-box diagonal `diagonal`) or the law's for `opts.quality`, rounded to the `f32` the
-/// stream stores.
-pub fn pixel_step(codec: &dyn PictureCodec, diagonal: f64, opts: &EncodeOptions) -> Result<f32> {
-    super::quality::stored_step("pixel step", diagonal, opts, codec.step_factor(opts))
-}
-
-/// The residual images an encoding with `codec` and `opts` makes of `residuals` on the atlas of
-/// `reference`, `triangles` and `partition`, at `pixel_step`.
-pub fn images_of(
-    codec: &dyn PictureCodec,
-    reference: &[Point],
-    triangles: &[[u32; 3]],
-    partition: &crate::motion::Partition,
-    residuals: &[Vec<[f32; 3]>],
-    opts: &EncodeOptions,
-    pixel_step: f32,
-) -> Result<GeometryImages> {
-    let atlas = lattice::build_atlas(reference, triangles, partition, opts.lattice)?;
-    Ok(images_on(codec, atlas, residuals, opts, pixel_step))
-}
-
-/// The residual images of `residuals` on a built atlas (lattice size and atlas).
-fn images_on(
-    codec: &dyn PictureCodec,
-    (size, atlas): ((u16, u16), atlas::Atlas),
-    residuals: &[Vec<[f32; 3]>],
-    opts: &EncodeOptions,
-    pixel_step: f32,
-) -> GeometryImages {
-    GeometryImages::new(
+    Ok(GeometryImages::new(
         size,
         atlas,
         residuals,
-        (codec.range_mode(opts), codec.depth(opts)),
+        (plan.ranges(), plan.depth),
         pixel_step,
-        padding::PaddingOptions {
-            method: padding_method(codec, opts),
-            jpeg_quality: match codec.codec() {
-                Codec::Jpeg => codec.quantiser(opts),
-                _ => opts.quality,
-            },
-            jpeg_table: super::jpeg::TABLE,
-            ..padding::PaddingOptions::default()
-        },
-    )
+        codec.padding(plan),
+    ))
 }
 
-/// The geometry-video residual encoder over one picture codec.
-pub struct Encoder<P>(P);
+/// The geometry-video residual encoder over one picture codec, with the plan's settings.
+pub(crate) struct Encoder {
+    codec: &'static dyn PictureCodec,
+    plan: PicturePlan,
+    pixel_step: f32,
+}
 
-impl<P: PictureCodec> Encoder<P> {
-    /// The encoder for picture codec `codec`.
-    pub fn new(codec: P) -> Self {
-        Self(codec)
+impl Encoder {
+    /// The encoder of `plan` on `codec` at `pixel_step`.
+    pub fn new(codec: &'static dyn PictureCodec, plan: PicturePlan, pixel_step: f32) -> Self {
+        Self {
+            codec,
+            plan,
+            pixel_step,
+        }
     }
 }
 
-impl<P: PictureCodec> ResidualEncoder for Encoder<P> {
+impl ResidualEncoder for Encoder {
     fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals> {
         let clock = Instant::now();
-        let images = images(&self.0, input)?;
+        let shape = (input.reference, input.mesh.triangles(), input.partition);
+        let images = images(
+            (self.codec, &self.plan),
+            self.pixel_step,
+            shape,
+            input.residuals,
+            input.atlas,
+        )?;
         let atlas_seconds = clock.elapsed().as_secs_f64();
         let clock = Instant::now();
         input.progress.stage("images");
-        let (setup, chunks) = code_pictures(&self.0, &images, input)?;
+        let (codec_data, chunks) = code_pictures(self, &images, input)?;
         let images_seconds = clock.elapsed().as_secs_f64();
         let mut ranges = ByteWriter::new();
         quantise::write_ranges(images.pixel_step, &images.ranges, &mut ranges);
@@ -175,19 +92,23 @@ impl<P: PictureCodec> ResidualEncoder for Encoder<P> {
             images.lattice,
             input.mesh.triangles(),
         )?;
-        let opts = input.options;
+        let stats = images.atlas.stats().clone();
+        let setup = PictureSetup {
+            lattice: images.lattice,
+            quantiser: self.plan.quantiser,
+            gop: u32::try_from(self.plan.gop).unwrap_or(u32::MAX),
+            depth: self.plan.depth,
+            padding: images.padding.method,
+            charts: stats.charts as u32,
+            chart_pixels: stats.chart_pixels as u32,
+            codec_data,
+        };
         Ok(CodedResiduals {
-            params: CodecParams {
-                lattice: images.lattice,
-                qscale: self.0.quantiser(opts),
-                gop: self.0.gop(opts),
-                padding: images.padding.method.to_string(),
-            },
-            atlas: Some(images.atlas.stats().clone()),
+            setup: setup.to_bytes(),
+            atlas: Some(stats),
             before_predictor: vec![Part::whole(Tag::LATTICE, lattice_part)],
             after_predictor: vec![
                 Part::whole(Tag::RANGES, ranges.into_bytes()),
-                Part::whole(Tag::CODEC_SETUP, setup),
                 Part::whole(Tag::FRAME_INDEX, index.to_bytes()),
                 Part {
                     tag: Tag::FRAMES,
@@ -209,7 +130,7 @@ impl<P: PictureCodec> ResidualEncoder for Encoder<P> {
 /// afresh), so they run on rayon's threads; each gets its own picture encoder and the chunks are
 /// joined in frame order. The encoders' set-up parts must agree, as one encoder's frames do.
 fn code_pictures(
-    codec: &dyn PictureCodec,
+    coder: &Encoder,
     images: &GeometryImages,
     input: &ResidualInput,
 ) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
@@ -221,7 +142,7 @@ fn code_pictures(
         .collect();
     let coded: Vec<Result<(Vec<u8>, Vec<FrameChunk>)>> = groups
         .into_par_iter()
-        .map(|group| code_group(codec, images, input, group))
+        .map(|group| code_group(coder, images, input, group))
         .collect();
     let mut setup: Option<Vec<u8>> = None;
     let mut chunks = Vec::with_capacity(frames);
@@ -232,7 +153,7 @@ fn code_pictures(
             Some(s) if *s != group_setup => {
                 return Err(Error::Codec(format!(
                     "the {} encoders of two groups of pictures gave different set-ups",
-                    codec.codec().name()
+                    coder.plan.codec.name()
                 )))
             }
             Some(_) => {}
@@ -242,7 +163,7 @@ fn code_pictures(
     if chunks.len() != frames {
         return Err(Error::Codec(format!(
             "the {} encoder gave {} pictures for {} frames",
-            codec.codec().name(),
+            coder.plan.codec.name(),
             chunks.len(),
             frames
         )));
@@ -252,13 +173,16 @@ fn code_pictures(
 
 /// Pads, tiles and codes the frames of one group of pictures in order, from its key frame.
 fn code_group(
-    codec: &dyn PictureCodec,
+    coder: &Encoder,
     images: &GeometryImages,
     input: &ResidualInput,
     group: std::ops::Range<usize>,
 ) -> Result<(Vec<u8>, Vec<FrameChunk>)> {
     let (w, h) = (images.lattice.0 as usize, images.lattice.1 as usize);
-    let mut encoder = codec.encoder((3 * w) as u32, h as u32, group.start, input.options)?;
+    let (width, height) = ((3 * w) as u32, h as u32);
+    let mut encoder = coder
+        .codec
+        .encoder(width, height, group.start, &coder.plan)?;
     let mut previous: Option<[Vec<f32>; 3]> = None;
     for f in group {
         let prev = previous.as_ref().filter(|_| images.continues(f));
@@ -276,7 +200,7 @@ fn code_group(
 }
 
 /// The geometry-image side of a stream: what the decoder reads before any picture.
-pub struct ImageLayout {
+pub(crate) struct ImageLayout {
     /// Lattice pixel of every vertex.
     pub pixels: Vec<[u16; 2]>,
     /// One grey level in model units, before any frame's shift.
@@ -287,34 +211,45 @@ pub struct ImageLayout {
     pub corrections: Corrections,
     /// Where each frame's picture lies.
     pub index: FrameIndex,
-    /// The codec set-up part.
-    pub setup: Vec<u8>,
+    /// The stream's set-up: lattice, quantiser, groups, depth, padding, the codec's own bytes.
+    pub setup: PictureSetup,
+}
+
+impl ImageLayout {
     /// Lattice width and height.
-    pub lattice: (u16, u16),
+    pub fn lattice(&self) -> (u16, u16) {
+        self.setup.lattice
+    }
+
     /// Bits a sample of the pictures.
-    pub depth: u8,
+    pub fn depth(&self) -> u8 {
+        self.setup.depth
+    }
 }
 
 /// The geometry-video residual decoder over one picture codec.
-pub struct Decoder<P> {
-    codec: P,
+pub(crate) struct Decoder {
+    codec: Codec,
+    pictures: &'static dyn PictureCodec,
     layout: ImageLayout,
 }
 
-impl<P: PictureCodec> Decoder<P> {
-    /// Reads the lattice coordinates, ranges, codec set-up and frame index.
+impl Decoder {
+    /// Reads the set-up (`setup`, the payload of its part), lattice coordinates, ranges and frame
+    /// index of `codec`'s stream, whose pictures `pictures` decodes.
     pub fn open<R: Read + Seek>(
-        codec: P,
+        (codec, pictures): (Codec, &'static dyn PictureCodec),
+        setup: &[u8],
         stream: &StreamLayout,
         reader: &mut ContainerReader<R>,
     ) -> Result<Self> {
         let h = stream.header;
         let (v, frames) = (h.vertices as usize, h.frames as usize);
-        let lattice = (h.lattice_width, h.lattice_height);
+        let setup = PictureSetup::from_bytes(setup, h.vertices)?;
+        let lattice = setup.lattice;
         let pixels =
             side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, stream.triangles)?;
-        let setup = reader.part(Tag::CODEC_SETUP)?;
-        let depth = codec.depth_of_setup(&setup)?;
+        let depth = setup.depth;
         let ranges_bytes = reader.part(Tag::RANGES)?;
         let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
         let (pixel_step, ranges) = quantise::read_ranges(&mut r, frames, depth)?;
@@ -324,6 +259,7 @@ impl<P: PictureCodec> Decoder<P> {
         let index = FrameIndex::from_bytes(&reader.part(Tag::FRAME_INDEX)?, frames, images_len)?;
         Ok(Self {
             codec,
+            pictures,
             layout: ImageLayout {
                 pixels,
                 pixel_step,
@@ -331,22 +267,18 @@ impl<P: PictureCodec> Decoder<P> {
                 corrections,
                 index,
                 setup,
-                lattice,
-                depth,
             },
         })
     }
 
     fn picture_size(&self) -> (u32, u32) {
-        (
-            3 * u32::from(self.layout.lattice.0),
-            u32::from(self.layout.lattice.1),
-        )
+        let (w, h) = self.layout.lattice();
+        (3 * u32::from(w), u32::from(h))
     }
 
     fn picture_decoder(&self) -> Result<Box<dyn PictureDecoder>> {
         let (w, h) = self.picture_size();
-        self.codec.decoder(w, h, &self.layout.setup)
+        self.pictures.decoder(w, h, &self.layout.setup)
     }
 
     fn next_picture<R: Read + Seek>(
@@ -369,7 +301,7 @@ impl<P: PictureCodec> Decoder<P> {
                 plane.width, plane.height
             )));
         }
-        let lw = self.layout.lattice.0 as usize;
+        let lw = self.layout.lattice().0 as usize;
         let mut residuals = vec![[0.0f32; 3]; frame.len()];
         for a in 0..3 {
             let levels = tile::sample(plane, a, lw, &self.layout.pixels);
@@ -392,7 +324,7 @@ impl<P: PictureCodec> Decoder<P> {
     }
 }
 
-impl<P: PictureCodec, R: Read + Seek> ResidualDecoder<R> for Decoder<P> {
+impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
     fn add_frame(
         &mut self,
         reader: &mut ContainerReader<R>,
@@ -416,6 +348,28 @@ impl<P: PictureCodec, R: Read + Seek> ResidualDecoder<R> for Decoder<P> {
             progress.frames(1);
         }
         Ok(())
+    }
+
+    fn describe(&self) -> Description {
+        let setup = &self.layout.setup;
+        let settings = self
+            .pictures
+            .settings(setup.quantiser, setup.gop, setup.depth);
+        Description {
+            codec: self.codec,
+            settings,
+            pictures: Some(PicturesDescription {
+                lattice: setup.lattice,
+                bit_depth: setup.depth,
+                charts: setup.charts,
+                packing_efficiency: setup.packing_efficiency(),
+                padding: setup.padding.name(),
+                corrections: (0..self.layout.ranges.len())
+                    .map(|f| self.layout.corrections.frame(f).len() as u32)
+                    .collect(),
+            }),
+            bands: None::<BandsDescription>,
+        }
     }
 
     fn images(&self) -> Option<&ImageLayout> {

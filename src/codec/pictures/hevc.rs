@@ -1,5 +1,5 @@
 //! HEVC (H.265) at 10 or 12 bits a sample: FFmpeg's `libx265` encoder and its native `hevc`
-//! decoder, through `ffmpeg-next` (cargo feature `mpeg4`, which brings FFmpeg); the encoder,
+//! decoder, through `ffmpeg-next` (cargo feature `ffmpeg`); the encoder,
 //! decoder and set-up part are [`super::deep`]'s, shared with AV1.
 //!
 //! The x | y | z picture is coded as the three planes of a 4:4:4 picture (`yuv444p10le`,
@@ -18,69 +18,121 @@
 //! The stream's codec set-up part holds the sample depth and the planes (one byte each), which the
 //! decoder needs before any picture (the depth to read the residual ranges).
 
-use super::deep::{self, Flavour};
-use super::{Codec, PictureLaw};
-use ffmpeg_next::{codec, Dictionary};
+use super::deep::DeepConfig;
+use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
+use crate::codec::Codec;
+use crate::error::Result;
+use crate::motion::DEFAULT_AFFINE_PRECISION;
 
-pub use super::deep::{Packet, Planes, DEFAULT_PLANES, DEPTHS};
+#[cfg(feature = "ffmpeg")]
+pub(crate) use coder::PICTURES;
+#[cfg(feature = "ffmpeg")]
+pub use coder::X265;
 
 /// The largest QP x265 takes.
 pub const MAX_QP: u8 = 51;
 
-/// Encoder settings.
-pub type HevcOptions = deep::Options;
+/// Fails, naming the option, when one of `config` is out of range for HEVC.
+pub(crate) fn check(config: &DeepConfig) -> Result<()> {
+    config.check(Codec::Hevc, MAX_QP)
+}
 
-/// libx265 and FFmpeg's `hevc` decoder.
-#[derive(Debug, Clone, Copy)]
-pub struct X265;
+/// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: [`hevc_law`], affine
+/// maps at a quarter of the residual step in P-frame groups too (docs/design.md, "Affine
+/// precision per codec").
+pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
+    let law = (
+        hevc_law as fn(u8, u8) -> PictureLaw,
+        DEFAULT_AFFINE_PRECISION,
+    );
+    config.plan(Codec::Hevc, law, rate, diagonal)
+}
 
-/// HEVC as the geometry-video picture codec.
-pub const PICTURES: deep::Pictures<X265> = deep::Pictures(X265);
+/// HEVC's law at 10 bits a sample: a pixel step of [`HEVC_STEP_FACTOR`] × the target step and the
+/// QP that follows the target step, 6 per halving ([`HEVC_QP_AT_50`] at quality 50), between
+/// [`HEVC_MIN_QP`] and 51; beyond them the pixel step takes the rest. At equal error the rate
+/// hardly depends on how pixel step and QP share it, except that QPs under 10 cost more than a
+/// finer pixel step; quality 50 lands on MPEG-4's error at quality 50 (docs/design.md, "Quality
+/// laws").
+pub const HEVC_STEP_FACTOR: f64 = 0.02;
+/// The QP of quality 50 at 10 bits a sample.
+pub const HEVC_QP_AT_50: f64 = 28.0;
+/// The lowest QP the law uses at 10 bits a sample.
+pub const HEVC_MIN_QP: f64 = 10.0;
 
-impl Flavour for X265 {
-    fn name(&self) -> &'static str {
-        "hevc"
-    }
-
-    fn codec(&self) -> Codec {
-        Codec::Hevc
-    }
-
-    fn encoder_name(&self) -> &'static str {
-        "libx265"
-    }
-
-    fn decoder_id(&self) -> codec::Id {
-        codec::Id::HEVC
-    }
-
-    fn max_qp(&self) -> u8 {
-        MAX_QP
-    }
-
-    fn law(&self, quality: u8, depth: u8) -> PictureLaw {
-        super::hevc_law(quality, depth)
-    }
-
-    /// `x265-params` of a fixed QP, IDR frames every `gop` frames, no B-frames, scene cuts or open
-    /// GOPs, headers on every IDR, no thread pool and one frame thread.
-    fn settings(&self, options: &deep::Options, gop: u32) -> Dictionary<'static> {
-        let mut dict = Dictionary::new();
-        dict.set("preset", "medium");
-        dict.set("tune", "psnr");
-        let params = format!(
-            "qp={qp}:keyint={gop}:min-keyint={gop}:scenecut=0:open-gop=0:bframes=0:\
-             repeat-headers=1:info=0:pools=none:frame-threads=1:log-level=error",
-            qp = options.qp
-        );
-        dict.set("x265-params", &params);
-        dict
+/// HEVC's pixel step factor and QP for a user quality 1..100 at `depth` bits a sample. A deeper
+/// sample takes the same pixel step and a QP 6 lower per bit over 10: HEVC's QP is relative to the
+/// sample range, so this is the same quantiser step in model units; what 12 bits add is a finer
+/// rounding of the samples. The QP stops at 0.
+pub fn hevc_law(quality: u8, depth: u8) -> PictureLaw {
+    let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
+    let deeper = 6.0 * (f64::from(depth) - 10.0);
+    let exact = HEVC_QP_AT_50 + 6.0 * scale.log2() - deeper;
+    let qp = exact.round().clamp((HEVC_MIN_QP - deeper).max(0.0), 51.0);
+    let beyond = if exact.round() == qp { 0.0 } else { exact - qp };
+    PictureLaw {
+        step_factor: HEVC_STEP_FACTOR * 2f64.powf(beyond / 6.0),
+        quantiser: qp as u8,
     }
 }
 
-#[cfg(test)]
+/// libx265 as a [`deep::Flavour`].
+#[cfg(feature = "ffmpeg")]
+mod coder {
+    use super::super::deep::{self, Flavour};
+    use super::MAX_QP;
+    use crate::codec::Codec;
+    use ffmpeg_next::{codec, Dictionary};
+
+    /// libx265 and FFmpeg's `hevc` decoder.
+    #[derive(Debug, Clone, Copy)]
+    pub struct X265;
+
+    /// HEVC as the geometry-video picture codec.
+    pub(crate) const PICTURES: deep::Pictures<X265> = deep::Pictures(X265);
+
+    impl Flavour for X265 {
+        fn name(&self) -> &'static str {
+            "hevc"
+        }
+
+        fn codec(&self) -> Codec {
+            Codec::Hevc
+        }
+
+        fn encoder_name(&self) -> &'static str {
+            "libx265"
+        }
+
+        fn decoder_id(&self) -> codec::Id {
+            codec::Id::HEVC
+        }
+
+        fn max_qp(&self) -> u8 {
+            MAX_QP
+        }
+
+        /// `x265-params` of a fixed QP, IDR frames every `gop` frames, no B-frames, scene cuts or open
+        /// GOPs, headers on every IDR, no thread pool and one frame thread.
+        fn settings(&self, options: &deep::Options, gop: u32) -> Dictionary<'static> {
+            let mut dict = Dictionary::new();
+            dict.set("preset", "medium");
+            dict.set("tune", "psnr");
+            let params = format!(
+                "qp={qp}:keyint={gop}:min-keyint={gop}:scenecut=0:open-gop=0:bframes=0:\
+                 repeat-headers=1:info=0:pools=none:frame-threads=1:log-level=error",
+                qp = options.qp
+            );
+            dict.set("x265-params", &params);
+            dict
+        }
+    }
+}
+
+#[cfg(all(test, feature = "ffmpeg"))]
 mod tests {
-    use super::*;
+    use super::coder::*;
+    use crate::codec::pictures::deep;
 
     #[test]
     fn deep_planes_round_trip_with_idr_frames_every_gop() {

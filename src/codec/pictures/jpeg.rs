@@ -7,10 +7,11 @@
 //! the same bytes decode to the same samples on every machine. JPEG decoders legitimately differ by ±1
 //! (IDCT rounding); the encoder and decoder of mcgv must use this one function to agree exactly.
 
-use super::geometry_video::{PictureCodec, PictureDecoder, PictureEncoder};
-use super::{abbreviated, Codec, Plane};
-use crate::encoder::EncodeOptions;
-use crate::geometry_image::RangeMode;
+use super::{abbreviated, PictureCodec, PictureDecoder, PictureEncoder, PictureOptions, Plane};
+use super::{PicturePlan, PictureSetup, Resolved};
+use crate::codec::rate::{anchor, read_law, Anchor, PictureLaw, Rate, RatePlan};
+use crate::codec::Codec;
+use crate::motion::DEFAULT_AFFINE_PRECISION;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::frame_index::FrameChunk;
 use crate::{Error, Result};
@@ -107,36 +108,75 @@ fn side_u16(width: u32, height: u32) -> Result<(u16, u16)> {
     }
 }
 
+/// JPEG's options: its own quality, and the lattice and padding of its pictures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct JpegConfig {
+    /// JPEG's own quality 1..=100 for the residual pictures; `None` takes the law's for the
+    /// encoding's quality.
+    pub quality: Option<u8>,
+    /// The lattice and padding (default `snap`).
+    pub pictures: PictureOptions,
+}
+
+impl JpegConfig {
+    /// Fails, naming the option, when one is out of range.
+    pub(crate) fn check(&self) -> Result<()> {
+        if self.quality.is_some_and(|q| !(1..=100).contains(&q)) {
+            return Err(Error::option("jpeg_quality", "must be between 1 and 100"));
+        }
+        self.pictures.check(Codec::Jpeg)
+    }
+
+    /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: the law's pixel
+    /// step, every frame its own key frame and ranges, `snap` padding at the JPEG quality.
+    pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
+        let law = jpeg_law(rate.quality);
+        let plan = PicturePlan {
+            codec: Codec::Jpeg,
+            quantiser: self.quality.unwrap_or(law.quantiser),
+            gop: 1,
+            depth: 8,
+            padding: padding::Method::Snap,
+            lattice: self.pictures.lattice,
+        };
+        let resolved = Resolved {
+            step_factor: law.step_factor,
+            affine_precision: DEFAULT_AFFINE_PRECISION,
+            plan,
+        };
+        super::plan(rate, diagonal, &self.pictures, resolved)
+    }
+}
+
+/// JPEG's law, read off the lower hull of (bpvf, vertex RMSE) over pixel step × JPEG quality on
+/// the smallest lattice the charts fit: the error follows about the square root of the pixel
+/// step, so the factor falls as the quality rises; JPEG quality 90 from quality 75 on (measured in
+/// docs/design.md, "Quality laws").
+const JPEG_LAW: [Anchor; 4] = [
+    anchor(1, 1.25, 75),
+    anchor(50, 0.25, 75),
+    anchor(75, 0.4, 90),
+    anchor(90, 0.2, 90),
+];
+
+/// JPEG's pixel step factor and JPEG quality for a user quality 1..100.
+pub fn jpeg_law(quality: u8) -> PictureLaw {
+    read_law(&JPEG_LAW, quality)
+}
+
 /// JPEG as the geometry-video picture codec: every frame a key frame, the tables every frame
 /// shares stored once in the codec set-up part ([`super::abbreviated`]).
-pub struct Pictures;
+pub(crate) struct Pictures;
 
 impl PictureCodec for Pictures {
-    fn codec(&self) -> Codec {
-        Codec::Jpeg
-    }
-
-    fn range_mode(&self, _opts: &EncodeOptions) -> RangeMode {
-        RangeMode::PerFrame
-    }
-
-    /// `snap`, tuned to JPEG's quantiser at the stream's quality (padding/README.md).
-    fn default_padding(&self, _opts: &EncodeOptions) -> padding::Method {
-        padding::Method::Snap
-    }
-
-    fn step_factor(&self, opts: &EncodeOptions) -> f64 {
-        super::jpeg_law(opts.quality).step_factor
-    }
-
-    /// The JPEG quality: the option's, else the law's for `quality`.
-    fn quantiser(&self, opts: &EncodeOptions) -> u8 {
-        opts.jpeg_quality
-            .unwrap_or_else(|| super::jpeg_law(opts.quality).quantiser)
-    }
-
-    fn gop(&self, _opts: &EncodeOptions) -> u32 {
-        1
+    /// `snap` quantises as JPEG will: at the picture's JPEG quality, with its table.
+    fn padding(&self, plan: &PicturePlan) -> padding::PaddingOptions {
+        padding::PaddingOptions {
+            method: plan.padding,
+            jpeg_quality: plan.quantiser,
+            jpeg_table: TABLE,
+            ..padding::PaddingOptions::default()
+        }
     }
 
     fn encoder(
@@ -144,20 +184,29 @@ impl PictureCodec for Pictures {
         _width: u32,
         _height: u32,
         _first_frame: usize,
-        opts: &EncodeOptions,
+        plan: &PicturePlan,
     ) -> Result<Box<dyn PictureEncoder>> {
         Ok(Box::new(FrameEncoder {
-            quality: self.quantiser(opts),
+            quality: plan.quantiser,
             shared: None,
             chunks: Vec::new(),
         }))
     }
 
-    fn decoder(&self, width: u32, height: u32, setup: &[u8]) -> Result<Box<dyn PictureDecoder>> {
+    fn settings(&self, quantiser: u8, _gop: u32, _depth: u8) -> Vec<(&'static str, u32)> {
+        vec![("jpeg_quality", quantiser.into())]
+    }
+
+    fn decoder(
+        &self,
+        width: u32,
+        height: u32,
+        setup: &PictureSetup,
+    ) -> Result<Box<dyn PictureDecoder>> {
         Ok(Box::new(FrameDecoder {
             width,
             height,
-            setup: setup.to_vec(),
+            setup: setup.codec_data.clone(),
         }))
     }
 }

@@ -1,28 +1,196 @@
 //! The picture path: residuals as geometry images coded by a picture codec.
 //!
 //! [`geometry_video`] splats each frame's residuals onto a multi-chart atlas, pads and tiles them
-//! into one picture per frame and hands the pictures to a [`geometry_video::PictureCodec`]: JPEG
-//! ([`jpeg`], every frame alone), or through FFmpeg (cargo feature `ffmpeg`) MPEG-4 Part 2
-//! ([`mpeg4`]) and HEVC and AV1 at 10 or 12 bits a sample ([`hevc`], [`av1`], sharing [`deep`]).
+//! into one picture per frame and hands the pictures to a [`PictureCodec`]: JPEG ([`jpeg`], every
+//! frame alone), or through FFmpeg (cargo feature `ffmpeg`) MPEG-4 Part 2 ([`mpeg4`]) and HEVC and
+//! AV1 at 10 or 12 bits a sample ([`hevc`], [`av1`], sharing [`deep`]). Each codec's file holds its
+//! configuration, its quality law and its coder; what they share — the lattice and padding options
+//! and the resolved [`PicturePlan`] — is here.
 
 pub mod abbreviated;
-#[cfg(feature = "ffmpeg")]
 pub mod av1;
-#[cfg(feature = "ffmpeg")]
 pub mod deep;
 pub mod geometry_video;
-#[cfg(feature = "ffmpeg")]
 pub mod hevc;
 pub mod jpeg;
 #[cfg(feature = "ffmpeg")]
 mod libav;
-#[cfg(feature = "ffmpeg")]
 pub mod mpeg4;
+mod setup;
 
-use super::quality::jpeg_law;
-use super::quality::{self, PictureLaw};
-#[cfg(feature = "ffmpeg")]
-use super::quality::{av1_law, hevc_law, mpeg4_law};
-use super::StreamLayout;
-use super::{Codec, CodecParams, CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
+use super::rate::{CoderPlan, Rate, RatePlan};
+use super::Codec;
+use crate::error::{Error, Result};
 pub use crate::geometry_image::Plane;
+use crate::geometry_image::{lattice, Lattice, RangeMode};
+use crate::stream::frame_index::FrameChunk;
+pub(crate) use setup::PictureSetup;
+
+/// Frames per group of pictures of the video codecs unless asked otherwise.
+pub const DEFAULT_GOP: usize = 50;
+
+/// The options every picture codec's configuration holds: the lattice its geometry images are
+/// laid on and how their free pixels are filled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PictureOptions {
+    /// Lattice width and height, or chosen from the mesh (the smallest the charts fit).
+    pub lattice: Lattice,
+    /// How free pixels are filled; `None` takes the codec's measured best.
+    pub padding: Option<padding::Method>,
+}
+
+impl PictureOptions {
+    /// Fails, naming the option, on a lattice the stream cannot carry, or on `snap` padding for a
+    /// codec that is not JPEG (it models JPEG's quantiser at the picture's quality).
+    pub(crate) fn check(&self, codec: Codec) -> Result<()> {
+        if let Lattice::Fixed(w, h) = self.lattice {
+            lattice::check(w, h)?;
+        }
+        if self.padding == Some(padding::Method::Snap) && codec != Codec::Jpeg {
+            return Err(Error::option(
+                "padding",
+                format!(
+                    "snap models JPEG's quantiser and applies to the jpeg codec only, not {}",
+                    codec.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A picture codec's settings for one encoding, resolved from its configuration and the quality.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PicturePlan {
+    /// Which picture codec.
+    pub codec: Codec,
+    /// The codec's own quantiser: JPEG quality, MPEG-4 qscale, HEVC QP or AV1 `crf`.
+    pub quantiser: u8,
+    /// Frames per group of pictures: a key frame, then P-frames (1: every frame alone).
+    pub gop: usize,
+    /// Bits a sample of the pictures.
+    pub depth: u8,
+    /// How free pixels are filled.
+    pub padding: padding::Method,
+    /// The lattice option.
+    pub lattice: Lattice,
+}
+
+impl PicturePlan {
+    /// How residual ranges are shared: by the frames of a group of pictures, so that P-frames
+    /// predict like from like (one frame a group for intra coding).
+    pub fn ranges(&self) -> RangeMode {
+        match self.gop {
+            0 | 1 => RangeMode::PerFrame,
+            n => RangeMode::PerGroup(n),
+        }
+    }
+}
+
+/// What a picture codec's configuration resolves before the shared part of its plan.
+pub(crate) struct Resolved {
+    /// The pixel step as a multiple of the quality's target step.
+    pub step_factor: f64,
+    /// The affine precision the codec measured best, unless the caller asks another.
+    pub affine_precision: f64,
+    /// The codec's settings; its `padding` method is the default, replaced by the caller's.
+    pub plan: PicturePlan,
+}
+
+/// The rate plan of a picture codec: its pixel step from the law's factor, its padding (the
+/// caller's or the codec's default).
+pub(crate) fn plan(
+    rate: &Rate,
+    diagonal: f64,
+    options: &PictureOptions,
+    resolved: Resolved,
+) -> Result<RatePlan> {
+    let step = rate.stored_step("pixel step", diagonal, resolved.step_factor)?;
+    let mut plan = resolved.plan;
+    plan.lattice = options.lattice;
+    plan.padding = options.padding.unwrap_or(plan.padding);
+    Ok(rate.plan(step, resolved.affine_precision, CoderPlan::Pictures(plan)))
+}
+
+/// What a picture codec (one file per codec) tells the geometry-video coder. `Sync`: groups of
+/// pictures are coded on several threads at once.
+pub(crate) trait PictureCodec: Sync {
+    /// The padding options of the pictures `plan` codes: a method that models the codec's
+    /// quantiser is given it.
+    fn padding(&self, plan: &PicturePlan) -> padding::PaddingOptions {
+        padding::PaddingOptions::with_method(plan.padding)
+    }
+    /// The codec's settings as reports name them (its options' names), from its quantiser, its
+    /// frames per group and its bits a sample.
+    fn settings(&self, quantiser: u8, gop: u32, depth: u8) -> Vec<(&'static str, u32)>;
+    /// An encoder for `width`×`height` pictures whose first picture is frame `first_frame` of the
+    /// sequence (a key frame: every group of pictures gets its own encoder).
+    fn encoder(
+        &self,
+        width: u32,
+        height: u32,
+        first_frame: usize,
+        plan: &PicturePlan,
+    ) -> Result<Box<dyn PictureEncoder>>;
+    /// A decoder for `width`×`height` pictures of a stream with set-up `setup`.
+    fn decoder(
+        &self,
+        width: u32,
+        height: u32,
+        setup: &PictureSetup,
+    ) -> Result<Box<dyn PictureDecoder>>;
+}
+
+/// Codes pictures in frame order.
+pub(crate) trait PictureEncoder {
+    /// Codes the next frame's picture (samples of the codec's depth).
+    fn push(&mut self, plane: &Plane<u16>) -> Result<()>;
+    /// Ends the sequence: the codec's own bytes of the set-up part, and one chunk per frame.
+    fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)>;
+}
+
+/// Decodes pictures, starting at a key frame and continuing in order.
+pub(crate) trait PictureDecoder {
+    /// Decodes frame `f` from its chunk.
+    fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane<u16>>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::av1::{av1_law, AV1_MAX_QP, AV1_QP_AT_50, AV1_STEP_FACTOR};
+    use super::hevc::{hevc_law, HEVC_QP_AT_50};
+    use super::jpeg::jpeg_law;
+    use super::mpeg4::mpeg4_law;
+    use crate::codec::rate::{target_step, PictureLaw};
+
+    #[test]
+    fn pixel_steps_fall_and_quantisers_do_not_coarsen_with_quality() {
+        let hevc10 = |q| hevc_law(q, 10);
+        let hevc12 = |q| hevc_law(q, 12);
+        let av1_10 = |q| av1_law(q, 10);
+        let av1_12 = |q| av1_law(q, 12);
+        for law in [jpeg_law, mpeg4_law, hevc10, hevc12, av1_10, av1_12] {
+            for q in 1..100u8 {
+                let (a, b) = (law(q), law(q + 1));
+                let step = |l: PictureLaw, q| l.step_factor * target_step(q, 1.0);
+                assert!(step(b, q + 1) <= step(a, q), "pixel step grows at {q}");
+            }
+        }
+        for q in 1..100u8 {
+            assert!(jpeg_law(q + 1).quantiser >= jpeg_law(q).quantiser);
+            assert!(mpeg4_law(q + 1).quantiser <= mpeg4_law(q).quantiser);
+            assert!((1..=31).contains(&mpeg4_law(q).quantiser));
+            assert!(hevc_law(q + 1, 10).quantiser <= hevc_law(q, 10).quantiser);
+            assert!(hevc_law(q, 12).quantiser <= 51);
+            assert!(av1_law(q + 1, 10).quantiser <= av1_law(q, 10).quantiser);
+            assert!(av1_law(q, 10).quantiser <= 63);
+        }
+        assert_eq!(hevc_law(50, 10).quantiser, HEVC_QP_AT_50 as u8);
+        assert_eq!(hevc_law(50, 12).quantiser, HEVC_QP_AT_50 as u8 - 12);
+        assert_eq!(av1_law(50, 10).quantiser, AV1_QP_AT_50);
+        // The 12-bit crf of quality 50 has a quarter of the 10-bit step (700 / 4 = 175: crf 11).
+        assert_eq!(av1_law(50, 12).quantiser, 11);
+        assert_eq!(av1_law(10, 10).quantiser, AV1_MAX_QP);
+        assert!(av1_law(10, 10).step_factor > AV1_STEP_FACTOR);
+    }
+}

@@ -39,12 +39,6 @@ const SIGNS: usize = 3;
 /// f64 → i64 conversion or the decoder's dequantisation lose meaning.
 pub(super) const MAX_LEVEL: f64 = (1u64 << 40) as f64;
 
-/// The quantiser step for `--quality`: Δ = D · 1e-3 · s(q) / 100, with D the first frame's
-/// bounding-box diagonal and s the IJG scale law (see [`crate::codec::ijg_scale_percent`]).
-pub fn step_for_quality(quality: u8, diagonal: f64) -> f64 {
-    crate::codec::quality::target_step(quality, diagonal)
-}
-
 /// Rate–distortion rounding of the levels (encoder only; the decoder reads levels as ever): each
 /// level is chosen among the two integers nearest the coefficient and zero by the squared error
 /// in steps plus `lambda` × the bits the adaptive model would spend on it now.

@@ -11,11 +11,13 @@ pub mod index;
 pub mod spatial;
 pub mod transform;
 
+use super::rate::{CoderPlan, Rate, RatePlan};
 use super::StreamLayout;
-use super::{CodecParams, CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
-use crate::encoder::EncodeOptions;
+use super::{BandsDescription, Codec, Description};
+use super::{CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
 use crate::error::{Error, Result};
-use crate::mesh::{AnimatedMesh, Point};
+use crate::mesh::Point;
+use crate::motion::DEFAULT_AFFINE_PRECISION;
 use crate::progress::Progress;
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
 use coefficients::{BandCoder, Rounding};
@@ -25,7 +27,7 @@ use std::io::{Read, Seek};
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use coefficients::{step_for_quality, DEAD_ZONE};
+pub use coefficients::DEAD_ZONE;
 
 /// The price of a bit, in squared steps, of the encoder's rate–distortion rounding
 /// ([`Rounding`]). Coefficient bytes at equal vertex RMSE against the dead-zone quantiser
@@ -37,26 +39,35 @@ pub use coefficients::{step_for_quality, DEAD_ZONE};
 /// walking_cat, −3.2 to −3.8 % horse-collapse, −3.4 to −5.5 % pcow.
 pub const ROUNDING_LAMBDA: f64 = 0.1;
 
-/// The absolute quantiser step of an encoding: `step` (a fraction of the first frame's
-/// bounding-box diagonal) or the one `quality` maps to, rounded to the `f32` the stream stores, so
-/// that the encoder quantises with exactly the step the decoder reads.
-pub fn step(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<f32> {
-    step_of_diagonal(mesh.bbox_diagonal(), opts)
+/// The version of the temporal DCT's set-up part (its only byte: the step and the bands are a
+/// segment's own, in its band index).
+const SETUP_VERSION: u8 = 1;
+
+/// The temporal DCT's options: none of its own yet (the step is every codec's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub struct TdctConfig {}
+
+impl TdctConfig {
+    /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: the quality's
+    /// target step is the quantiser step; affine maps at a quarter of it.
+    pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
+        let step = rate.stored_step("temporal-DCT step", diagonal, 1.0)?;
+        Ok(rate.plan(step, DEFAULT_AFFINE_PRECISION, CoderPlan::Tdct))
+    }
 }
 
-/// [`step`] for a first frame of bounding-box diagonal `diagonal`.
-fn step_of_diagonal(diagonal: f64, opts: &EncodeOptions) -> Result<f32> {
-    crate::codec::quality::stored_step("temporal-DCT step", diagonal, opts, 1.0)
+/// The temporal-DCT residual encoder at one quantiser step (model units, as stored).
+pub(crate) struct Encoder {
+    /// The quantiser step.
+    pub step: f32,
 }
-
-/// The temporal-DCT residual encoder.
-pub struct Encoder;
 
 impl ResidualEncoder for Encoder {
     fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals> {
         let clock = Instant::now();
         input.progress.stage("temporal DCT");
-        let step = step_of_diagonal(input.diagonal, input.options)?;
+        let step = self.step;
         let coefficients = coefficients::forward(input.residuals)?;
         let step64 = f64::from(step);
         // Plain rounding here only decides which bands are empty; the levels coded are chosen by
@@ -77,12 +88,7 @@ impl ResidualEncoder for Encoder {
         let (index, payload) = BandIndex::build(step, chunks);
         input.progress.frames(input.residuals.len() as u64);
         Ok(CodedResiduals {
-            params: CodecParams {
-                lattice: (0, 0),
-                qscale: 0,
-                gop: 1,
-                padding: "none".into(),
-            },
+            setup: vec![SETUP_VERSION],
             atlas: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
@@ -100,33 +106,38 @@ impl ResidualEncoder for Encoder {
 }
 
 /// The decoded temporal-DCT coefficients of a stream, read once at open.
-pub struct Bands {
+pub(crate) struct Bands {
     /// Byte length of every band in the stream, decoded or not.
     pub lengths: Vec<u64>,
     /// Dequantised coefficients of the decoded bands (`[3v + a]`); `None` for an all-zero band.
     /// Bands past the decoded ones are missing (truncated stream, or a preview) and count as zero.
     pub decoded: Vec<Option<Vec<f32>>>,
-    /// Whether the stream was cut inside the coefficients part.
-    pub truncated: bool,
     /// The quantiser step.
     pub step: f32,
 }
 
 /// The temporal-DCT residual decoder.
-pub struct Decoder {
+pub(crate) struct Decoder {
     bands: Bands,
     frames: usize,
 }
 
 impl Decoder {
-    /// Reads the band index and decodes the bands, low to high, up to `max_bands`, the end of a
-    /// truncated file, or the last band. A band cut by the end of the file ends decoding (it and
-    /// the rest count as zero); a band present in full that fails its CRC is damage, an error.
+    /// Checks the set-up (`setup`, the payload of its part), reads the band index and decodes the
+    /// bands, low to high, up to `max_bands`, the end of a truncated file, or the last band. A
+    /// band cut by the end of the file ends decoding (it and the rest count as zero); a band
+    /// present in full that fails its CRC is damage, an error.
     pub fn open<R: Read + Seek>(
+        setup: &[u8],
         stream: &StreamLayout,
         reader: &mut ContainerReader<R>,
         max_bands: Option<usize>,
     ) -> Result<Self> {
+        if setup != [SETUP_VERSION] {
+            return Err(Error::Stream(format!(
+                "temporal-DCT set-up {setup:?}: this build reads version {SETUP_VERSION}"
+            )));
+        }
         let (vertices, frames) = (
             stream.header.vertices as usize,
             stream.header.frames as usize,
@@ -158,7 +169,6 @@ impl Decoder {
             bands: Bands {
                 lengths: index.bands.iter().map(|b| b.len).collect(),
                 decoded,
-                truncated: declared.is_some(),
                 step,
             },
             frames,
@@ -235,7 +245,16 @@ impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
         Ok(())
     }
 
-    fn bands(&self) -> Option<&Bands> {
-        Some(&self.bands)
+    fn describe(&self) -> Description {
+        Description {
+            codec: Codec::Tdct,
+            settings: Vec::new(),
+            pictures: None,
+            bands: Some(BandsDescription {
+                step: self.bands.step,
+                lengths: self.bands.lengths.clone(),
+                decoded: self.bands.decoded.len(),
+            }),
+        }
     }
 }

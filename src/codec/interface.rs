@@ -1,0 +1,151 @@
+//! The one interface of the residual coders: what the encoder hands a coder and gets back, what a
+//! decoder of a stream does, and how a codec describes what it stored.
+
+use super::pictures::geometry_video::ImageLayout;
+use super::Codec;
+use crate::error::{Error, Result};
+use crate::geometry_image::lattice::AtlasCache;
+use crate::geometry_image::Plane;
+use crate::mesh::{AnimatedMesh, Point, Triangle};
+use crate::motion::Partition;
+use crate::progress::Progress;
+use crate::stream::container::{ContainerReader, Part, Tag};
+use crate::stream::header::Header;
+
+/// What the encoder hands a residual coder: the animation, the decoder's reference frame and
+/// partition, and every frame's residual against the quantised predictor. The coder's settings
+/// were given when it was made (from the encoding's rate plan).
+pub(crate) struct ResidualInput<'a> {
+    /// The animation (vertices in the stream's order): the clip, or one temporal segment of it.
+    pub mesh: &'a AnimatedMesh,
+    /// The decoded first frame, which the decoder will have.
+    pub reference: &'a [Point],
+    /// The motion clusters.
+    pub partition: &'a Partition,
+    /// `residuals[f][v]`: frame f's residual of vertex v against the quantised predictor.
+    pub residuals: &'a [Vec<[f32; 3]>],
+    /// Where to report frames done.
+    pub progress: &'a dyn Progress,
+    /// Codecs with an atlas: the atlas of `reference` and `partition` if already built, else
+    /// where to keep it (encodings sharing one partition share it); `None` builds it afresh.
+    pub atlas: Option<&'a AtlasCache>,
+}
+
+/// What a residual coder produced: its set-up and its parts, in file order.
+pub(crate) struct CodedResiduals {
+    /// The payload of the codec's set-up part (whole stream, first of the codec's parts): its
+    /// own version and settings.
+    pub setup: Vec<u8>,
+    /// The atlas's figures, for codecs with an atlas.
+    pub atlas: Option<atlas::AtlasStats>,
+    /// Whole-stream parts written after the set-up, before the predictor's (geometry video: the
+    /// lattice coordinates).
+    pub before_predictor: Vec<Part>,
+    /// Parts written after the predictor's (a temporal segment's own).
+    pub after_predictor: Vec<Part>,
+    /// Seconds per stage of the coder.
+    pub stage_seconds: Vec<(String, f64)>,
+}
+
+impl CodedResiduals {
+    /// The codec's parts around the predictor's, in file order: the set-up part and the other
+    /// whole-stream parts before, a segment's own after.
+    pub fn into_parts(self) -> (Vec<Part>, Vec<Part>) {
+        let mut before = vec![Part::whole(Tag::CODEC_SETUP, self.setup)];
+        before.extend(self.before_predictor);
+        (before, self.after_predictor)
+    }
+}
+
+/// The encoding half of a residual codec.
+pub(crate) trait ResidualEncoder {
+    /// Codes every frame's residuals.
+    fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals>;
+}
+
+/// What every residual decoder may need of the stream, read before it.
+pub(crate) struct StreamLayout<'a> {
+    /// The stream header (of a temporal segment: its frames).
+    pub header: &'a Header,
+    /// The shared connectivity.
+    pub triangles: &'a [Triangle],
+}
+
+/// The decoding half of a residual codec: adds the coded residuals to the decoder's prediction.
+pub(crate) trait ResidualDecoder<R> {
+    /// Adds frame `f`'s residuals to its prediction, reading no more of the stream than `f` needs.
+    fn add_frame(
+        &mut self,
+        reader: &mut ContainerReader<R>,
+        f: usize,
+        frame: &mut [Point],
+    ) -> Result<()>;
+
+    /// Adds every frame's residuals to the predictions, in order.
+    fn add_all(
+        &mut self,
+        reader: &mut ContainerReader<R>,
+        frames: &mut [Vec<Point>],
+        progress: &dyn Progress,
+    ) -> Result<()>;
+
+    /// What the codec stored: its settings, and its bands or pictures.
+    fn describe(&self) -> Description;
+
+    /// The geometry-image side of the stream, for codecs that code images.
+    fn images(&self) -> Option<&ImageLayout> {
+        None
+    }
+
+    /// Frame `f`'s decoded picture (x | y | z residual images side by side, samples of the stream's
+    /// depth), for codecs that code images.
+    fn picture(&mut self, _reader: &mut ContainerReader<R>, _f: usize) -> Result<Plane<u16>> {
+        Err(Error::Usage(format!(
+            "a {} stream has no pictures",
+            self.describe().codec.name()
+        )))
+    }
+}
+
+/// What a residual codec stored, as reports show it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Description {
+    /// The codec.
+    pub codec: Codec,
+    /// The codec's own settings, named as its options are (`jpeg_quality`, `qscale`, `qp`,
+    /// `gop`, `bit_depth`), in the order reports list them.
+    pub settings: Vec<(&'static str, u32)>,
+    /// Codecs that code pictures: their lattice and atlas.
+    pub pictures: Option<PicturesDescription>,
+    /// Codecs that code frequency bands: the bands.
+    pub bands: Option<BandsDescription>,
+}
+
+/// The pictures of a geometry-video stream.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PicturesDescription {
+    /// Lattice width and height in pixels.
+    pub lattice: (u16, u16),
+    /// Bits a sample.
+    pub bit_depth: u8,
+    /// Charts in the atlas.
+    pub charts: u32,
+    /// Chart pixels over lattice pixels.
+    pub packing_efficiency: f64,
+    /// The padding the encoder used.
+    pub padding: &'static str,
+    /// Per frame, the residuals sent exactly beside the pictures (those outside the frame's
+    /// range).
+    pub corrections: Vec<u32>,
+}
+
+/// The frequency bands of a temporal-DCT stream (of its open segment).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BandsDescription {
+    /// The quantiser step in the mesh's units.
+    pub step: f32,
+    /// Byte length of every band, low to high frequency.
+    pub lengths: Vec<u64>,
+    /// Bands decoded: all of them, or fewer for a truncated stream or a preview.
+    pub decoded: usize,
+}
