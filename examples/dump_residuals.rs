@@ -44,10 +44,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .iter()
             .map(|&f| if f { 255 } else { 0 })
             .collect();
-        for (levels, c) in images.raw.iter().zip(["x", "y", "z"]) {
-            let grey: Vec<u16> = levels
-                .iter()
-                .map(|&v| (v.clamp(0.0, 255.0) * 257.0).round() as u16)
+        let raw = &images.raw;
+        for (axis, c) in ["x", "y", "z"].into_iter().enumerate() {
+            // One coordinate's columns of the x | y | z picture, 8-bit levels spread to 16 bits.
+            let grey: Vec<u16> = raw
+                .data
+                .chunks_exact(raw.width as usize)
+                .flat_map(|row| &row[axis * w as usize..(axis + 1) * w as usize])
+                .map(|&v| v.min(255) * 257)
                 .collect();
             let stem = format!("{:04}_{c}", images.frame);
             image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, grey)

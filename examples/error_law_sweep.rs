@@ -115,7 +115,7 @@ fn main() -> Res<()> {
                     codec: CodecConfig::Hevc(DeepConfig {
                         qp: Some(q),
                         bit_depth,
-                        gop: hevc_gop.unwrap_or(mcgv_video::DEFAULT_GOP),
+                        gop: hevc_gop.unwrap_or(mcgv_video::codec::DEFAULT_GOP),
                         ..DeepConfig::default()
                     }),
                     step: Some(s),

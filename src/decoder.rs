@@ -196,6 +196,36 @@ impl<R: Read + Seek> Decoder<R> {
         self.weights.as_ref()
     }
 
+    /// Where each of `original`'s vertices is in the decoded frames, when the stream holds them
+    /// in another order (`inverse[v]` is input vertex `v`'s decoded index), so that they can be
+    /// put back ([`AnimatedMesh::permuted`]); `None` when the order is the input's, or `original`
+    /// is not the stream's source. A stream encoded with `reorder` keeps no permutation (that is
+    /// what saves its bits), but the first-frame coder is deterministic: coding the original's
+    /// first frame again gives it.
+    pub fn input_order(&self, original: &AnimatedMesh) -> Result<Option<Vec<u32>>> {
+        let h = &self.header;
+        if !h.reorder || original.vertex_count() != h.vertices as usize {
+            return Ok(None);
+        }
+        let options = first_frame::FirstFrameOptions {
+            bits: h.first_frame_bits,
+            reorder: true,
+        };
+        let coded = first_frame::encode(original.frame(0), original.triangles(), &options)?;
+        let Some(permutation) = coded.permutation else {
+            return Ok(None);
+        };
+        if permutation.len() != original.vertex_count() {
+            return Ok(None);
+        }
+        // permutation[new] = old: input vertex `old` is decoded vertex `new`.
+        let mut inverse = vec![0u32; permutation.len()];
+        for (new, &old) in permutation.iter().enumerate() {
+            inverse[old as usize] = new as u32;
+        }
+        Ok(Some(inverse))
+    }
+
     /// The stream's length in bytes.
     pub fn file_len(&self) -> u64 {
         self.reader.file_len()

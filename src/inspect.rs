@@ -4,21 +4,26 @@
 //! [`Decoder::describe`].)
 
 use crate::codec::pictures::geometry_video;
+pub use crate::codec::Plane;
 use crate::decoder::Decoder;
 use crate::encoder::analysis::{self, StreamChoices};
 use crate::error::{Error, Result};
 use crate::first_frame::FirstFrameOptions;
+use crate::geometry_image::tile;
+pub use crate::geometry_image::{AxisRange, FrameRanges};
 use crate::mesh::AnimatedMesh;
 use std::io::{Read, Seek};
 
-/// One frame's residual images as the encoder made them: levels in `0..=255`, x, y, z.
+/// One frame's residual images as the encoder made them: x | y | z side by side, levels of the
+/// stream's sample depth.
 pub struct EncoderImages {
     /// The frame.
     pub frame: usize,
-    /// The quantised residuals at the vertices' pixels, every other pixel 0.
-    pub raw: [Vec<f32>; 3],
+    /// The quantised residuals at the vertices' pixels and the charts' interiors, every other
+    /// pixel 0.
+    pub raw: Plane<u16>,
     /// After padding: what the picture codec was given.
-    pub padded: [Vec<f32>; 3],
+    pub padded: Plane<u16>,
     /// The pixels that carry data (the vertices' and the charts' interiors); the others are padding.
     pub fixed: Vec<bool>,
 }
@@ -87,14 +92,19 @@ pub fn encoder_images<R: Read + Seek>(
     let mut images = geometry_video::images(codec, layout.pixel_step, shape, residuals, None)?;
     images.ranges = layout.ranges.clone();
     images.depth = layout.depth();
+    let (w, h) = layout.lattice();
+    let (w, h) = (usize::from(w), usize::from(h));
+    let compose = |levels: [Vec<f32>; 3]| {
+        tile::compose([&levels[0], &levels[1], &levels[2]], w, h, images.depth)
+    };
     images.corrections = layout.corrections.clone();
     frames
         .iter()
         .map(|&f| {
             Ok(EncoderImages {
                 frame: f,
-                raw: images.raw(&residuals[f], f)?,
-                padded: images.padded_alone(residuals, f)?,
+                raw: compose(images.raw(&residuals[f], f)?),
+                padded: compose(images.padded_alone(residuals, f)?),
                 fixed: images.atlas.fixed_mask(),
             })
         })

@@ -1,10 +1,12 @@
 //! mcgv-video: Multi-Chart Geometry Video coding of animated triangle meshes.
 //!
-//! An animation (one connectivity, a position per vertex and frame) becomes one compact `.mcgv`
-//! stream and back. Data flows one way: [`mesh`] → [`motion`] (clusters, predictor, residuals) →
-//! [`codec`] (geometry images on an atlas coded as JPEG or MPEG-4 pictures, or a temporal DCT) →
-//! [`stream`]; [`first_frame`] codes the connectivity and first frame, [`metrics`] measures the
-//! result. The library knows nothing of command lines or terminals.
+//! An animation — one connectivity, a position per vertex and frame — becomes one compact `.mcgv`
+//! stream and back. The mesh is split into clusters that move nearly rigidly, one affine map per
+//! cluster and frame predicts every frame from the first, and a residual codec stores what the
+//! prediction misses: a temporal DCT of each vertex's remainder (the default, [`Codec::Tdct`]), or
+//! geometry images coded as JPEG, MPEG-4 Part 2, HEVC or AV1 pictures.
+//!
+//! # Encode and decode
 //!
 //! ```
 //! use mcgv_video::{encode, AnimatedMesh, Codec, Decoder, EncodeOptions};
@@ -21,10 +23,11 @@
 //!     .collect();
 //! let mesh = AnimatedMesh::new(triangles, frames)?;
 //!
-//! let options = EncodeOptions { codec: Codec::Tdct.into(), quality: 60, clusters: 2, ..Default::default() };
+//! let options = EncodeOptions { quality: 60, clusters: 2, ..Default::default() };
 //! let bytes = encode(&mesh, &options)?.to_bytes();
 //!
 //! let mut decoder = Decoder::new(&bytes)?;
+//! assert_eq!(decoder.codec(), Codec::Tdct);
 //! let frame = decoder.decode_frame(7)?;
 //! let all = decoder.decode_all()?;
 //! assert_eq!(all.frame_count(), 10);
@@ -32,26 +35,59 @@
 //! # Ok::<(), mcgv_video::Error>(())
 //! ```
 //!
-//! Reading a file: [`read_animation`] takes an OBJ folder or glob, a PC2 cache with its base OBJ,
-//! or a glTF/GLB clip. FFmpeg (for MPEG-4) sits behind the `mpeg4` cargo feature, on by default.
+//! # Where to start
+//!
+//! - Reading: [`read_animation`] takes an OBJ folder or glob, a PC2 cache with its base OBJ, or a
+//!   glTF/GLB clip ([`ReadOptions`]); [`FrameSource`] reads a long clip a run of frames at a time.
+//! - Encoding: [`encode`] with [`EncodeOptions`] — the options every codec shares, and in
+//!   [`EncodeOptions::codec`] a [`CodecConfig`] holding the chosen codec's own ([`codec`]).
+//!   [`Encoded::report`] says what it did; [`encoder::SegmentedEncoder`] codes a long clip's
+//!   temporal segments one by one, on any thread or machine.
+//! - Decoding: [`Decoder`] opens a stream, decodes one frame alone or all of them, and
+//!   [`Decoder::describe`] says what the codec stored.
+//! - Measuring: [`metrics`] (RMSE, Hausdorff, vertex RMSE, KG error), [`inspect`] (the images a
+//!   picture codec coded).
+//! - Writing meshes: [`mesh`] (OBJ, PC2, glTF).
+//!
+//! Every failure is one typed [`Error`]. The cargo feature `ffmpeg` (default) adds the MPEG-4,
+//! HEVC and AV1 codecs through FFmpeg; without it JPEG and the temporal DCT remain. The feature
+//! `internals` makes the pipeline's inner modules public for the project's own tests, benches,
+//! fuzzing and examples: they are not a stable API.
+
+#![deny(missing_docs)]
+
+/// Declares modules the public API does not expose: crate-private, or public (and unstable) with
+/// the `internals` feature.
+macro_rules! internal {
+    ($($(#[$meta:meta])* $name:ident;)*) => {$(
+        $(#[$meta])*
+        #[cfg(feature = "internals")]
+        pub mod $name;
+        $(#[$meta])*
+        #[cfg(not(feature = "internals"))]
+        pub(crate) mod $name;
+    )*};
+}
 
 pub mod codec;
-pub mod decoder;
+mod decoder;
 pub mod encoder;
-pub mod error;
-pub mod first_frame;
-pub mod geometry_image;
+mod error;
 pub mod inspect;
-pub mod limits;
 pub mod mesh;
 pub mod metrics;
-pub mod motion;
-pub mod output;
-pub mod progress;
-pub mod stream;
+mod progress;
 
-pub use codec::pictures::DEFAULT_GOP;
-pub use codec::Codec;
+internal! {
+    first_frame;
+    geometry_image;
+    limits;
+    motion;
+    output;
+    stream;
+}
+
+pub use codec::{Codec, CodecConfig, Description};
 pub use decoder::{DecodeOptions, Decoder};
 pub use encoder::{
     encode, encode_source, encode_with_progress, EncodeOptions, EncodeReport, Encoded,
@@ -65,3 +101,4 @@ pub use motion::PredictorKind;
 /// How free pixels of the geometry images are filled (the `padding` crate's methods).
 pub use padding::Method as PaddingMethod;
 pub use progress::{Progress, Silent};
+pub use stream::header::Header;

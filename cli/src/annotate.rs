@@ -6,7 +6,7 @@
 //! dependencies, no font file to find at run time): a few labels do not need a font rasteriser.
 
 use image::{GrayImage, Rgb, RgbImage};
-use mcgv_video::geometry_image::quantise::FrameRanges;
+use mcgv_video::inspect::FrameRanges;
 
 const WHITE: Rgb<u8> = Rgb([255, 255, 255]);
 const INK: Rgb<u8> = Rgb([0, 0, 0]);
@@ -176,7 +176,7 @@ mod tests {
     #[test]
     fn residual_picture_has_three_labelled_panels_and_a_scale() {
         let plane = GrayImage::from_fn(3 * 64, 16, |x, _| image::Luma([(x % 256) as u8]));
-        let range = mcgv_video::geometry_image::quantise::AxisRange::new(0.01, 20);
+        let range = mcgv_video::inspect::AxisRange::new(0.01, 20);
         let picture = residual_picture(&plane, 64, "frame 0", Some(&[range; 3]));
         assert_eq!(picture.width(), 3 * 64 + 2 * GAP);
         assert!(picture.pixels().any(|p| *p == ZERO_MARK));

@@ -1,6 +1,8 @@
 //! The command line: argument definitions (clap). `main.rs` dispatches them to [`crate::commands`].
 
+use clap::builder::{PossibleValue, TypedValueParser};
 use clap::{Args, Parser, Subcommand};
+use mcgv_video::Codec;
 use std::path::PathBuf;
 
 /// mcgv-video: compress animated triangle meshes into one `.mcgv` file (Multi-Chart Geometry Video).
@@ -108,8 +110,8 @@ pub struct EncodeArgs {
     pub output: PathBuf,
     /// Residual coder: tdct is the smallest at equal error; jpeg decodes any frame on its own;
     /// mpeg4, hevc and av1 (10/12-bit pictures) suit hardware video decoders.
-    #[arg(long, value_enum, default_value_t = CodecChoice::Tdct)]
-    pub codec: CodecChoice,
+    #[arg(long, default_value_t = Codec::default(), value_parser = codec_names())]
+    pub codec: Codec,
     /// Rate knob for every codec, 1..100 (higher = better quality, more bits; default 50).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
     pub quality: Option<u8>,
@@ -219,18 +221,29 @@ fn parse_bit_depth(value: &str) -> Result<BitDepth, String> {
     }
 }
 
-/// The padding methods `--padding` takes (the padding crate's names).
+/// The padding methods `--padding` takes, the codecs' defaults first (each the name of a
+/// [`mcgv_video::PaddingMethod`]).
+const PADDING_METHODS: [&str; 8] = [
+    "snap",
+    "biharmonic",
+    "pushpull",
+    "cg",
+    "midgrey",
+    "mean",
+    "laplace",
+    "dct",
+];
+
 fn padding_methods() -> clap::builder::PossibleValuesParser {
-    clap::builder::PossibleValuesParser::new([
-        "snap",
-        "biharmonic",
-        "cg",
-        "midgrey",
-        "mean",
-        "pushpull",
-        "laplace",
-        "dct",
-    ])
+    clap::builder::PossibleValuesParser::new(PADDING_METHODS)
+}
+
+/// The codecs `--codec` takes, by their names, each with its line of help.
+fn codec_names() -> impl clap::builder::TypedValueParser<Value = Codec> {
+    let names = Codec::ALL.map(|c| PossibleValue::new(c.name()).help(c.summary()));
+    // Only the listed names get through, each the name of a codec.
+    clap::builder::PossibleValuesParser::new(names)
+        .map(|n| Codec::from_name(&n).unwrap_or_default())
 }
 
 /// The motion segmentations.
@@ -242,22 +255,6 @@ pub enum SegmentationChoice {
     Decimation,
     /// Both, at the quality's step; the smaller stream is kept.
     Auto,
-}
-
-/// The residual coders.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum CodecChoice {
-    /// JPEG per frame: every frame decodes on its own.
-    Jpeg,
-    /// MPEG-4 Part 2: an I-frame, then P-frames.
-    Mpeg4,
-    /// No images: each vertex's residuals as a temporal DCT, coded low to high frequency (a
-    /// truncated stream still decodes a coarser animation).
-    Tdct,
-    /// HEVC (libx265) at 10 or 12 bits a sample: an IDR frame, then P-frames (--gop 1: all-intra).
-    Hevc,
-    /// AV1 (libaom) at 10 or 12 bits a sample: a key frame, then P-frames (--gop 1: all-intra).
-    Av1,
 }
 
 /// The motion predictors.
@@ -408,5 +405,19 @@ impl From<&InputArgs> for mcgv_video::ReadOptions {
                 .max_positions
                 .unwrap_or(mcgv_video::DEFAULT_MAX_POSITIONS),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::PADDING_METHODS;
+
+    #[test]
+    fn every_padding_method_is_offered_once() {
+        let mut offered = PADDING_METHODS.to_vec();
+        let mut methods = mcgv_video::PaddingMethod::NAMES.to_vec();
+        offered.sort_unstable();
+        methods.sort_unstable();
+        assert_eq!(offered, methods);
     }
 }

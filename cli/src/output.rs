@@ -3,7 +3,7 @@
 //!
 //! One rule for parent folders everywhere: a missing parent folder of `-o` is created.
 
-use mcgv_video::error::{Error, Result};
+use mcgv_video::{Error, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -126,7 +126,7 @@ pub fn write_pc2_with_base(
         )));
     }
     create_parent(path)?;
-    mcgv_video::mesh::io::write_obj_mesh_frame(mesh, 0, &base)?;
+    mcgv_video::mesh::write_obj_mesh_frame(mesh, 0, &base)?;
     mcgv_video::mesh::write_pc2(mesh, path)?;
     Ok(base)
 }

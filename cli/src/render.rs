@@ -4,8 +4,8 @@
 //! Hand-written because it is a few dozen lines; a rendering crate would be far heavier than the job.
 
 use image::{Rgb, RgbImage};
-use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::{bounding_box, Point, Triangle};
+use mcgv_video::{Error, Result};
 use std::path::Path;
 
 const BACKGROUND: Rgb<u8> = Rgb([255, 255, 255]);

@@ -2,10 +2,10 @@
 //! (`tests/fuzz_regressions.rs`) includes this file by path and replays crashers through the same code.
 
 use mcgv_video::codec::tdct::index::BandIndex;
-use mcgv_video::decoder::Decoder;
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::{parse_gltf, parse_obj, parse_pc2, AnimatedMesh, Summary, Triangle};
 use mcgv_video::stream::container::{FILE_HEADER_LEN, PART_HEADER_LEN};
+use mcgv_video::Decoder;
 use mcgv_video::Result;
 use std::path::Path;
 

@@ -1,45 +1,56 @@
-//! Residual coders: how the motion the predictor leaves over is stored.
+//! Residual codecs: how the motion the predictor leaves over is stored, and each codec's own
+//! options.
 //!
-//! Every codec implements one interface, [`ResidualEncoder`] and [`ResidualDecoder`], owns its
-//! options (a variant of [`CodecConfig`], its type in the codec's own file) and its quality law
-//! (turning the caller's rate into a [`RatePlan`]), and writes its own parts. The places that know
-//! which codecs exist are [`Codec`] and [`CodecConfig`]: a new codec is one new module and one
-//! variant of each (docs/design.md, "The codec interface").
+//! Pick a codec with a [`CodecConfig`] in [`crate::EncodeOptions::codec`]; `Codec::X.into()` gives
+//! codec X with every default, and each variant's type holds the codec's own options:
 //!
-//! - [`pictures`] is the papers' geometry video: the residuals are splatted onto a multi-chart
-//!   atlas, padded, and coded as pictures — one JPEG per frame (any frame decodes alone), or
-//!   through FFmpeg (cargo feature `ffmpeg`) MPEG-4 Part 2 I- and P-frames and HEVC and AV1 at 10
-//!   or 12 bits a sample.
-//! - [`tdct`] is the follow-up paper's temporal DCT: each vertex's residual trajectory transformed
-//!   over all frames and coded band by band, no images.
+//! - [`CodecConfig::Tdct`] ([`TdctConfig`], the default): the follow-up paper's temporal DCT.
+//!   Each vertex's residual trajectory is transformed over all frames and coded band by band,
+//!   low to high frequency: the fewest bits, and a stream cut short still decodes, coarser.
+//! - [`CodecConfig::Jpeg`] ([`JpegConfig`]): the papers' geometry video, the residuals splatted
+//!   onto a multi-chart atlas and coded as one JPEG picture per frame: any frame decodes alone.
+//! - [`CodecConfig::Mpeg4`] ([`Mpeg4Config`]), [`CodecConfig::Hevc`] and [`CodecConfig::Av1`]
+//!   ([`DeepConfig`], 10 or 12 bits a sample): the same pictures as video through FFmpeg (cargo
+//!   feature `ffmpeg`), a key frame then P-frames (or all-intra).
+//!
+//! The picture codecs share [`PictureOptions`] (the lattice and padding). The rate is not a codec
+//! option: [`crate::EncodeOptions::quality`] (or `step`) is, and each codec's law turns it into a
+//! [`RatePlan`] — its step and quantiser — when an encoding starts. A decoded stream says what its
+//! codec stored with a [`Description`].
+//!
+//! Inside the crate every codec implements one interface (a residual encoder and decoder, its own
+//! set-up part); adding one is a module and a variant of [`Codec`] and [`CodecConfig`]
+//! (docs/design.md, "The codec interface").
 
 mod interface;
-pub mod pictures;
 mod rate;
-pub mod tdct;
+#[cfg(test)]
+mod raw;
+internal! {
+    pictures;
+    tdct;
+}
 
 pub use interface::{BandsDescription, Description, PicturesDescription};
 pub(crate) use interface::{
     CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput, StreamLayout,
 };
 pub use pictures::deep::DeepConfig;
+pub(crate) use pictures::geometry_video;
 pub use pictures::jpeg::JpegConfig;
 pub use pictures::mpeg4::Mpeg4Config;
-pub use pictures::{abbreviated, geometry_video, jpeg, PictureOptions, Plane};
-#[cfg(feature = "ffmpeg")]
-pub use pictures::{av1, deep, hevc, mpeg4};
+pub use pictures::{PictureOptions, Plane, DEFAULT_GOP};
 pub(crate) use rate::Rate;
-pub use rate::{ijg_scale_percent, target_step, PictureLaw, RatePlan};
+pub use rate::{target_step, RatePlan};
 pub use tdct::TdctConfig;
 
 use crate::error::{Error, Result};
 use crate::stream::container::{ContainerReader, Tag};
 use pictures::PictureCodec;
-use rate::CoderPlan;
 use std::io::{Read, Seek};
 
 /// The residual codec recorded in the stream.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Codec {
     /// One JPEG picture per frame: every frame decodes on its own.
@@ -47,7 +58,9 @@ pub enum Codec {
     /// MPEG-4 Part 2: I-frames every `gop` frames, P-frames between.
     Mpeg4,
     /// No images: each vertex's residuals as a temporal DCT over all frames, coded from low to high
-    /// frequency, so that a truncated stream still decodes a coarser animation.
+    /// frequency, so that a truncated stream still decodes a coarser animation. The default: the
+    /// fewest bits at equal error.
+    #[default]
     Tdct,
     /// HEVC at 10 or 12 bits a sample (libx265): IDR frames every `gop` frames, P-frames between
     /// (`gop` 1: all-intra, every frame decodes alone).
@@ -55,16 +68,30 @@ pub enum Codec {
     /// AV1 at 10 or 12 bits a sample (libaom): key frames every `gop` frames, P-frames between
     /// (`gop` 1: all-intra, every frame decodes alone).
     Av1,
+    /// Rounded residuals, one chunk a frame: the interface's test codec ([`raw`]).
+    #[cfg(test)]
+    Raw,
 }
 
 impl Codec {
     /// Every codec, in the order of their stream ids.
+    #[cfg(not(test))]
     pub const ALL: [Codec; 5] = [
         Codec::Jpeg,
         Codec::Mpeg4,
         Codec::Tdct,
         Codec::Hevc,
         Codec::Av1,
+    ];
+    /// Every codec, in the order of their stream ids (with the test codec).
+    #[cfg(test)]
+    pub const ALL: [Codec; 6] = [
+        Codec::Jpeg,
+        Codec::Mpeg4,
+        Codec::Tdct,
+        Codec::Hevc,
+        Codec::Av1,
+        Codec::Raw,
     ];
 
     /// The codec's id in the stream header.
@@ -75,6 +102,8 @@ impl Codec {
             Codec::Tdct => 3,
             Codec::Hevc => 4,
             Codec::Av1 => 5,
+            #[cfg(test)]
+            Codec::Raw => 255,
         }
     }
 
@@ -94,6 +123,35 @@ impl Codec {
             Codec::Tdct => "tdct",
             Codec::Hevc => "hevc",
             Codec::Av1 => "av1",
+            #[cfg(test)]
+            Codec::Raw => "raw",
+        }
+    }
+
+    /// The codec of a name (as [`Codec::name`] gives it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Codec::ALL.into_iter().find(|c| c.name() == name)
+    }
+
+    /// What the codec is for, in a line (for help texts).
+    pub fn summary(self) -> &'static str {
+        match self {
+            Codec::Jpeg => "JPEG pictures, one per frame: every frame decodes on its own",
+            Codec::Mpeg4 => "MPEG-4 Part 2 pictures: an I-frame, then P-frames",
+            Codec::Tdct => {
+                "temporal DCT of each vertex's residuals, coded low to high frequency: the \
+                 fewest bits; a truncated stream decodes coarser"
+            }
+            Codec::Hevc => {
+                "HEVC (libx265) pictures at 10 or 12 bits: an IDR frame, then P-frames (--gop 1: \
+                 all-intra)"
+            }
+            Codec::Av1 => {
+                "AV1 (libaom) pictures at 10 or 12 bits: a key frame, then P-frames (--gop 1: \
+                 all-intra)"
+            }
+            #[cfg(test)]
+            Codec::Raw => "rounded residuals, one chunk a frame (tests only)",
         }
     }
 
@@ -105,12 +163,14 @@ impl Codec {
             Codec::Tdct => CodecConfig::Tdct(TdctConfig::default()),
             Codec::Hevc => CodecConfig::Hevc(DeepConfig::default()),
             Codec::Av1 => CodecConfig::Av1(DeepConfig::default()),
+            #[cfg(test)]
+            Codec::Raw => CodecConfig::Raw(raw::RawConfig),
         }
     }
 
     /// Whether the codec codes geometry images on a lattice (and so has an atlas).
     pub fn has_images(self) -> bool {
-        !matches!(self, Codec::Tdct)
+        matches!(self, Codec::Jpeg | Codec::Mpeg4 | Codec::Hevc | Codec::Av1)
     }
 
     /// Whether the codec codes frequency bands, so that a stream cut short, or decoded up to a
@@ -150,6 +210,26 @@ impl Codec {
             #[cfg(not(feature = "ffmpeg"))]
             Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => return Err(unavailable(self)),
             Codec::Tdct => None,
+            #[cfg(test)]
+            Codec::Raw => None,
+        })
+    }
+
+    /// The residual encoder of `plan` (a plan of this codec).
+    pub(crate) fn encoder(self, plan: &RatePlan) -> Result<Box<dyn ResidualEncoder>> {
+        let step = plan.step;
+        Ok(match (self.pictures()?, &plan.pictures) {
+            (Some(pictures), Some(settings)) => Box::new(geometry_video::Encoder::new(
+                pictures,
+                settings.clone(),
+                step,
+            )),
+            (Some(_), None) => return Err(Error::Codec(format!("a {self} plan without pictures"))),
+            (None, _) => match self {
+                #[cfg(test)]
+                Codec::Raw => Box::new(raw::Encoder { step }),
+                _ => Box::new(tdct::Encoder { step }),
+            },
         })
     }
 
@@ -169,8 +249,18 @@ impl Codec {
                 stream,
                 reader,
             )?),
-            None => Box::new(tdct::Decoder::open(&setup, stream, reader, max_bands)?),
+            None => match self {
+                #[cfg(test)]
+                Codec::Raw => Box::new(raw::Decoder::open(&setup, stream, reader)?),
+                _ => Box::new(tdct::Decoder::open(&setup, stream, reader, max_bands)?),
+            },
         })
+    }
+}
+
+impl std::fmt::Display for Codec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -196,6 +286,9 @@ pub enum CodecConfig {
     Hevc(DeepConfig),
     /// AV1 pictures at 10 or 12 bits a sample.
     Av1(DeepConfig),
+    /// The interface's test codec.
+    #[cfg(test)]
+    Raw(raw::RawConfig),
 }
 
 impl Default for CodecConfig {
@@ -219,12 +312,16 @@ impl CodecConfig {
             CodecConfig::Mpeg4(_) => Codec::Mpeg4,
             CodecConfig::Hevc(_) => Codec::Hevc,
             CodecConfig::Av1(_) => Codec::Av1,
+            #[cfg(test)]
+            CodecConfig::Raw(_) => Codec::Raw,
         }
     }
 
     /// The lattice and padding options of a picture codec (`None` for codecs without pictures).
     pub fn pictures_mut(&mut self) -> Option<&mut PictureOptions> {
         match self {
+            #[cfg(test)]
+            CodecConfig::Raw(_) => None,
             CodecConfig::Tdct(_) => None,
             CodecConfig::Jpeg(c) => Some(&mut c.pictures),
             CodecConfig::Mpeg4(c) => Some(&mut c.pictures),
@@ -232,10 +329,33 @@ impl CodecConfig {
         }
     }
 
+    /// The codec's own quantiser and its option's name (`jpeg_quality`, `qscale`, `qp`); `None`
+    /// for a codec whose step is its only quantiser (tdct).
+    pub fn quantiser_mut(&mut self) -> Option<(&'static str, &mut Option<u8>)> {
+        match self {
+            #[cfg(test)]
+            CodecConfig::Raw(_) => None,
+            CodecConfig::Tdct(_) => None,
+            CodecConfig::Jpeg(c) => Some(("jpeg_quality", &mut c.quality)),
+            CodecConfig::Mpeg4(c) => Some(("qscale", &mut c.qscale)),
+            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(("qp", &mut c.qp)),
+        }
+    }
+
+    /// The bits a sample of a codec that codes deeper pictures (`None` for 8-bit codecs).
+    pub fn bit_depth_mut(&mut self) -> Option<&mut Option<u8>> {
+        match self {
+            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(&mut c.bit_depth),
+            _ => None,
+        }
+    }
+
     /// The frames per group of pictures of a video codec (`None` for codecs that code every frame
     /// alone or no pictures).
     pub fn gop_mut(&mut self) -> Option<&mut usize> {
         match self {
+            #[cfg(test)]
+            CodecConfig::Raw(_) => None,
             CodecConfig::Tdct(_) | CodecConfig::Jpeg(_) => None,
             CodecConfig::Mpeg4(c) => Some(&mut c.gop),
             CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(&mut c.gop),
@@ -245,6 +365,8 @@ impl CodecConfig {
     /// Fails, naming the option, when one is out of range.
     pub(crate) fn check(&self) -> Result<()> {
         match self {
+            #[cfg(test)]
+            CodecConfig::Raw(_) => Ok(()),
             CodecConfig::Tdct(_) => Ok(()),
             CodecConfig::Jpeg(c) => c.check(),
             CodecConfig::Mpeg4(c) => c.check(),
@@ -261,6 +383,8 @@ impl CodecConfig {
             CodecConfig::Mpeg4(c) => c.plan(rate, diagonal),
             CodecConfig::Hevc(c) => pictures::hevc::plan(c, rate, diagonal),
             CodecConfig::Av1(c) => pictures::av1::plan(c, rate, diagonal),
+            #[cfg(test)]
+            CodecConfig::Raw(c) => c.plan(rate, diagonal),
         }
     }
 }
@@ -268,15 +392,7 @@ impl CodecConfig {
 impl RatePlan {
     /// The residual encoder with this plan's settings.
     pub(crate) fn encoder(&self) -> Result<Box<dyn ResidualEncoder>> {
-        Ok(match &self.coder {
-            CoderPlan::Tdct => Box::new(tdct::Encoder { step: self.step }),
-            CoderPlan::Pictures(plan) => {
-                let codec = plan.codec.pictures()?.ok_or_else(|| {
-                    Error::Codec(format!("{} codes no pictures", plan.codec.name()))
-                })?;
-                Box::new(geometry_video::Encoder::new(codec, plan.clone(), self.step))
-            }
-        })
+        self.codec.encoder(self)
     }
 }
 
@@ -292,5 +408,40 @@ mod tests {
         }
         assert!(Codec::from_id(2).is_err());
         assert!(Codec::from_id(6).is_err());
+        for codec in Codec::ALL {
+            assert_eq!(Codec::from_name(codec.name()), Some(codec));
+        }
+    }
+
+    #[test]
+    fn affine_precision_is_fine_only_for_p_frames_that_suffer_from_coarse_maps() {
+        let rate = |affine_precision| Rate {
+            quality: 50,
+            step: None,
+            affine_precision,
+        };
+        let code = |codec: Codec, gop| {
+            let mut config = codec.default_config();
+            match &mut config {
+                CodecConfig::Mpeg4(c) => c.gop = gop,
+                CodecConfig::Hevc(c) | CodecConfig::Av1(c) => c.gop = gop,
+                _ => {}
+            }
+            config.plan(&rate(None), 1.0).unwrap().affine_precision
+        };
+        // In sixteenths: 4 = 1/4, 1 = 1/16.
+        for (codec, gop, expected) in [
+            (Codec::Tdct, 50, 4),
+            (Codec::Jpeg, 50, 4),
+            (Codec::Hevc, 1, 4),
+            (Codec::Hevc, 50, 4),
+            (Codec::Av1, 1, 4),
+            (Codec::Av1, 50, 1),
+            (Codec::Mpeg4, 50, 1),
+        ] {
+            assert_eq!(code(codec, gop), expected, "{codec:?} gop {gop}");
+        }
+        let asked = Codec::Av1.default_config().plan(&rate(Some(0.5)), 1.0);
+        assert_eq!(asked.unwrap().affine_precision, 8);
     }
 }

@@ -8,6 +8,7 @@
 //! here: the target step of a quality, and the reading of a law given by anchors.
 
 use super::pictures::PicturePlan;
+use super::Codec;
 use crate::error::{Error, Result};
 use crate::motion;
 
@@ -67,10 +68,17 @@ impl Rate {
         (k * 16.0).round().clamp(1.0, 255.0) as u8
     }
 
-    /// The plan of a residual coder whose step is `step` and whose affine precision is
-    /// `default_affine_precision` unless asked otherwise. The affine step is a fraction of the
-    /// diagonal: the residual step's fraction (explicit, or the quality's) times the precision.
-    pub fn plan(&self, step: f32, default_affine_precision: f64, coder: CoderPlan) -> RatePlan {
+    /// The plan of `codec`, whose step is `step`, whose affine precision is
+    /// `default_affine_precision` unless asked otherwise, and whose pictures (a picture codec's)
+    /// are `pictures`. The affine step is a fraction of the diagonal: the residual step's fraction
+    /// (explicit, or the quality's) times the precision.
+    pub fn plan(
+        &self,
+        step: f32,
+        default_affine_precision: f64,
+        codec: Codec,
+        pictures: Option<PicturePlan>,
+    ) -> RatePlan {
         let affine_precision = self.affine_precision_code(default_affine_precision);
         let fraction = self.step.unwrap_or_else(|| target_step(self.quality, 1.0));
         let k = f64::from(affine_precision) / 16.0;
@@ -79,7 +87,8 @@ impl Rate {
             step,
             affine_step: (fraction * k).clamp(motion::MIN_AFFINE_STEP, motion::MAX_AFFINE_STEP),
             affine_precision,
-            coder,
+            codec,
+            pictures,
         }
     }
 }
@@ -97,17 +106,10 @@ pub struct RatePlan {
     pub affine_step: f64,
     /// The affine precision (affine step over the residual step) in sixteenths.
     pub affine_precision: u8,
-    /// The residual coder's own settings.
-    pub(crate) coder: CoderPlan,
-}
-
-/// A residual coder's resolved settings.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum CoderPlan {
-    /// The temporal DCT: its step is the plan's.
-    Tdct,
-    /// A picture codec: its quantiser, groups, depth, padding and lattice.
-    Pictures(PicturePlan),
+    /// The codec.
+    pub codec: Codec,
+    /// A picture codec's quantiser, groups, depth, padding and lattice.
+    pub(crate) pictures: Option<PicturePlan>,
 }
 
 /// What one quality means for a picture codec.
@@ -175,10 +177,10 @@ mod tests {
             step,
             affine_precision,
         };
-        let plan = rate(None, None).plan(1.0, 0.25, CoderPlan::Tdct);
+        let plan = rate(None, None).plan(1.0, 0.25, Codec::Tdct, None);
         assert_eq!(plan.affine_precision, 4);
         assert!((plan.affine_step - 0.25e-3).abs() < 1e-15);
-        let plan = rate(Some(2e-3), Some(0.5)).plan(1.0, 0.25, CoderPlan::Tdct);
+        let plan = rate(Some(2e-3), Some(0.5)).plan(1.0, 0.25, Codec::Tdct, None);
         assert_eq!(plan.affine_precision, 8);
         assert!((plan.affine_step - 1e-3).abs() < 1e-15);
         let degenerate = rate(None, None).stored_step("step", 0.0, 1.0);

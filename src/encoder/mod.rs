@@ -1,23 +1,36 @@
 //! The encoder: mesh → first frame → motion segmentation → predictor and residuals → residual
-//! codec → stream. [`encode`] is a chain of small stages; what a codec does with the residuals is
-//! behind [`ResidualEncoder`](crate::codec::ResidualEncoder), and the container only sees parts.
+//! codec → stream.
+//!
+//! [`encode`] codes an animation with [`EncodeOptions`] and returns the stream with its
+//! [`EncodeReport`]; options left open (`Auto` predictor or segmentation, first-frame precision)
+//! are chosen by coding the candidates and keeping the fewest bits at equal error
+//! ([`ChoiceReport`]). A clip longer than [`EncodeOptions::segment_frames`] is coded in temporal
+//! segments: [`SegmentedEncoder`] does that one segment at a time, and [`CodedSegment`]s coded on
+//! other threads or machines join into the same stream.
 
-pub mod analysis;
 mod attributes;
-pub mod auto;
-pub mod distortion;
-pub mod first_frame_bits;
 mod options;
-pub mod segments;
+internal! {
+    analysis;
+    auto;
+    distortion;
+    first_frame_bits;
+    segments;
+}
 
-pub use analysis::{Prediction, SegmentationReport};
+pub use crate::motion::DEFAULT_E0;
+use analysis::Prediction;
+pub use analysis::SegmentationReport;
 pub use auto::{Candidate, ChoiceReport};
 pub use first_frame_bits::FirstFrameTrial;
+#[cfg(feature = "internals")]
+pub use options::kmeans_ladder;
+pub(crate) use options::MotionModel;
 pub use options::{
-    kmeans_ladder, EncodeOptions, MotionModel, PredictorChoice, Segmentation, SegmentationChoice,
-    DEFAULT_FIRST_FRAME_BITS, DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
+    EncodeOptions, PredictorChoice, Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS,
+    DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
-pub use segments::{encode_source, SegmentedEncoder};
+pub use segments::{analysis_frames, encode_source, CodedSegment, SegmentedEncoder};
 
 use crate::codec::{Codec, RatePlan, ResidualInput};
 use crate::error::Result;
@@ -99,9 +112,9 @@ pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Encoded> {
 }
 
 /// Encodes an animation, telling `progress` each stage and each frame coded. With an automatic
-/// predictor or segmentation, every candidate is tried ([`auto`]) and the smallest stream kept;
-/// so are the first-frame precisions when `first_frame_bits` is open and the codec's trials are
-/// cheap ([`first_frame_bits`]).
+/// predictor or segmentation, every candidate is tried and the fewest bits at equal error kept
+/// ([`ChoiceReport`]); so are the first-frame precisions when `first_frame_bits` is open and the
+/// codec's trials are cheap ([`FirstFrameTrial`]).
 pub fn encode_with_progress(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,

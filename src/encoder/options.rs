@@ -58,7 +58,7 @@ pub struct EncodeOptions {
     /// Bits per texture coordinate over each set's bounding box (1..=24; inputs with UVs only).
     pub uv_bits: u8,
     /// Frames per temporal segment: a longer clip is coded as segments of this many frames, each
-    /// with its own temporal DCT or groups of pictures ([`super::segments`]); `None` codes any
+    /// with its own temporal DCT or groups of pictures ([`super::SegmentedEncoder`]); `None` codes any
     /// clip as one.
     pub segment_frames: Option<usize>,
     /// Segments coded at once (on rayon's threads): memory holds this many segments' working
@@ -328,46 +328,5 @@ impl EncodeOptions {
             }
         }
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::codec::Codec;
-
-    #[test]
-    fn affine_precision_is_fine_only_for_p_frames_that_suffer_from_coarse_maps() {
-        let code = |codec: Codec, gop| {
-            let mut config = codec.default_config();
-            match &mut config {
-                CodecConfig::Mpeg4(c) => c.gop = gop,
-                CodecConfig::Hevc(c) | CodecConfig::Av1(c) => c.gop = gop,
-                _ => {}
-            }
-            let opts = EncodeOptions {
-                codec: config,
-                ..EncodeOptions::default()
-            };
-            opts.plan(1.0).unwrap().affine_precision
-        };
-        // In sixteenths: 4 = 1/4, 1 = 1/16.
-        for (codec, gop, expected) in [
-            (Codec::Tdct, 50, 4),
-            (Codec::Jpeg, 50, 4),
-            (Codec::Hevc, 1, 4),
-            (Codec::Hevc, 50, 4),
-            (Codec::Av1, 1, 4),
-            (Codec::Av1, 50, 1),
-            (Codec::Mpeg4, 50, 1),
-        ] {
-            assert_eq!(code(codec, gop), expected, "{codec:?} gop {gop}");
-        }
-        let asked = EncodeOptions {
-            codec: Codec::Av1.into(),
-            affine_precision: Some(0.5),
-            ..EncodeOptions::default()
-        };
-        assert_eq!(asked.plan(1.0).unwrap().affine_precision, 8);
     }
 }

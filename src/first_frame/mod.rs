@@ -60,7 +60,8 @@ pub struct EncodedFirstFrame {
     pub decoded_positions: Vec<Point>,
     /// With `reorder`: `permutation[new] = old` vertex index; `None` when the order is kept.
     pub permutation: Option<Vec<u32>>,
-    /// Bytes of each stream, for reports.
+    /// Bytes of each stream (read by the first-frame bench and tests).
+    #[cfg_attr(not(feature = "internals"), allow(dead_code))]
     pub sizes: StreamSizes,
 }
 

@@ -33,9 +33,16 @@ impl Correction {
 pub struct Corrections(Vec<Vec<Correction>>);
 
 impl Corrections {
-    /// No corrections for `frames` frames.
-    pub fn none(frames: usize) -> Self {
-        Self(vec![Vec::new(); frames])
+    /// How many corrections in all.
+    #[cfg(any(test, feature = "internals"))]
+    pub fn len(&self) -> usize {
+        self.0.iter().map(Vec::len).sum()
+    }
+
+    /// Whether there are none.
+    #[cfg(any(test, feature = "internals"))]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 
     /// The corrections of every residual that does not fit its frame's range.
@@ -67,16 +74,6 @@ impl Corrections {
     /// Frame `f`'s corrections (none past the last frame).
     pub fn frame(&self, f: usize) -> &[Correction] {
         self.0.get(f).map_or(&[], Vec::as_slice)
-    }
-
-    /// How many corrections in all.
-    pub fn len(&self) -> usize {
-        self.0.iter().map(Vec::len).sum()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 
     /// Appends the list to `w`.

@@ -8,7 +8,7 @@ use crate::motion::Partition;
 /// The size of the geometry-image lattice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Lattice {
-    /// Sized from the vertex count (see [`auto_side`]), grown until the charts fit.
+    /// Sized from the vertex count (about 2 pixels a vertex), grown until the charts fit.
     #[default]
     Auto,
     /// Exactly this width and height.

@@ -14,7 +14,7 @@ mod plane;
 pub mod quantise;
 pub mod tile;
 
-pub use corrections::{Correction, Corrections};
+pub use corrections::Corrections;
 pub use images::GeometryImages;
 pub use lattice::Lattice;
 pub use plane::Plane;

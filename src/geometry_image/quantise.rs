@@ -25,14 +25,8 @@ use super::corrections::Corrections;
 use crate::error::{Error, Result};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 
-/// Largest quantised value of 8-bit images.
-pub const LEVELS: f32 = 255.0;
-/// The level of the offset in 8-bit images: mid-grey.
-pub const MID: f32 = 128.0;
 /// The share of a group's values that may be clipped and corrected before its step is widened.
 pub const CORRECTION_SHARE: f64 = 1.0 / 256.0;
-/// Sample depths the images can be made at, in bits.
-pub const DEPTHS: std::ops::RangeInclusive<u8> = 8..=16;
 
 /// Largest level at `depth` bits a sample (255 at 8 bits).
 pub fn max_level(depth: u8) -> f32 {
@@ -268,14 +262,14 @@ mod tests {
     #[test]
     fn levels_round_trip_within_half_a_step_and_mid_grey_is_the_offset() {
         let r = AxisRange::new(0.01, 7);
-        assert_eq!(r.quantise(0.07), MID);
+        assert_eq!(r.quantise(0.07), mid_level(8));
         for i in -127..=127 {
             let v = 0.07 + i as f32 * 0.0099;
             assert!(r.fits(v), "{v}");
             let back = r.dequantise(r.quantise(v).round());
             assert!((back - v).abs() <= 0.005 + 1e-6, "{v} -> {back}");
         }
-        assert!(!r.fits(0.07 + 1.3) && r.quantise(0.07 + 1.3) == LEVELS);
+        assert!(!r.fits(0.07 + 1.3) && r.quantise(0.07 + 1.3) == max_level(8));
     }
 
     #[test]

@@ -24,17 +24,6 @@ pub fn compose(images: [&[f32]; 3], width: usize, height: usize, depth: u8) -> P
     }
 }
 
-/// One coordinate's image (`axis` 0, 1, 2) cut back out of a composed plane, as `f32` levels.
-pub fn axis_image(plane: &Plane<u16>, axis: usize, width: usize, height: usize) -> Vec<f32> {
-    let stride = plane.width as usize;
-    let mut out = Vec::with_capacity(width * height);
-    for y in 0..height {
-        let start = y * stride + axis * width;
-        out.extend(plane.data[start..start + width].iter().map(|&v| v as f32));
-    }
-    out
-}
-
 /// The levels at the given lattice pixels of coordinate `axis` of a composed plane.
 pub fn sample(plane: &Plane<u16>, axis: usize, width: usize, pixels: &[[u16; 2]]) -> Vec<f32> {
     let stride = plane.width as usize;
@@ -47,6 +36,17 @@ pub fn sample(plane: &Plane<u16>, axis: usize, width: usize, pixels: &[[u16; 2]]
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One coordinate's image (`axis` 0, 1, 2) cut back out of a composed plane, as `f32` levels.
+    pub fn axis_image(plane: &Plane<u16>, axis: usize, width: usize, height: usize) -> Vec<f32> {
+        let stride = plane.width as usize;
+        let mut out = Vec::with_capacity(width * height);
+        for y in 0..height {
+            let start = y * stride + axis * width;
+            out.extend(plane.data[start..start + width].iter().map(|&v| v as f32));
+        }
+        out
+    }
 
     #[test]
     fn compose_then_cut_and_sample() {

@@ -1,14 +1,18 @@
 //! Animated triangle meshes: one connectivity shared by all frames, one position set per frame.
 //!
-//! Readers and writers for OBJ sequences, PC2 point caches and glTF live in the submodules;
-//! [`topology`] holds the adjacency helpers the later stages need.
+//! [`AnimatedMesh`] is what every stage works on. [`read_animation`] reads OBJ sequences (a folder
+//! or glob), PC2 point caches with their base OBJ, and glTF/GLB morph-target or skinned clips
+//! (baked at a frame rate); [`FrameSource`] reads a long one a run of frames at a time. The
+//! writers give OBJ frames, PC2 caches and glTF with a morph target per frame.
 
 mod attributes;
-pub mod frames;
-pub mod gltf_write;
-pub mod io;
 mod summary;
-pub mod topology;
+internal! {
+    frames;
+    gltf_write;
+    io;
+    topology;
+}
 
 mod gltf;
 mod obj;
@@ -20,10 +24,11 @@ pub use frames::FrameSource;
 /// Frames per second of a glTF output when the source's rate is unknown (OBJ and PC2 inputs).
 pub const DEFAULT_FPS: f64 = 30.0;
 pub use gltf::Clip;
-pub use gltf_write::{write_gltf, GltfOptions};
+pub use gltf_write::{is_gltf_path, write_gltf, GltfOptions, MANY_MORPH_TARGETS};
 pub use io::{
-    clips, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame, write_obj_mesh_frame,
-    write_obj_sequence, write_pc2, ReadOptions,
+    clips, input_files, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame,
+    write_obj_mesh_frame, write_obj_sequence, write_obj_sequence_from, write_pc2, ObjFrameWriter,
+    Pc2Writer, ReadOptions,
 };
 pub use summary::Summary;
 

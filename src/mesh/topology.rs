@@ -48,6 +48,7 @@ impl VertexAdjacency {
         &self.targets[self.offsets[v]..self.offsets[v + 1]]
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// All vertices within `k` edges of `v`, `v` itself first, then by increasing distance.
     pub fn k_ring(&self, v: usize, k: usize) -> Vec<u32> {
         let mut scratch = KRingScratch::new(self.vertex_count());

@@ -14,6 +14,7 @@ use crate::mesh::{Point, Triangle};
 /// Triangles per leaf: a few exact distance tests are cheaper than another level of boxes.
 const LEAF_SIZE: usize = 4;
 
+#[cfg(any(test, feature = "internals"))]
 /// Room for the traversal stack of any tree: median splits halve the count, so 2³² triangles need
 /// at most 32 levels.
 const MAX_DEPTH: usize = 64;
@@ -177,11 +178,13 @@ impl TriangleBvh {
         self.corners.get(t as usize)
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// Number of triangles in the tree.
     pub fn len(&self) -> usize {
         self.corners.len()
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// Always false: a tree is never built over no triangles.
     pub fn is_empty(&self) -> bool {
         self.corners.is_empty()
@@ -194,6 +197,7 @@ impl TriangleBvh {
         }
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// The triangle nearest to `p`. `hint`, a triangle likely to be near (out-of-range hints are
     /// ignored), only speeds the search up: the answer is exact either way.
     pub fn nearest(&self, p: Vec3, hint: Option<u32>) -> Nearest {

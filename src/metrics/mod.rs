@@ -2,19 +2,22 @@
 //! KG error, Hausdorff distance and bpvf.
 //!
 //! Every distance is divided by the diagonal of the *original's* first-frame bounding box.
-//! [`surface`] holds the per-frame surface distance (reusable by benches); [`bvh`] and [`triangle`]
-//! the exact nearest-triangle machinery; [`sampling`] where the surfaces are sampled.
+//! [`compare`] measures two animations held in memory; [`Comparison`] measures a long one a run of
+//! frames at a time.
 
-pub mod bvh;
 mod running;
-pub mod sampling;
-pub mod surface;
-pub mod triangle;
+internal! {
+    bvh;
+    sampling;
+    surface;
+    triangle;
+}
 
 pub use running::Comparison;
+pub use surface::Surface;
+#[cfg(feature = "internals")]
 pub use surface::{
-    frame_distance, frame_distance_planned, FrameDistance, IndexCache, OneSided, Surface,
-    SurfacePlans,
+    frame_distance, frame_distance_planned, FrameDistance, IndexCache, OneSided, SurfacePlans,
 };
 
 use crate::error::{Error, Result};

@@ -124,11 +124,13 @@ impl SamplingPlan {
         planner.finish()
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.samples.len()
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// True when the surface has no faces.
     pub fn is_empty(&self) -> bool {
         self.samples.is_empty()
@@ -176,6 +178,7 @@ impl SamplingPlan {
     }
 }
 
+#[cfg(any(test, feature = "internals"))]
 /// Samples the surface of `triangles` at `positions` with the given `spacing`; the weights sum to
 /// the total area. (A plan made and applied at once; see [`SamplingPlan`] to reuse one.)
 pub fn sample_surface(triangles: &[Triangle], positions: &[Point], spacing: f64) -> Vec<Sample> {

@@ -158,7 +158,7 @@ pub struct SurfacePlans {
 
 impl SurfacePlans {
     /// Plans both surfaces from their reference frames `a` and `b` with the sample `spacing`
-    /// (see [`super::sampling::sample_spacing`]).
+    /// (see `sampling::sample_spacing`).
     pub fn new(a: Surface<'_>, b: Surface<'_>, spacing: f64) -> Self {
         Self {
             first: SamplingPlan::new(a.triangles, a.positions, spacing),
@@ -167,6 +167,7 @@ impl SurfacePlans {
     }
 }
 
+#[cfg(any(test, feature = "internals"))]
 /// Both one-sided distances between surfaces `a` and `b` of one frame, each sampled with `spacing`.
 pub fn frame_distance(a: Surface<'_>, b: Surface<'_>, spacing: f64) -> Result<FrameDistance> {
     let plans = SurfacePlans::new(a, b, spacing);

@@ -33,10 +33,13 @@ pub use affine::{
     identity_levels, AffineTrack, ClusterGeometry, QuantisedAffine, DEFAULT_AFFINE_PRECISION,
     MAX_AFFINE_LEVEL, MAX_AFFINE_STEP, MIN_AFFINE_STEP,
 };
-pub use decimate::{decimate, DecimateOptions, Decimation, DEFAULT_E0, MAX_DECIMATION_CLUSTERS};
-pub use fit::AffineCoefficients;
-pub use kmeans::{segment, SegmentOptions, MIN_CLUSTER_SIZE};
+#[cfg(any(test, feature = "internals"))]
+pub use decimate::Decimation;
+pub use decimate::{decimate, DecimateOptions, DEFAULT_E0};
+pub use kmeans::{segment, SegmentOptions};
 pub use partition::Partition;
 pub use predictor::{predict_frame, PredictorKind};
-pub use residual::{energy, residuals};
-pub use skinning::{cluster_neighbours, SkinningWeights, DEFAULT_RIDGE, MAX_WEIGHT, WEIGHT_BITS};
+#[cfg(any(test, feature = "internals"))]
+pub use residual::energy;
+pub use residual::residuals;
+pub use skinning::{cluster_neighbours, SkinningWeights, DEFAULT_RIDGE, WEIGHT_BITS};

@@ -11,6 +11,7 @@ pub fn residuals(frame: &[Point], predicted: &[Point]) -> Vec<[f32; 3]> {
         .collect()
 }
 
+#[cfg(any(test, feature = "internals"))]
 /// Sum of squared lengths of a set of displacement vectors.
 pub fn energy(vectors: &[[f32; 3]]) -> f64 {
     vectors

@@ -182,6 +182,7 @@ pub fn encode_affine(track: &AffineTrack) -> Result<Vec<u8>> {
     Ok(w.into_bytes())
 }
 
+#[cfg(any(test, feature = "internals"))]
 /// Decodes the affine track of `frames` frames for `partition`'s clusters on the decoded frame 0
 /// `reference` (whose cluster geometry sets the steps). The part is read twice: once keeping no
 /// level (as [`check_affine`]), then into a track, so that its 12 levels a frame and cluster (96

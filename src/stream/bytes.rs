@@ -62,16 +62,6 @@ impl ByteWriter {
     pub fn into_bytes(self) -> Vec<u8> {
         self.bytes
     }
-
-    /// Number of bytes written so far.
-    pub fn len(&self) -> usize {
-        self.bytes.len()
-    }
-
-    /// True when nothing was written.
-    pub fn is_empty(&self) -> bool {
-        self.bytes.is_empty()
-    }
 }
 
 /// Reads little-endian values from a byte slice; `context` names the part in errors.

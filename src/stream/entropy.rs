@@ -173,6 +173,7 @@ impl SymbolModel {
         }
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// Number of symbols.
     pub fn size(&self) -> usize {
         self.size
@@ -229,6 +230,7 @@ impl UIntModel {
 }
 
 impl IntModel {
+    #[cfg(any(test, feature = "internals"))]
     /// Bits that coding `value` would cost now, without coding it.
     pub fn cost(&self, value: i64) -> f64 {
         signed_cost(value, &self.magnitude, &self.sign)
@@ -357,6 +359,7 @@ impl Encoder {
         self.raw_bits(low, length - 1);
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// Codes a signed integer.
     pub fn signed(&mut self, value: i64, model: &mut IntModel) {
         self.signed_with(value, model.parts());
@@ -493,6 +496,7 @@ impl Decoder {
         u64::try_from(value).map_err(|_| corrupt("integer overflows 64 bits"))
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// Decodes a signed integer.
     pub fn signed(&mut self, model: &mut IntModel) -> Result<i64> {
         self.signed_with(model.parts())

@@ -120,16 +120,6 @@ impl FrameIndex {
             .find(|&i| self.entries[i].key)
             .unwrap_or(0)
     }
-
-    /// Number of frames.
-    pub fn len(&self) -> usize {
-        self.entries.len()
-    }
-
-    /// True when there are no frames.
-    pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
-    }
 }
 
 #[cfg(test)]

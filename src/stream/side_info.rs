@@ -13,7 +13,9 @@ use crate::mesh::Triangle;
 use crate::motion::{cluster_neighbours, Partition, SkinningWeights};
 
 pub(crate) use super::affine_coding::decode_checked_affine;
-pub use super::affine_coding::{check_affine, decode_affine, encode_affine};
+#[cfg(any(test, feature = "internals"))]
+pub use super::affine_coding::decode_affine;
+pub use super::affine_coding::{check_affine, encode_affine};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::entropy::{
     self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel,

@@ -6,10 +6,10 @@
 #![allow(dead_code)]
 
 use mcgv_video::codec::{Codec, CodecConfig};
-use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, Point, ReadOptions, Triangle};
 use mcgv_video::stream::container::{Checksum, ContainerReader, ContainerWriter, Tag};
+use mcgv_video::{DecodeOptions, Decoder};
 use mcgv_video::{Lattice, PaddingMethod};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};

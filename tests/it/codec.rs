@@ -1,9 +1,9 @@
 //! Round trips through the residual-image codecs: error bounds, rate control, random access, and
 //! robustness against damaged input.
 
-use mcgv_video::codec::mpeg4::mpeg4_law;
-use mcgv_video::codec::mpeg4::{self, Mpeg4Options, Packet};
-use mcgv_video::codec::{abbreviated, jpeg, Plane};
+use mcgv_video::codec::pictures::mpeg4::mpeg4_law;
+use mcgv_video::codec::pictures::mpeg4::{self, Mpeg4Options, Packet};
+use mcgv_video::codec::pictures::{abbreviated, jpeg, Plane};
 use mcgv_video::Result;
 use std::f64::consts::TAU;
 use std::process::Command;

@@ -4,8 +4,8 @@
 use crate::common::{harness, parts, rebuild, tiny_stream};
 
 use mcgv_video::codec::Codec;
-use mcgv_video::decoder::Decoder;
 use mcgv_video::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
+use mcgv_video::Decoder;
 use mcgv_video::Error;
 use std::io::Cursor;
 use std::path::PathBuf;

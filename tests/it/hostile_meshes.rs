@@ -7,10 +7,10 @@
 
 use crate::common::{canonical, config};
 use mcgv_video::codec::Codec;
-use mcgv_video::decoder::Decoder;
 use mcgv_video::encoder::{encode, EncodeOptions};
 use mcgv_video::mesh::{AnimatedMesh, Point, Triangle};
 use mcgv_video::stream::entropy::{self, BitModel, IntModel, SymbolCoder, SymbolModel, UIntModel};
+use mcgv_video::Decoder;
 use mcgv_video::{Lattice, PaddingMethod};
 use proptest::prelude::*;
 

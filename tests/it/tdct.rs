@@ -3,7 +3,6 @@
 //! and damaged or forged streams.
 
 use crate::common::{config, encode_bytes, read_media, vertex_rmse};
-use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::{encode, EncodeOptions, Segmentation};
 use mcgv_video::mesh::{AnimatedMesh, Triangle};
 use mcgv_video::metrics::compare;
@@ -11,6 +10,7 @@ use mcgv_video::motion::PredictorKind;
 use mcgv_video::stream::container::{ContainerReader, Tag, FILE_HEADER_LEN, PART_HEADER_LEN};
 use mcgv_video::PaddingMethod;
 use mcgv_video::{codec::Codec, stream::header::Header};
+use mcgv_video::{DecodeOptions, Decoder};
 use std::collections::BTreeSet;
 use std::io::Cursor;
 

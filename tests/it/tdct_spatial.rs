@@ -5,7 +5,6 @@ use crate::common::{encode_bytes, read_media};
 use mcgv_video::codec::tdct::coefficients::{forward, quantise, BandCoder, DEAD_ZONE};
 use mcgv_video::codec::tdct::spatial::{Neighbourhood, Spatial};
 use mcgv_video::codec::Codec;
-use mcgv_video::decoder::{DecodeOptions, Decoder};
 use mcgv_video::encoder::analysis::{predict, segment};
 use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
@@ -13,6 +12,7 @@ use mcgv_video::mesh::AnimatedMesh;
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::PredictorKind;
 use mcgv_video::stream::container::ContainerReader;
+use mcgv_video::{DecodeOptions, Decoder};
 use std::io::Cursor;
 use std::sync::Arc;
 

@@ -10,9 +10,9 @@ use crate::args::ConvertArgs;
 use crate::output::{
     animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
 };
-use mcgv_video::error::Result;
-use mcgv_video::mesh::gltf_write::is_gltf_path;
+use mcgv_video::mesh::is_gltf_path;
 use mcgv_video::mesh::{write_gltf, write_obj_sequence, GltfOptions, ReadOptions};
+use mcgv_video::Result;
 
 /// Runs `convert`.
 pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {

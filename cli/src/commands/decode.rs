@@ -5,13 +5,11 @@ use crate::output::{
     animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
 };
 use crate::progress;
-use mcgv_video::decoder::{DecodeOptions, Decoder};
-use mcgv_video::error::{Error, Result};
-use mcgv_video::mesh::gltf_write::MANY_MORPH_TARGETS;
-use mcgv_video::mesh::io::{
-    write_obj_mesh_frame, write_obj_sequence_from, ObjFrameWriter, Pc2Writer,
-};
+use mcgv_video::mesh::MANY_MORPH_TARGETS;
 use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions, DEFAULT_FPS};
+use mcgv_video::mesh::{write_obj_mesh_frame, write_obj_sequence_from, ObjFrameWriter, Pc2Writer};
+use mcgv_video::{DecodeOptions, Decoder};
+use mcgv_video::{Error, Result};
 use std::fs::File;
 use std::io::BufReader;
 use std::time::Instant;

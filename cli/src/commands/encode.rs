@@ -1,23 +1,21 @@
 //! `mcgv-video encode`.
 
-use crate::args::{BitDepth, CodecChoice, EncodeArgs, PredictorChoice, SegmentationChoice};
+use crate::args::{BitDepth, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
-use mcgv_video::codec::{
-    Codec, CodecConfig, DeepConfig, JpegConfig, Mpeg4Config, PictureOptions, TdctConfig,
-};
+use mcgv_video::codec::{Codec, CodecConfig, PictureOptions};
 use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
 use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
-use mcgv_video::error::{Error, Result};
-use mcgv_video::mesh::io::input_files;
+use mcgv_video::mesh::input_files;
 use mcgv_video::mesh::ReadOptions;
-use mcgv_video::motion::PredictorKind;
 use mcgv_video::Lattice;
+use mcgv_video::PredictorKind;
+use mcgv_video::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Parses the encode arguments into encoder options, rejecting nonsense with a clear message.
 pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions> {
-    let e0 = args.e0.unwrap_or(mcgv_video::motion::DEFAULT_E0);
+    let e0 = args.e0.unwrap_or(mcgv_video::encoder::DEFAULT_E0);
     let segmentation = match args.segmentation {
         SegmentationChoice::Kmeans => {
             if args.e0.is_some() {
@@ -66,18 +64,11 @@ pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions>
     })
 }
 
-/// The codec and its own options from the flags: the one place that knows which flag belongs to
-/// which codec (another codec's flag is a usage error naming the codecs it belongs to).
+/// The codec and its own options from the flags: each flag sets a field of the codec's
+/// configuration; a flag of a field the codec has not is a usage error naming the codecs it
+/// belongs to (the configurations say which, [`CodecConfig`]).
 fn codec_config(args: &EncodeArgs) -> Result<CodecConfig> {
     let lattice = parse_lattice(&args.lattice)?;
-    let codec = match args.codec {
-        CodecChoice::Jpeg => Codec::Jpeg,
-        CodecChoice::Mpeg4 => Codec::Mpeg4,
-        CodecChoice::Tdct => Codec::Tdct,
-        CodecChoice::Hevc => Codec::Hevc,
-        CodecChoice::Av1 => Codec::Av1,
-    };
-    check_codec_options(args, codec, lattice)?;
     let padding = match &args.padding {
         Some(name) => Some(
             name.parse::<mcgv_video::PaddingMethod>()
@@ -85,72 +76,86 @@ fn codec_config(args: &EncodeArgs) -> Result<CodecConfig> {
         ),
         None => None,
     };
-    let pictures = PictureOptions { lattice, padding };
-    let gop = args.gop.map_or(mcgv_video::DEFAULT_GOP, |g| {
-        usize::try_from(g).unwrap_or(usize::MAX)
-    });
-    let deep = DeepConfig {
-        qp: args.qp,
-        gop,
-        bit_depth: match args.bit_depth {
-            BitDepth::Auto => None,
-            BitDepth::Bits(bits) => Some(bits),
-        },
-        pictures,
+    let bit_depth = match args.bit_depth {
+        BitDepth::Auto => None,
+        BitDepth::Bits(bits) => Some(bits),
     };
-    Ok(match codec {
-        Codec::Tdct => CodecConfig::Tdct(TdctConfig::default()),
-        Codec::Jpeg => CodecConfig::Jpeg(JpegConfig {
-            quality: args.jpeg_quality,
-            pictures,
-        }),
-        Codec::Mpeg4 => CodecConfig::Mpeg4(Mpeg4Config {
-            qscale: args.qscale,
-            gop,
-            pictures,
-        }),
-        Codec::Hevc => CodecConfig::Hevc(deep),
-        Codec::Av1 => CodecConfig::Av1(deep),
-    })
+    let gop = args.gop.map(|g| usize::try_from(g).unwrap_or(usize::MAX));
+    let mut config = CodecConfig::from(args.codec);
+    let quantiser = |name: &'static str, value: Option<u8>| {
+        move |c: &mut CodecConfig| match c.quantiser_mut() {
+            Some((n, q)) if n == name => {
+                *q = value;
+                true
+            }
+            _ => false,
+        }
+    };
+    set(
+        &mut config,
+        "qscale",
+        args.qscale.is_some(),
+        quantiser("qscale", args.qscale),
+    )?;
+    set(
+        &mut config,
+        "qp",
+        args.qp.is_some(),
+        quantiser("qp", args.qp),
+    )?;
+    let jpeg = quantiser("jpeg_quality", args.jpeg_quality);
+    set(
+        &mut config,
+        "jpeg_quality",
+        args.jpeg_quality.is_some(),
+        jpeg,
+    )?;
+    set(&mut config, "bit_depth", bit_depth.is_some(), |c| {
+        c.bit_depth_mut().map(|d| *d = bit_depth).is_some()
+    })?;
+    set(&mut config, "gop", gop.is_some(), |c| {
+        c.gop_mut().zip(gop).map(|(g, gop)| *g = gop).is_some()
+    })?;
+    let picture = |c: &mut CodecConfig| c.pictures_mut().is_some();
+    set(&mut config, "padding", padding.is_some(), picture)?;
+    set(&mut config, "lattice", lattice != Lattice::Auto, picture)?;
+    if let Some(pictures) = config.pictures_mut() {
+        *pictures = PictureOptions { lattice, padding };
+    }
+    Ok(config)
 }
 
-/// One rule for options of another codec: a usage error naming the codec(s) they belong to.
-fn check_codec_options(args: &EncodeArgs, codec: Codec, lattice: Lattice) -> Result<()> {
-    let images: &[Codec] = &[Codec::Jpeg, Codec::Mpeg4, Codec::Hevc, Codec::Av1];
-    let deep: &[Codec] = &[Codec::Hevc, Codec::Av1];
-    let given: [(&'static str, bool, &[Codec]); 7] = [
-        ("qscale", args.qscale.is_some(), &[Codec::Mpeg4]),
-        ("qp", args.qp.is_some(), deep),
-        ("bit_depth", args.bit_depth != BitDepth::Auto, deep),
-        ("jpeg_quality", args.jpeg_quality.is_some(), &[Codec::Jpeg]),
-        (
-            "gop",
-            args.gop.is_some(),
-            &[Codec::Mpeg4, Codec::Hevc, Codec::Av1],
-        ),
-        ("padding", args.padding.is_some(), images),
-        ("lattice", lattice != Lattice::Auto, images),
-    ];
-    for (option, set, codecs) in given {
-        if set && !codecs.contains(&codec) {
-            let names: Vec<&str> = codecs.iter().map(|c| c.name()).collect();
-            return Err(Error::option(
-                option,
-                format!(
-                    "applies to the {} codec only, not {}{}; add --codec {} or leave it out",
-                    names.join(" and "),
-                    codec.name(),
-                    if args.codec == CodecChoice::Tdct {
-                        " (the default)"
-                    } else {
-                        ""
-                    },
-                    names[0]
-                ),
-            ));
-        }
+/// Sets `option` of `config` with `apply`, which tells whether the codec has it, when the user
+/// gave it; an option the codec has not is a usage error naming the codecs that have it.
+fn set(
+    config: &mut CodecConfig,
+    option: &'static str,
+    given: bool,
+    apply: impl Fn(&mut CodecConfig) -> bool,
+) -> Result<()> {
+    if !given || apply(config) {
+        return Ok(());
     }
-    Ok(())
+    let takers: Vec<&str> = Codec::ALL
+        .into_iter()
+        .filter(|c| apply(&mut c.default_config()))
+        .map(Codec::name)
+        .collect();
+    let codec = config.codec();
+    Err(Error::option(
+        option,
+        format!(
+            "applies to the {} codec only, not {}{}; add --codec {} or leave it out",
+            takers.join(" and "),
+            codec.name(),
+            if codec == Codec::default() {
+                " (the default)"
+            } else {
+                ""
+            },
+            takers.first().copied().unwrap_or_default()
+        ),
+    ))
 }
 
 /// Parses `auto` or `WIDTHxHEIGHT`.

@@ -2,11 +2,10 @@
 
 use crate::args::EvalArgs;
 use crate::progress;
-use mcgv_video::decoder::Decoder;
-use mcgv_video::error::{Error, Result};
-use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::{AnimatedMesh, FrameSource, ReadOptions};
 use mcgv_video::metrics::{same_frame_count, Comparison, Measures, Surface};
+use mcgv_video::Decoder;
+use mcgv_video::{Error, Result};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
@@ -54,12 +53,7 @@ fn compare_stream(
 ) -> Result<Measures> {
     let frames = original.frame_count();
     same_frame_count(frames, decoder.header().frames as usize)?;
-    let bits = decoder.header().first_frame_bits;
-    let same_vertices = original.first().vertex_count() == decoder.header().vertices as usize;
-    let order = match decoder.header().reorder && same_vertices {
-        true => input_order(original.first(), bits)?,
-        false => None,
-    };
+    let order = decoder.input_order(original.first())?;
     let pb = progress::bar(frames as u64, "decode", quiet);
     let mut comparison: Option<Comparison> = None;
     for (s, range) in decoder.segments().to_vec().into_iter().enumerate() {
@@ -110,31 +104,6 @@ fn first_surface(source: &FrameSource) -> Surface<'_> {
         triangles: source.first().triangles(),
         positions: source.first().frame(0),
     }
-}
-
-/// A stream encoded with `--reorder` holds its vertices in the first-frame coder's traversal
-/// order, and keeps no permutation (that is what saves its bits). The coder is deterministic, so
-/// coding the original's first frame again gives the permutation: the returned `inverse` puts the
-/// decoded vertices back in the input order (input vertex `v` is decoded vertex `inverse[v]`), so
-/// that vertex RMSE and KG error compare each vertex with itself.
-fn input_order(original: &AnimatedMesh, bits: u8) -> Result<Option<Vec<u32>>> {
-    let options = FirstFrameOptions {
-        bits,
-        reorder: true,
-    };
-    let coded = first_frame::encode(original.frame(0), original.triangles(), &options)?;
-    let Some(permutation) = coded.permutation else {
-        return Ok(None);
-    };
-    if permutation.len() != original.vertex_count() {
-        return Ok(None);
-    }
-    // permutation[new] = old; the decoded mesh is in `new` order, so vertex `old` is at inverse[old].
-    let mut inverse = vec![0u32; permutation.len()];
-    for (new, &old) in permutation.iter().enumerate() {
-        inverse[old as usize] = new as u32;
-    }
-    Ok(Some(inverse))
 }
 
 /// Whether a path names a `.mcgv` stream (compared after decoding, with its bpvf).

@@ -1,8 +1,8 @@
 //! `mcgv-video info`: what an animation is made of, as text or one JSON object.
 
 use crate::args::InfoArgs;
-use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::{clips, Clip, Point, ReadOptions, Summary};
+use mcgv_video::{Error, Result};
 use std::time::Instant;
 
 /// What `info` reports; the field names are the JSON keys.

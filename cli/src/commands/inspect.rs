@@ -4,10 +4,10 @@ use crate::annotate;
 use crate::args::InspectArgs;
 use mcgv_video::codec::Description;
 use mcgv_video::codec::Plane;
-use mcgv_video::decoder::Decoder;
-use mcgv_video::error::{Error, Result};
-use mcgv_video::geometry_image::{tile, FrameRanges};
-use mcgv_video::stream::header::Header;
+use mcgv_video::inspect::FrameRanges;
+use mcgv_video::Decoder;
+use mcgv_video::Header;
+use mcgv_video::{Error, Result};
 use std::path::Path;
 
 /// Runs `inspect`.
@@ -314,14 +314,12 @@ fn write_encoder_pngs<R: std::io::Read + std::io::Seek>(
     frames: &[usize],
     quiet: bool,
 ) -> Result<()> {
-    let (w, h) = (usize::from(lattice.0), usize::from(lattice.1));
+    let w = usize::from(lattice.0);
     let mesh = super::read_input(original, &(&args.input_args).into(), quiet)?;
     let ranges = decoder.ranges().to_vec();
     for images in mcgv_video::inspect::encoder_images(decoder, &mesh, frames)? {
         let f = images.frame;
-        for (kind, levels) in [("raw", &images.raw), ("padded", &images.padded)] {
-            let depth = ranges.get(f).map_or(8, |r| r[0].depth);
-            let plane = tile::compose([&levels[0], &levels[1], &levels[2]], w, h, depth);
+        for (kind, plane) in [("raw", images.raw), ("padded", images.padded)] {
             save_residuals(
                 &dir.join(format!("frame_{f:04}_{kind}.png")),
                 plane,

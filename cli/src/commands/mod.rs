@@ -7,8 +7,8 @@ pub mod eval;
 pub mod info;
 pub mod inspect;
 
-use mcgv_video::error::{Error, Result};
 use mcgv_video::mesh::{clips, read_animation, AnimatedMesh, Clip, FrameSource, ReadOptions};
+use mcgv_video::{Error, Result};
 use std::path::Path;
 
 /// An animation's frames as `encode` and `eval` read them: OBJ sequences and PC2 caches a run of

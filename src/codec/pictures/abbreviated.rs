@@ -91,7 +91,7 @@ pub fn join(shared: &[u8], tables: &[u8], scan: &[u8]) -> Result<Vec<u8>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::codec::{jpeg, Plane};
+    use crate::codec::pictures::{jpeg, Plane};
 
     #[test]
     fn split_and_join_restore_a_real_jpeg() {

@@ -18,26 +18,10 @@ use crate::error::Result;
 use crate::motion::DEFAULT_AFFINE_PRECISION;
 
 #[cfg(feature = "ffmpeg")]
-pub use coder::Libaom;
-#[cfg(feature = "ffmpeg")]
 pub(crate) use coder::PICTURES;
 
 /// The largest quantiser (`crf`) libaom takes.
 pub const MAX_QP: u8 = 63;
-/// libaom's speed preset: 0 (slowest, smallest) ..= 6 in its "good" usage. 4 measured 2 % lower
-/// RMSE at equal rate on CesiumMan (quality 50 / 75) for 50 % / 42 % more encode CPU time.
-pub const CPU_USED: u8 = 6;
-/// Frames libaom looks ahead in a P-frame group (`--gop` above 1), which lets it code hidden
-/// alternate-reference frames (`auto-alt-ref`): a future frame coded first, shown later, that the
-/// frames between predict from. The hidden frame travels in the packet of a shown frame (AV1's
-/// temporal unit), so the stream keeps one packet per frame, in order. Measured against no look-ahead
-/// (docs/results.md, "AV1 tuning"): 13–20 % fewer bits at equal RMSE on walking_cat and pcow, and
-/// less encode time.
-pub const LAG_IN_FRAMES: u8 = 19;
-/// Strength of the temporal filter libaom runs over the frames an alternate reference stands for:
-/// 0, no filtering (docs/results.md, "AV1 tuning").
-pub const ARNR_STRENGTH: u8 = 0;
-
 /// Fails, naming the option, when one of `config` is out of range for AV1.
 pub(crate) fn check(config: &DeepConfig) -> Result<()> {
     config.check(Codec::Av1, MAX_QP)
@@ -174,8 +158,21 @@ pub fn av1_law(quality: u8, depth: u8) -> PictureLaw {
 #[cfg(feature = "ffmpeg")]
 mod coder {
     use super::super::deep::{self, Flavour};
-    use super::{ARNR_STRENGTH, CPU_USED, LAG_IN_FRAMES, MAX_QP};
-    use crate::codec::Codec;
+    use super::MAX_QP;
+
+    /// libaom's speed preset: 0 (slowest, smallest) ..= 6 in its "good" usage. 4 measured 2 % lower
+    /// RMSE at equal rate on CesiumMan (quality 50 / 75) for 50 % / 42 % more encode CPU time.
+    pub const CPU_USED: u8 = 6;
+    /// Frames libaom looks ahead in a P-frame group (`--gop` above 1), which lets it code hidden
+    /// alternate-reference frames (`auto-alt-ref`): a future frame coded first, shown later, that the
+    /// frames between predict from. The hidden frame travels in the packet of a shown frame (AV1's
+    /// temporal unit), so the stream keeps one packet per frame, in order. Measured against no look-ahead
+    /// (docs/results.md, "AV1 tuning"): 13–20 % fewer bits at equal RMSE on walking_cat and pcow, and
+    /// less encode time.
+    pub const LAG_IN_FRAMES: u8 = 19;
+    /// Strength of the temporal filter libaom runs over the frames an alternate reference stands for:
+    /// 0, no filtering (docs/results.md, "AV1 tuning").
+    pub const ARNR_STRENGTH: u8 = 0;
     use ffmpeg_next::{codec, Dictionary};
 
     /// libaom's encoder and FFmpeg's AV1 decoder.
@@ -188,10 +185,6 @@ mod coder {
     impl Flavour for Libaom {
         fn name(&self) -> &'static str {
             "av1"
-        }
-
-        fn codec(&self) -> Codec {
-            Codec::Av1
         }
 
         fn encoder_name(&self) -> &'static str {
@@ -255,10 +248,7 @@ mod tests {
                 step: None,
                 affine_precision: None,
             };
-            let depth = |plan: RatePlan| match plan.coder {
-                crate::codec::rate::CoderPlan::Pictures(p) => p.depth,
-                crate::codec::rate::CoderPlan::Tdct => 0,
-            };
+            let depth = |plan: RatePlan| plan.pictures.map_or(0, |p| p.depth);
             (
                 depth(plan(&config, &rate, 1.0).unwrap()),
                 depth(super::super::hevc::plan(&config, &rate, 1.0).unwrap()),

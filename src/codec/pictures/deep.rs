@@ -13,10 +13,10 @@ use crate::codec::rate::{PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::{Error, Result};
 
+#[cfg(all(feature = "ffmpeg", any(test, feature = "internals")))]
+pub use coder::{Decoder, Encoder, Packet, Planes, DEFAULT_PLANES};
 #[cfg(feature = "ffmpeg")]
-pub use coder::{Decoder, Encoder, Options, Packet, Planes, DEFAULT_PLANES};
-#[cfg(feature = "ffmpeg")]
-pub(crate) use coder::{Flavour, Pictures};
+pub(crate) use coder::{Flavour, Options, Pictures};
 
 /// The options of HEVC and AV1: the codec's quantiser, the groups of pictures, the sample depth,
 /// and the lattice and padding of the pictures.
@@ -28,9 +28,9 @@ pub struct DeepConfig {
     /// Frames per group of pictures: a key frame, then `gop − 1` P-frames (1: all-intra, every
     /// frame decodes alone).
     pub gop: usize,
-    /// Bits a sample, 10 or 12; `None` picks it from the quality ([`auto_depth`]).
+    /// Bits a sample, 10 or 12; `None` picks it from the quality (12 bits from quality 90).
     pub bit_depth: Option<u8>,
-    /// The lattice and padding (default: [`deep_padding`]).
+    /// The lattice and padding (default: `pushpull` all-intra, `biharmonic` with P-frames).
     pub pictures: PictureOptions,
 }
 
@@ -132,7 +132,6 @@ mod coder {
     use super::super::PictureSetup;
     use super::super::{libav, PictureCodec, PictureDecoder, PictureEncoder, PicturePlan, Plane};
     use super::DEPTHS;
-    use crate::codec::Codec;
     use crate::geometry_image::quantise;
     use crate::stream::frame_index::FrameChunk;
     use crate::{Error, Result};
@@ -148,8 +147,6 @@ mod coder {
     pub trait Flavour: Sync {
         /// The codec's name in errors and on the command line ("hevc", "av1").
         fn name(&self) -> &'static str;
-        /// The codec's stream id.
-        fn codec(&self) -> Codec;
         /// The FFmpeg encoder's name.
         fn encoder_name(&self) -> &'static str;
         /// The FFmpeg decoder's codec id (FFmpeg picks its preferred decoder for it).

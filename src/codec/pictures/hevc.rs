@@ -26,8 +26,6 @@ use crate::motion::DEFAULT_AFFINE_PRECISION;
 
 #[cfg(feature = "ffmpeg")]
 pub(crate) use coder::PICTURES;
-#[cfg(feature = "ffmpeg")]
-pub use coder::X265;
 
 /// The largest QP x265 takes.
 pub const MAX_QP: u8 = 51;
@@ -81,7 +79,6 @@ pub fn hevc_law(quality: u8, depth: u8) -> PictureLaw {
 mod coder {
     use super::super::deep::{self, Flavour};
     use super::MAX_QP;
-    use crate::codec::Codec;
     use ffmpeg_next::{codec, Dictionary};
 
     /// libx265 and FFmpeg's `hevc` decoder.
@@ -94,10 +91,6 @@ mod coder {
     impl Flavour for X265 {
         fn name(&self) -> &'static str {
             "hevc"
-        }
-
-        fn codec(&self) -> Codec {
-            Codec::Hevc
         }
 
         fn encoder_name(&self) -> &'static str {

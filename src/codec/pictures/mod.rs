@@ -18,7 +18,7 @@ mod libav;
 pub mod mpeg4;
 mod setup;
 
-use super::rate::{CoderPlan, Rate, RatePlan};
+use super::rate::{Rate, RatePlan};
 use super::Codec;
 use crate::error::{Error, Result};
 pub use crate::geometry_image::Plane;
@@ -109,7 +109,8 @@ pub(crate) fn plan(
     let mut plan = resolved.plan;
     plan.lattice = options.lattice;
     plan.padding = options.padding.unwrap_or(plan.padding);
-    Ok(rate.plan(step, resolved.affine_precision, CoderPlan::Pictures(plan)))
+    let codec = plan.codec;
+    Ok(rate.plan(step, resolved.affine_precision, codec, Some(plan)))
 }
 
 /// What a picture codec (one file per codec) tells the geometry-video coder. `Sync`: groups of

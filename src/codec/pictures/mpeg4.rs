@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 
 #[cfg(feature = "ffmpeg")]
 pub(crate) use coder::Pictures;
-#[cfg(feature = "ffmpeg")]
+#[cfg(all(feature = "ffmpeg", any(test, feature = "internals")))]
 pub use coder::{Decoder, Encoder, Mpeg4Options, Packet};
 
 /// MPEG-4 Part 2's options: its quantiser, its groups of pictures, their lattice and padding.
@@ -165,6 +165,7 @@ mod coder {
     }
 
     impl Encoder {
+        #[cfg(any(test, feature = "internals"))]
         /// Opens an encoder for `width × height` planes (sides even, at most 8191).
         pub fn new(width: u32, height: u32, options: &Mpeg4Options) -> Result<Self> {
             Self::starting_at(width, height, options, 0)

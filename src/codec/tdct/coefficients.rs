@@ -16,7 +16,9 @@ use crate::error::{Error, Result};
 use crate::stream::entropy::{self, BitModel, SignedModels, SymbolCoder, UIntModel};
 use std::sync::Arc;
 
-pub use super::transform::{basis, forward, quantise, Inverse, DEAD_ZONE};
+#[cfg(any(test, feature = "internals"))]
+pub use super::transform::DEAD_ZONE;
+pub use super::transform::{basis, forward, quantise, Inverse};
 
 /// Frequency classes of the context model: band k is in class min(⌊log2(k+1)⌋, CLASSES − 1).
 const CLASSES: usize = 8;
@@ -208,12 +210,14 @@ impl BandCoder {
         Ok((enc.finish()?, copy))
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// Encodes band `k` with the spatial predictor that codes it smallest: its chunk, empty when
     /// every level is zero.
     pub fn encode(&mut self, k: usize, levels: &[i64]) -> Result<Vec<u8>> {
         self.encode_among(k, levels, &Spatial::ALL)
     }
 
+    #[cfg(any(test, feature = "internals"))]
     /// [`Self::encode`] choosing among `candidates` only (for measurements).
     pub fn encode_among(
         &mut self,

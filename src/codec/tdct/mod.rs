@@ -11,7 +11,7 @@ pub mod index;
 pub mod spatial;
 pub mod transform;
 
-use super::rate::{CoderPlan, Rate, RatePlan};
+use super::rate::{Rate, RatePlan};
 use super::StreamLayout;
 use super::{BandsDescription, Codec, Description};
 use super::{CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
@@ -27,6 +27,7 @@ use std::io::{Read, Seek};
 use std::sync::Arc;
 use std::time::Instant;
 
+#[cfg(any(test, feature = "internals"))]
 pub use coefficients::DEAD_ZONE;
 
 /// The price of a bit, in squared steps, of the encoder's rate–distortion rounding
@@ -53,7 +54,7 @@ impl TdctConfig {
     /// target step is the quantiser step; affine maps at a quarter of it.
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
         let step = rate.stored_step("temporal-DCT step", diagonal, 1.0)?;
-        Ok(rate.plan(step, DEFAULT_AFFINE_PRECISION, CoderPlan::Tdct))
+        Ok(rate.plan(step, DEFAULT_AFFINE_PRECISION, Codec::Tdct, None))
     }
 }
 

@@ -26,6 +26,7 @@ impl Spatial {
     /// Both predictors, in the order of their stream bit.
     pub const ALL: [Spatial; 2] = [Spatial::None, Spatial::Mean];
 
+    #[cfg(any(test, feature = "internals"))]
     /// The stream bit.
     pub fn bit(self) -> u64 {
         match self {
@@ -55,6 +56,7 @@ pub struct Neighbourhood {
 }
 
 impl Neighbourhood {
+    #[cfg(any(test, feature = "internals"))]
     /// `vertices` vertices in index order without neighbours: no spatial prediction possible.
     pub fn isolated(vertices: usize) -> Self {
         Self {

@@ -7,6 +7,7 @@ use super::coefficients::MAX_LEVEL;
 use crate::error::{Error, Result};
 use rustdct::DctPlanner;
 
+#[cfg(any(test, feature = "internals"))]
 /// The dead-zone offset θ of the quantiser: level = sign(c)·⌊|c|/Δ + 0.5 − θ⌋. Only the encoder
 /// uses it (the decoder reconstructs level·Δ).
 ///

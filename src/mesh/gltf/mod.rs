@@ -70,7 +70,7 @@ pub(crate) fn material_name(material: &gltf::Material) -> String {
     }
 }
 
-/// One animation (clip) of a glTF file, as [`read_gltf`] would bake it.
+/// One animation (clip) of a glTF file, as [`super::read_animation`] would bake it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Clip {
     /// Its index in the file (what `ReadOptions::clip` takes besides the name).

@@ -120,14 +120,19 @@ pub struct Decimation {
     pub error: f64,
     /// Connected components of the (seam-welded) vertex graph: a lower bound on K.
     pub components: usize,
+    /// The diagnostics below are read by the motion bench and the tests.
     /// Frames the errors were measured on (all but frame 0, which every affine map fits exactly,
     /// unless subsampled).
+    #[cfg_attr(not(feature = "internals"), allow(dead_code))]
     pub frames_used: usize,
     /// Half-edge collapses done.
+    #[cfg_attr(not(feature = "internals"), allow(dead_code))]
     pub collapses: usize,
     /// K of the paper's plain decimation: the clusters the first collapses left, before refinement.
+    #[cfg_attr(not(feature = "internals"), allow(dead_code))]
     pub decimated_clusters: usize,
     /// `E_l` of the paper's plain decimation, before refinement.
+    #[cfg_attr(not(feature = "internals"), allow(dead_code))]
     pub decimated_error: f64,
 }
 
