@@ -140,7 +140,7 @@ pub enum SegmentationChoice {
     /// This segmentation.
     Fixed(Segmentation),
     /// k-means (K = `EncodeOptions::clusters`; with tdct also the larger K of
-    /// [`kmeans_ladder`]) and decimation down to `e0` are tried at the encoding's step; the
+    /// `kmeans_ladder`) and decimation down to `e0` are tried at the encoding's step; the
     /// smallest stream is kept.
     Auto {
         /// Decimation's error threshold E0.
@@ -196,8 +196,8 @@ pub struct MotionModel {
 
 /// The k-means cluster counts an automatic segmentation tries with a codec of cheap trials, from
 /// the caller's `k`: k, 1.5 k and 2 k. More clusters fit the motion more closely for more side
-/// information; which wins depends on the animation and the step (docs/design.md, "First-frame
-/// bits trials and k-means ladder").
+/// information; which wins depends on the animation and the step
+/// (docs/design.md, "First-frame bits trials and k-means ladder").
 pub fn kmeans_ladder(k: usize) -> Vec<usize> {
     let mut ladder = vec![k, k + k.div_ceil(2), 2 * k];
     ladder.dedup();
