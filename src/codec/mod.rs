@@ -187,7 +187,8 @@ impl Codec {
     }
 
     /// Whether the automatic choice may estimate a candidate from a sample of frames: the frames
-    /// are coded each on its own (measured on JPEG; spread frames misrank P-frames).
+    /// are coded each on its own, whereas spread P-frames cost like I-frames and misrank the
+    /// candidates (docs/design.md, "Automatic choice: bits at equal error").
     pub(crate) fn sampled_trials(self) -> bool {
         matches!(self, Codec::Jpeg)
     }

@@ -299,8 +299,8 @@ fn step_overrides_quality_and_is_checked() {
 
 /// Dead-zone quantisation against plain rounding, at equal error: bytes of the coefficients and
 /// vertex RMSE (coefficient-domain error equals time-domain error, the DCT being orthonormal) over
-/// a sweep of steps. `cargo test --release --test tdct measure_dead_zone -- --ignored --nocapture`;
-/// the figures are in the doc of `codec::tdct::DEAD_ZONE`.
+/// a sweep of steps. `cargo test --release --test it measure_dead_zone -- --ignored --nocapture`;
+/// the figures are in docs/design.md, "Temporal-DCT coder (rounding, contexts, spatial prediction)".
 #[test]
 #[ignore = "measurement, not a check"]
 fn measure_dead_zone() {

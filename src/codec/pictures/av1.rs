@@ -9,7 +9,7 @@
 //! frame rides in the packet of a shown one), in order, the sequence header in-band on every key
 //! frame. One thread and no row multi-threading, so the output does not depend on scheduling.
 //!
-//! `cpu-used` [`CPU_USED`] trades compression for speed (docs/results.md, "AV1").
+//! `cpu-used` [`CPU_USED`] trades compression for speed (docs/design.md, "AV1 settings").
 
 use super::deep::DeepConfig;
 use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
@@ -44,27 +44,19 @@ pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<Ra
 /// follows the target step ([`AV1_QP_AT_50`] at quality 50), between [`AV1_MIN_QP`] and
 /// [`AV1_MAX_QP`]; beyond them the pixel step takes the rest. Unlike HEVC's QP, AV1's quantiser
 /// index does not double its step at a fixed pace (about linear up to index 96, then about 9.5
-/// `crf` per doubling), so the law reads the step off [`AV1_AC_STEPS`]. Measured on CesiumMan
-/// (docs/results.md, "AV1"): quality 50 lands on HEVC's error at quality 50 (RMSE 3.80e-4 at
-/// 2.72 bpvf, HEVC 3.81e-4 at 2.79); at equal error the rate hardly depends on how pixel step
-/// and `crf` share it (pixel step 5e-5 `crf` 32, 1e-4 `crf` 20, 2e-4 `crf` 8: 3.82, 3.71, 4.36
-/// bpvf at RMSE 2.45, 2.54, 2.20e-4) up to `crf` 32, above which libaom's constant-quality mode
-/// keeps its key frames' quantiser and the error stops growing (5e-5: `crf` 32–56 all 2.45e-4).
-/// Those figures are on the former automatic lattice, where the factor was 0.1; on the smallest
-/// lattice that fits it was 0.04, scaled as [`HEVC_STEP_FACTOR`] (docs/results.md, "Quality laws
-/// on the smallest lattice"); the alternate references of P-frame groups (docs/results.md, "AV1
-/// tuning") then raised the error at quality 50 by 1.3× (CesiumMan 2.75e-4 against MPEG-4's
-/// 2.12e-4) and 1.6× (horse-gallop 3.27e-4 against 2.03e-4), hence 0.028.
+/// `crf` per doubling), so the law reads the step off [`AV1_AC_STEPS`]. At equal error the rate
+/// hardly depends on how pixel step and `crf` share it up to `crf` 32, above which libaom's
+/// constant-quality mode keeps its key frames' quantiser and the error stops growing. The factor
+/// puts quality 50 near MPEG-4's error at quality 50, with the alternate references of P-frame
+/// groups (docs/design.md, "Quality laws (JPEG, MPEG-4, HEVC, AV1)").
 pub const AV1_STEP_FACTOR: f64 = 0.028;
 /// libaom's `crf` at quality 50 at 10 bits a sample.
 pub const AV1_QP_AT_50: u8 = 32;
 /// The highest `crf` the law uses (the error stops following `crf` above it).
 pub const AV1_MAX_QP: u8 = 32;
-/// The lowest `crf` the law uses. Not 0: with no quantiser deltas `crf` 0 is lossless coding.
-/// It was 8, which capped P-frame groups at the top (horse-collapse: quality 90 and 97 both at
-/// RMSE 1.27e-4, 5.6 bpvf, as there the pixel step cannot go finer than the group's residual range
-/// allows at 12 bits); `crf` 1 lets the error keep falling up to quality 97 (horse-collapse: 3.8e-5
-/// at 11.8 bpvf, 1.06e-5 at 21.7; docs/results.md, "AV1 and HEVC padding").
+/// The lowest `crf` the law uses. Not 0: with no quantiser deltas `crf` 0 is lossless coding. Not
+/// higher either: where the pixel step cannot go finer than a group's residual range allows, a
+/// higher floor would stop the error falling from quality 90 up (docs/design.md, "AV1 settings").
 pub const AV1_MIN_QP: u8 = 1;
 /// AV1's AC quantiser step at 10 and 12 bits a sample (the specification's `ac_qlookup_10` and
 /// `ac_qlookup_12` tables, libaom's `ac_qlookup_10_QTX` and `ac_qlookup_12_QTX`) at quantiser
@@ -137,8 +129,8 @@ pub fn av1_law(quality: u8, depth: u8) -> PictureLaw {
     let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
     let deeper = f64::from(depth) - 10.0;
     let want = av1_log2_step(f64::from(AV1_QP_AT_50), 10) + scale.log2() - deeper;
-    // The floor is a `crf`, not a step, at either depth (measured: quality 90 at 12 bits with a
-    // floor two bits lower than 10 bits' went to `crf` 3 and 159 bpvf on CesiumMan).
+    // The floor is a `crf`, not a step, at either depth: a floor following the depth sends the
+    // top qualities at 12 bits to tiny `crf`s and huge rates (docs/design.md, "AV1 settings").
     let floor = av1_log2_step(f64::from(AV1_MIN_QP), depth);
     let ceiling = av1_log2_step(f64::from(AV1_MAX_QP), depth);
     let crf = av1_crf_of(want.clamp(floor, ceiling), depth).round();
@@ -160,18 +152,17 @@ mod coder {
     use super::super::deep::{self, Flavour};
     use super::MAX_QP;
 
-    /// libaom's speed preset: 0 (slowest, smallest) ..= 6 in its "good" usage. 4 measured 2 % lower
-    /// RMSE at equal rate on CesiumMan (quality 50 / 75) for 50 % / 42 % more encode CPU time.
+    /// libaom's speed preset: 0 (slowest, smallest) ..= 6 in its "good" usage; slower presets
+    /// gain little error for much more encode time (docs/design.md, "AV1 settings").
     pub const CPU_USED: u8 = 6;
     /// Frames libaom looks ahead in a P-frame group (`--gop` above 1), which lets it code hidden
     /// alternate-reference frames (`auto-alt-ref`): a future frame coded first, shown later, that the
     /// frames between predict from. The hidden frame travels in the packet of a shown frame (AV1's
-    /// temporal unit), so the stream keeps one packet per frame, in order. Measured against no look-ahead
-    /// (docs/results.md, "AV1 tuning"): 13–20 % fewer bits at equal RMSE on walking_cat and pcow, and
-    /// less encode time.
+    /// temporal unit), so the stream keeps one packet per frame, in order. Fewer bits at equal error
+    /// than no look-ahead, and less encode time (docs/design.md, "AV1 settings").
     pub const LAG_IN_FRAMES: u8 = 19;
     /// Strength of the temporal filter libaom runs over the frames an alternate reference stands for:
-    /// 0, no filtering (docs/results.md, "AV1 tuning").
+    /// 0, no filtering (docs/design.md, "AV1 settings").
     pub const ARNR_STRENGTH: u8 = 0;
     use ffmpeg_next::{codec, Dictionary};
 
@@ -208,11 +199,10 @@ mod coder {
             dict.set("cpu-used", &CPU_USED.to_string());
             dict.set("crf", &options.qp.to_string());
             // libaom's constant-quality mode gives key frames a finer quantiser than `crf`, as x265's
-            // fixed QP does (its I/P ratio); pinning every frame to `crf` (`qmin` = `qmax`) measured
-            // 30 % more bits at equal error (CesiumMan, pixel step 5e-5: 5.06 bpvf at RMSE 2.43e-4
-            // with `crf` 12 pinned, 3.82 at 2.45e-4 with `crf` 32 free). These are libaom's own
-            // bounds: FFmpeg's generic defaults (2..31, MPEG-4's qscale range) would clamp every `crf`
-            // above 31 to 31 (measured: CesiumMan's rate and error stop changing from `crf` 32 up).
+            // fixed QP does (its I/P ratio); pinning every frame to `crf` (`qmin` = `qmax`) costs more
+            // bits at equal error (docs/design.md, "Quality laws (JPEG, MPEG-4, HEVC, AV1)"). These
+            // are libaom's own bounds: FFmpeg's generic defaults (2..31, MPEG-4's qscale range) would
+            // clamp every `crf` above 31 to 31 (docs/design.md, "AV1 settings").
             dict.set("qmin", "0");
             dict.set("qmax", &MAX_QP.to_string());
             dict.set("keyint_min", &gop.to_string());
@@ -273,7 +263,7 @@ mod tests {
 
     #[test]
     fn av1_quantiser_keeps_falling_up_to_quality_97_at_12_bits() {
-        // The former floor (`crf` 8) held every quality from 90 up at one `crf`.
+        // A floor of `crf` 8 would hold every quality from 90 up at one `crf`.
         let crfs: Vec<u8> = (90..=97).map(|q| av1_law(q, 12).quantiser).collect();
         assert!(crfs[0] < 8, "{crfs:?}");
         assert!(crfs[7] < crfs[0], "{crfs:?}");

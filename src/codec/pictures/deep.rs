@@ -99,11 +99,9 @@ pub const DEPTHS: [u8; 2] = [10, 12];
 pub const DEEPER_FROM_QUALITY: u8 = 90;
 
 /// The sample depth of an encoding at `quality` without `bit_depth`: 10 bits below quality
-/// [`DEEPER_FROM_QUALITY`], 12 from it. Measured at equal error (docs/results.md, "AV1"): below 90,
-/// 12 bits cost HEVC and AV1 as much as 10 or up to 20 % more (CesiumMan, walking cat: the finer
-/// rounding buys nothing at coarse steps); from 90 they cost as much or less (AV1 on CesiumMan
-/// 4–5 % less at quality 90 and 97) and reach errors 10 bits cannot (HEVC on the walking cat at 97:
-/// 3.4e-5 where 10 bits stop at 9.2e-5, its large residuals outgrowing 1024 levels).
+/// [`DEEPER_FROM_QUALITY`], 12 from it. At equal error the finer rounding of 12 bits buys nothing
+/// at coarse steps; at fine ones it costs as much or less, and reaches errors 10 bits cannot where
+/// large residuals outgrow 1024 levels (docs/design.md, "Sample depth: 12 bits from quality 90").
 pub fn auto_depth(quality: u8) -> u8 {
     if quality >= DEEPER_FROM_QUALITY {
         12
@@ -112,12 +110,9 @@ pub fn auto_depth(quality: u8) -> u8 {
     }
 }
 /// The padding of HEVC's and AV1's geometry images with a key frame every `gop` frames.
-/// P-frame groups: `biharmonic`, smooth across chart borders, what a transform codec codes cheaply
-/// (measured against the other methods at HEVC's QPs in docs/results.md). All-intra (`gop` 1):
-/// `pushpull`, measured at equal RMSE on the smallest-fitting lattice (docs/results.md, "AV1 and
-/// HEVC padding"): all-intra AV1 takes 10 % fewer bits than with `biharmonic` on walking_cat, 3–8 %
-/// on pcow and 1–3 % on horse-gallop, all-intra HEVC 9–11 % on walking_cat; in P-frame groups the
-/// other methods saved 1–3 % or lost up to 9 % (`laplace` on pcow), so those keep `biharmonic`.
+/// P-frame groups: `biharmonic`, smooth across chart borders, what a transform codec codes cheaply.
+/// All-intra (`gop` 1): `pushpull`, which needs fewer bits there at equal error; in P-frame groups
+/// no method beat `biharmonic` clearly (docs/design.md, "Padding per codec").
 pub fn deep_padding(gop: usize) -> padding::Method {
     if gop <= 1 {
         padding::Method::PushPull

@@ -3,10 +3,9 @@
 //! decoder and set-up part are [`super::deep`]'s, shared with AV1.
 //!
 //! The x | y | z picture is coded as the three planes of a 4:4:4 picture (`yuv444p10le`,
-//! `yuv444p12le`), which shares block modes and motion vectors between the coordinates: measured
-//! 3–9 % smaller at equal error than the three side by side in one monochrome (4:0:0) picture
-//! (`gray10le`, `gray12le`; [`Planes::Mono`], which the decoder also reads) on CesiumMan and the
-//! walking cat at quality 30/50/75 (docs/results.md).
+//! `yuv444p12le`), which shares block modes and motion vectors between the coordinates: fewer bits
+//! at equal error than the three side by side in one monochrome (4:0:0) picture (`gray10le`,
+//! `gray12le`; [`Planes::Mono`], which the decoder also reads; docs/design.md, "HEVC settings").
 //! The quantiser is a fixed QP (`qp=`, no rate control, `tune=psnr`: no psycho-visual tricks, which
 //! spend bits on what looks sharp rather than on the error). No B-frames, no scene cuts, no open
 //! GOPs: an IDR every `gop` frames (every frame with `gop` 1: all-intra), P-frames between, so each
@@ -36,8 +35,8 @@ pub(crate) fn check(config: &DeepConfig) -> Result<()> {
 }
 
 /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: [`hevc_law`], affine
-/// maps at a quarter of the residual step in P-frame groups too (docs/design.md, "Affine
-/// precision per codec").
+/// maps at a quarter of the residual step in P-frame groups too
+/// (docs/design.md, "Affine precision per codec").
 pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
     let law = (
         hevc_law as fn(u8, u8) -> PictureLaw,
@@ -50,8 +49,8 @@ pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<Ra
 /// QP that follows the target step, 6 per halving ([`HEVC_QP_AT_50`] at quality 50), between
 /// [`HEVC_MIN_QP`] and 51; beyond them the pixel step takes the rest. At equal error the rate
 /// hardly depends on how pixel step and QP share it, except that QPs under 10 cost more than a
-/// finer pixel step; quality 50 lands on MPEG-4's error at quality 50 (docs/design.md, "Quality
-/// laws").
+/// finer pixel step; quality 50 lands on MPEG-4's error at quality 50
+/// (docs/design.md, "Quality laws (JPEG, MPEG-4, HEVC, AV1)").
 pub const HEVC_STEP_FACTOR: f64 = 0.02;
 /// The QP of quality 50 at 10 bits a sample.
 pub const HEVC_QP_AT_50: f64 = 28.0;

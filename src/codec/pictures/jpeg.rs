@@ -25,10 +25,9 @@ use zune_jpeg::JpegDecoder;
 pub const MAX_SIDE: u32 = u16::MAX as u32;
 /// The quantisation table of every residual picture (scaled by the JPEG quality as libjpeg does):
 /// flat, not Annex K's. A residual image is not a photograph: an error in a high frequency moves
-/// vertices as far as one in a low frequency, so every coefficient gets the same step. Measured
-/// with the surface RMSE at equal `--quality` (issue 15, docs/results.md): at quality 50 the
-/// walking cat 17.8 → 16.3 bpvf and 8.7 → 7.1e-4, horse-collapse 8.0 → 7.8 bpvf and 7.8 → 6.9e-4.
-/// The table travels in the stream (the shared header), so older streams still decode.
+/// vertices as far as one in a low frequency, so every coefficient gets the same step
+/// (docs/design.md, "JPEG: flat quantisation table"). The table travels in the stream (the shared
+/// header), so older streams still decode.
 pub const TABLE: padding::JpegTable = padding::JpegTable::Flat;
 /// The EOI marker every complete JPEG ends with.
 const END_OF_IMAGE: [u8; 2] = [0xFF, 0xD9];
@@ -150,8 +149,8 @@ impl JpegConfig {
 
 /// JPEG's law, read off the lower hull of (bpvf, vertex RMSE) over pixel step × JPEG quality on
 /// the smallest lattice the charts fit: the error follows about the square root of the pixel
-/// step, so the factor falls as the quality rises; JPEG quality 90 from quality 75 on (measured in
-/// docs/design.md, "Quality laws").
+/// step, so the factor falls as the quality rises; JPEG quality 90 from quality 75 on
+/// (docs/design.md, "Quality laws (JPEG, MPEG-4, HEVC, AV1)").
 const JPEG_LAW: [Anchor; 4] = [
     anchor(1, 1.25, 75),
     anchor(50, 0.25, 75),

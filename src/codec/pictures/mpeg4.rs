@@ -76,8 +76,8 @@ impl Mpeg4Config {
 
 /// MPEG-4's law, made as JPEG's over pixel step × qscale: qscales 1, 2 and 4 lie on one curve
 /// (error about pixel step^0.6) where the 8-bit range allows; 2 is kept, and 1 from quality 90,
-/// where finer steps meet the 8-bit floor on sequences with large residuals (docs/design.md,
-/// "Quality laws").
+/// where finer steps meet the 8-bit floor on sequences with large residuals
+/// (docs/design.md, "Quality laws (JPEG, MPEG-4, HEVC, AV1)").
 const MPEG4_LAW: [Anchor; 4] = [
     anchor(1, 0.8, 2),
     anchor(50, 0.21, 2),
@@ -211,15 +211,14 @@ mod coder {
             video.set_threading(libav::one_thread());
             let mut dict = Dictionary::new();
             dict.set("sc_threshold", NO_SCENE_CUT);
-            // Trellis quantisation: measured +0.7..1.1 dB at qscale 2..8 for 1..2 % more bytes, at a third
-            // of the encoding speed (still > 1000 frames/s at 256×256).
+            // Trellis quantisation: a lower error per byte, for encoding time the residual pictures
+            // can afford (docs/design.md, "MPEG-4 encoder settings").
             dict.set("trellis", "1");
-            // Rate-distortion decisions, measured on the residual pictures at equal qscale (issue 15,
-            // docs/results.md): macroblock mode by rate-distortion (`mbd` rd), SATD for motion search
-            // (`cmp`, `subcmp`), the coded-block pattern chosen by rate-distortion and the zero motion
-            // vector always tried (`mpv_flags` cbp_rd, mv0: a chart stays in place from frame to
-            // frame). Together, on five media sequences, 5–16 % fewer bytes at equal error at quality
-            // 50 and 9–23 % at 90, for 2–4 % more CPU time of the whole CesiumMan encode.
+            // Rate-distortion decisions: macroblock mode by rate-distortion (`mbd` rd), SATD for
+            // motion search (`cmp`, `subcmp`), the coded-block pattern chosen by rate-distortion and
+            // the zero motion vector always tried (`mpv_flags` cbp_rd, mv0: a chart stays in place
+            // from frame to frame); fewer bits at equal error for a little more encoding time
+            // (docs/design.md, "MPEG-4 encoder settings").
             dict.set("mbd", "2");
             dict.set("cmp", "2");
             dict.set("subcmp", "2");

@@ -86,33 +86,11 @@ fn magnitude_class(magnitude: u64) -> usize {
 /// per frequency class and, when non-zero, a sign with one of [`SIGNS`], chosen by what the decoder
 /// already has: the same vertex/axis's level in the previous band, whether an earlier axis of the
 /// same vertex is non-zero in this band, and the neighbours' magnitude (six classes each), and for
-/// the sign, the signs the neighbours coded. Coefficient bytes at θ = 0.15, steps 4e-4..5e-3 of
-/// the diagonal (`measure_dead_zone`), three magnitude classes then: against one model for
-/// everything, the previous-band magnitude saves 6–9 % on CesiumMan, 9–17 % on Fox and 5–26 % on
-/// RiggedFigure, and the sibling axis a further 1–2 %, 1.5–5 % and 0–3 %. The frequency class
-/// alone changed nothing measurable (the models carried over already follow the bands' drift); it is kept as it
-/// costs nothing and separates the DC band, whose statistics differ.
-///
-/// Stream version 3 (issue 18): six magnitude classes instead of 0, 1, 2+, the sign contexts and
-/// the neighbours' coded values in their magnitude. Whole files at equal vertex RMSE, quality
-/// 10…70 (log-log interpolated; q90 at one quality), `--predictor affine --segmentation kmeans`:
-/// CesiumMan −0.8…−1.8 (−2.8) %, walking_cat −1.0…−2.3 (−2.9) %, the cloth −2.8…−8.3 (−8.0) %,
-/// horse-collapse −3.3…−4.3 (−4.1) %. Of that, the sign contexts give the most (cloth −5…−6 %,
-/// horse-collapse and pcow −2…−3 %, CesiumMan and walking_cat −1 %, Fox ±0.4 %). Measured and not
-/// kept: a sibling context of three classes (+0.1…+0.4 %), one activity class for the previous band
-/// and the neighbours together (+0.2…+1.3 %), four frequency classes (±0.3 %), slower adaptation of
-/// the bit models (+0.1…+1.5 %), half the mean as a third spatial predictor (0…−0.6 %: not worth a
-/// stream symbol).
-///
-/// Issue 18 (coefficient bytes at quality 10 / 50 / 90, `encode` + `inspect`): the breadth-first
-/// order, the neighbours' magnitude and the per-band one-ring mean together save 19 / 20 / 21 % on
-/// CesiumMan, 3–9 % on RiggedFigure, 41 / 38 / 31 % on horse-gallop, 31 / 25 / 20 % on horse-collapse,
-/// 14 / 10 / 8 % on walking_cat and 26 / 18 / 13 % on the cloth of `tests/it/cloth.rs` (40 × 40, 90
-/// frames); Fox (+0 to +1 %) and RiggedSimple (+0 to +8 bytes), whose bands never pick the mean, lose
-/// at most 0.4 % of the file. At equal step the mean in every band beats "none" by 2–7 % on
-/// CesiumMan (but loses 1 % at the coarsest step) and 5–9 % on the cloth, and loses 10–29 % on the
-/// other glTF samples, hence the per-band choice
-/// (`measure_spatial` in `tests/it/tdct_spatial.rs`).
+/// the sign, the signs the neighbours coded. The frequency class costs nothing and separates the DC
+/// band, whose statistics differ. The contexts, the spatial predictor and its per-band choice are
+/// each kept for the bytes they save at equal error (`measure_dead_zone` in `tests/it/tdct.rs`,
+/// `measure_spatial` in `tests/it/tdct_spatial.rs`;
+/// docs/design.md, "Temporal-DCT coder (rounding, contexts, spatial prediction)").
 #[derive(Clone)]
 pub struct BandCoder {
     /// Magnitude models, [`CONTEXTS`] per frequency class.
@@ -169,7 +147,7 @@ impl BandCoder {
                 };
                 let prev = magnitude_class(u64::from(self.previous[i]));
                 // With the mean predictor the neighbours' coded values tell how well it predicts,
-                // their levels how large the coefficients are; both help (see the struct's note).
+                // their levels how large the coefficients are; both help (see the struct's doc).
                 let near = (spatial::largest(levels, earlier, a))
                     .saturating_add(spatial::largest(&self.coded, earlier, a))
                     .div_ceil(2);

@@ -31,13 +31,9 @@ use std::time::Instant;
 pub use coefficients::DEAD_ZONE;
 
 /// The price of a bit, in squared steps, of the encoder's rate–distortion rounding
-/// ([`Rounding`]). Coefficient bytes at equal vertex RMSE against the dead-zone quantiser
-/// ([`DEAD_ZONE`]), steps 2e-4..5e-3 of the diagonal (`measure_rounding` in `tests/it/tdct.rs`):
-/// λ 0.05 / 0.1 / 0.15 / 0.2 / 0.3 save about 3 / 4 / 2 / 0 / −4 % on CesiumMan, 4 / 5 / 4 / 1 / −3 %
-/// on walking_cat and horse-collapse, 3 / 4 / 0 / −2 / −4 % on the cloth fixture, 5–10 / 6–20 / … on
-/// Fox and RiggedFigure (small, noisy); 0.1 is never worse than the dead zone. Whole files at equal
-/// vertex RMSE, quality 10–90: −1.3 to −2.1 % CesiumMan, −2.7 to −3.4 % Fox, −2.0 to −2.9 %
-/// walking_cat, −3.2 to −3.8 % horse-collapse, −3.4 to −5.5 % pcow.
+/// ([`Rounding`]): of the prices swept against the dead-zone quantiser ([`DEAD_ZONE`]), the one
+/// that saves most and is worse nowhere (`measure_rounding` in `tests/it/tdct.rs`;
+/// docs/design.md, "Temporal-DCT coder (rounding, contexts, spatial prediction)").
 pub const ROUNDING_LAMBDA: f64 = 0.1;
 
 /// The version of the temporal DCT's set-up part (its only byte: the step and the bands are a

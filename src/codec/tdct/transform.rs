@@ -9,13 +9,10 @@ use rustdct::DctPlanner;
 
 #[cfg(any(test, feature = "internals"))]
 /// The dead-zone offset θ of the quantiser: level = sign(c)·⌊|c|/Δ + 0.5 − θ⌋. Only the encoder
-/// uses it (the decoder reconstructs level·Δ).
-///
-/// Coefficient bytes saved against plain rounding (θ = 0) at equal vertex RMSE, log-interpolated
-/// over steps 4e-4..5e-3 of the diagonal (`measure_dead_zone` in `tests/tdct.rs`):
-/// θ 0.05 / 0.1 / 0.15 / 0.2 / 0.3 save 3.0 / 3.9 / 3.5 / 2.3 / −1.5 % on CesiumMan,
-/// 4.2 / 6.0 / 6.2 / 5.4 / 2.5 % on Fox and 4.2 / 6.3 / 9.4 / 5.8 / 1.7 % on RiggedFigure
-/// (a few hundred bytes, noisy). 0.15 is best on average; the gain grows with the step.
+/// uses it (the decoder reconstructs level·Δ). The encoder rounds by rate and distortion instead;
+/// 0.15, the best θ against plain rounding, is the baseline that rounding is measured against
+/// (`measure_dead_zone`, `measure_rounding` in `tests/it/tdct.rs`;
+/// docs/design.md, "Temporal-DCT coder (rounding, contexts, spatial prediction)").
 pub const DEAD_ZONE: f64 = 0.15;
 
 /// The orthonormal DCT-II of every vertex/axis residual sequence, band-major: `out[k][3v + a]` is
