@@ -10,9 +10,8 @@ use crate::error::{Error, Result};
 /// Default of [`DecodeOptions::max_positions`](crate::DecodeOptions::max_positions) and
 /// [`ReadOptions::max_positions`](crate::ReadOptions::max_positions): 10⁹ positions are 12 GB as
 /// f32 points, about what a machine of a few tens of GB holds as one decoded or baked clip; ten
-/// times the 50 000-vertex × 2 000-frame clip that long-clip work is measured on, and 84
-/// times the largest animation measured so far (28 374 vertices × 418 frames). Larger clips are
-/// read by raising the limit.
+/// times the 50 000-vertex × 2 000-frame clip of the long-clip benchmark, and 84 times the largest
+/// real animation tried (28 374 vertices × 418 frames). Larger clips are read by raising the limit.
 pub const DEFAULT_MAX_POSITIONS: u64 = 1_000_000_000;
 
 /// Refuses a stream whose header promises more than `limit` positions.

@@ -12,10 +12,9 @@
 //! residual coder is cheap next to the segmentation), and so does MPEG-4 (a sample misranks its
 //! P-frames); JPEG, whose pictures cost most of an encoding and are coded each on its own, codes a
 //! sample of frames per candidate, scales the sample's per-frame parts to the whole, weighs the
-//! error of the sample's own stream (decoded), and then codes the winner once in full. Bytes alone
-//! kept, on chickenCrossing's analysis clip at quality 10, skinning on 20 k-means clusters (an
-//! estimate 7 % below skinning on 70 decimation clusters); coded whole, it had 2.5× the error
-//! (vertex RMSE 4.99e-3 against 2.02e-3) and 10 % more bytes.
+//! error of the sample's own stream (decoded), and then codes the winner once in full: the
+//! sample's bytes alone can keep a candidate whose whole stream is both larger and worse
+//! (docs/design.md, "Automatic choice: bits at equal error").
 
 use super::{analysis, assemble, code, distortion, header, Analysed, Encoded, Settings, Stopwatch};
 use crate::codec::ResidualInput;

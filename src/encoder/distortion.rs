@@ -4,12 +4,11 @@
 //! error at that step is not the same for each: where a candidate's residuals outgrow the sample
 //! range, its step is widened for that frame or group (`geometry_image::quantise`), so it spends
 //! fewer bits *and* misses the quality's error. Comparing bytes alone then keeps the coarser
-//! stream (measured: horse-gallop, AV1 quality 70 with 1/4 affine precision kept affine maps on
-//! k-means, 206 382 bytes at vertex RMSE 5.9e-4, over skinning on decimation, 239 334 bytes at
-//! 3.3e-4). So the choice compares bits at equal error: each
-//! candidate's vertex RMSE is measured by decoding its stream, and its cost is the rate it would
-//! need at a common error on a rate–distortion curve of slope −[`RD_SLOPE`] in log-log (RMSE ∝
-//! rate^−RD_SLOPE), i.e. the candidate with the least `bits × RMSE^(1/RD_SLOPE)` is kept.
+//! stream (docs/design.md, "Automatic choice: bits at equal error"). So the choice compares bits
+//! at equal error: each candidate's vertex RMSE is measured by decoding its stream, and its cost is
+//! the rate it would need at a common error on a rate–distortion curve of slope −[`RD_SLOPE`] in
+//! log-log (RMSE ∝ rate^−RD_SLOPE), i.e. the candidate with the least `bits × RMSE^(1/RD_SLOPE)`
+//! is kept.
 
 use super::Encoded;
 use crate::decoder::Decoder;
@@ -18,11 +17,9 @@ use crate::mesh::AnimatedMesh;
 use crate::metrics;
 
 /// The log-log slope of the codecs' rate–distortion curves the choice assumes: RMSE ∝
-/// rate^−RD_SLOPE. The picture codecs' curves between qualities 30 and 75 measure 1.0 (JPEG on
-/// horse-gallop) to 2.5 (MPEG-4 on the walking cat), steeper at low rates. A flatter assumed slope
-/// weighs error more: 1 kept, on horse-gallop at AV1 quality 10, a stream 57 % larger for 39 %
-/// less error that quality 30 beat in both, and lost 3–6 % at equal error on two other points
-/// (docs/results.md, "Bits at equal error in the automatic choice").
+/// rate^−RD_SLOPE, within the range the picture codecs' curves measure. A flatter assumed slope
+/// weighs error more and keeps larger streams than their error is worth
+/// (docs/design.md, "Automatic choice: bits at equal error").
 pub const RD_SLOPE: f64 = 2.0;
 
 /// RMS distance over frames and vertices between `mesh` (in the stream's vertex order) and

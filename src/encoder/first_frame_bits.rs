@@ -74,7 +74,8 @@ pub(super) fn choose(
             bytes: encoded.report.bytes,
         });
         if encoded.report.bytes >= best.report.bytes {
-            // Coarser still has not helped where this did not (the media samples and the cloth).
+            // Coarser has not helped where this did not
+            // (docs/design.md, "First-frame bits trials and k-means ladder").
             progress.retell(trials.len() as u64 - 1, frames);
             break;
         }

@@ -1,4 +1,4 @@
-//! Temporal segments (issue 20): a clip longer than `segment_frames` is coded as runs of frames,
+//! Temporal segments: a clip longer than `segment_frames` is coded as runs of frames,
 //! so that the temporal DCT and the groups of pictures, and the encoder's memory, stay the size
 //! of a segment whatever the clip's length.
 //!
@@ -9,8 +9,7 @@
 //! predicted from the shared parts *as the decoder reads them* (decoded from the analysis clip's
 //! stream), so encoder and decoder agree bit for bit. Frames spread over the clip let the
 //! clusters and weights see all of its motion, not only its start (a captured performance often
-//! opens in a rest pose): on pdance, 32-frame segments cost 58 % more bits at equal error with
-//! the first segment as the analysis clip (docs/results.md "Temporal segments").
+//! opens in a rest pose; docs/design.md, "Temporal segments: 128 frames").
 //!
 //! A program can feed segments one by one ([`SegmentedEncoder::start`], [`SegmentedEncoder::push`],
 //! [`SegmentedEncoder::finish`]), e.g. from a reader that never holds the whole clip.

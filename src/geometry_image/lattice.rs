@@ -17,17 +17,9 @@ pub enum Lattice {
 
 /// Lattice pixels per vertex `Lattice::Auto` starts from; it then grows until the charts fit, so
 /// in practice the lattice is the smallest one the atlas packs. Every pixel is coded, and pixels
-/// without a vertex (interpolated chart interiors, padding between charts) only cost bits: on the
-/// media sequences the smallest lattice that fits needs the fewest bits at equal surface RMSE, for
-/// JPEG and MPEG-4 alike, although more vertices then move off a shared rounded pixel (issue 15,
-/// docs/results.md "Lattice density": `scripts/sweep.sh` with LATTICES, affine + k-means, qualities
-/// 10..90; bits at the former rule's error over its bits, JPEG / MPEG-4): walking_cat (1297
-/// vertices) 64×64 0.46 / 0.47 against 192×192, 48×48 does not fit; CesiumMan (3273) 160×160
-/// 0.66 / 0.76 against 256×256, 144×144 does not fit; pcow (2904) 80×80 0.52 / 0.56, 96×96
-/// 0.49 / 0.53; pdance (7061) 128×128 0.54 / 0.72; horse-gallop and horse-collapse (8431) 128×128
-/// 0.78 / 0.79 and 0.71 / 0.69, 96×96 does not fit. No lattice between the smallest that fits and
-/// the former one did better. The former rule (28 pixels per vertex, 256×256 for 2341..8738
-/// vertices) had been measured on RiggedFigure and Fox only.
+/// without a vertex (interpolated chart interiors, padding between charts) only cost bits: the
+/// smallest lattice that fits needs the fewest bits at equal surface RMSE, although more vertices
+/// then move off a shared rounded pixel (docs/design.md, "Lattice: the smallest that fits").
 const AUTO_PIXELS_PER_VERTEX: f64 = 1.9;
 
 /// The first lattice side `Lattice::Auto` tries for `vertices`: about

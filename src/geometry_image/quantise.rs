@@ -1,5 +1,5 @@
 //! Residual quantisation: one step for the whole sequence, set by the target error, not by each
-//! frame's range (issue 15).
+//! frame's range (docs/design.md, "One error law: a step per quality (stream version 2)").
 //!
 //! A residual `r` of one coordinate becomes the level `r / step − offset + mid`, mid-grey being
 //! 2^(depth − 1) at the picture codec's sample depth (128 for the 8-bit JPEG and MPEG-4, 512 or 2048

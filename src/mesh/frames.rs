@@ -1,4 +1,4 @@
-//! Animations read a run of frames at a time (issue 20): OBJ sequences file by file and PC2
+//! Animations read a run of frames at a time: OBJ sequences file by file and PC2
 //! caches sample by sample, so that a long clip is never held whole. glTF clips are baked whole
 //! (the baker poses every frame from the clip's channels) and served from memory.
 

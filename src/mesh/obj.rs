@@ -7,7 +7,8 @@
 //! and drops unused ones, and does not expose the original indices, so that order cannot be recovered
 //! from its output. `v`, `f`, `vt` and `usemtl` lines matter here; everything else (normals, groups,
 //! lines, points) is skipped. Polygons become triangle fans around their first corner, as `tobj`
-//! triangulates them; `tests/mesh_io.rs` checks the two agree.
+//! triangulates them; `tests/it/mesh_io.rs` checks the two agree
+//! (docs/design.md, "Own OBJ parser").
 //!
 //! Texture coordinates are per vertex in [`Attributes`] (as in glTF, `v` pointing down: OBJ's `vt`
 //! is flipped on the way in and out). They are kept when every face names a `vt` and each vertex

@@ -1,4 +1,4 @@
-//! The measures accumulated a run of frames at a time (issue 20): `eval` of a long clip holds one
+//! The measures accumulated a run of frames at a time: `eval` of a long clip holds one
 //! segment of each animation, not both whole. [`super::compare`] is one run of every frame, so the
 //! figures agree to the last bit whatever the runs.
 

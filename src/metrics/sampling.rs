@@ -14,11 +14,9 @@ use crate::mesh::{Point, Triangle};
 use rustc_hash::FxHashMap;
 
 /// Samples per bounding-box diagonal: faces longer than `diagonal / SAMPLES_PER_DIAGONAL` are
-/// subdivided. At 50 the papers' 7k-vertex Dance stays mostly at level 1 (about 3.4 samples per
-/// face, vertices included) and its one-sided RMS against a copy moved by a smooth wave agrees with
-/// Metro's million-sample figure within 0.3 %; 100 and 200 came within 0.1 % for 3 and 8 times the
-/// work. The coarser CesiumMan with per-vertex jitter is the hard case (1.3 %, see
-/// tests/metrics_reference.rs).
+/// subdivided. 50 agrees with Metro within the reference test's tolerance
+/// (`tests/it/metrics_reference.rs`); denser sampling gains little for several times the work
+/// (docs/design.md, "Surface RMSE: 50 samples per diagonal").
 pub const SAMPLES_PER_DIAGONAL: f64 = 50.0;
 
 /// Finest subdivision of one face: caps the work a single huge triangle can cause (16² sub-triangles).

@@ -8,9 +8,9 @@
 //! through adaptive integer models chosen by the coefficient's kind (linear part or translation)
 //! and the size of the trajectory's previous residual, which tracks how busy the motion is.
 //!
-//! Measured against coding the whole trajectory by a temporal DCT per coefficient, see the
-//! issue 18 note; the levels are uniform scalar quantisation of each frame's map, so every
-//! decoded coefficient is within half its step of the fitted one.
+//! The extrapolation codes smaller than a temporal DCT of each trajectory
+//! (docs/design.md, "Affine precision per codec"); the levels are uniform scalar quantisation of
+//! each frame's map, so every decoded coefficient is within half its step of the fitted one.
 
 use crate::error::{Error, Result};
 use crate::mesh::Point;

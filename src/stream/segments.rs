@@ -1,4 +1,4 @@
-//! Temporal segments (issue 20): a long clip is coded as runs of frames, each with its own affine
+//! Temporal segments: a long clip is coded as runs of frames, each with its own affine
 //! maps and residual parts (its own temporal DCT or groups of pictures), behind the parts the
 //! whole stream shares (header, first frame, partition, lattice, skinning weights).
 //!

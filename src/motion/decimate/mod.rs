@@ -45,24 +45,10 @@
 //! - Memory is 12 numbers per set and frame; past `max_vertex_frames` vertices × frames, the frames
 //!   are subsampled evenly (as the k-means features are) and `E_l` is estimated from them.
 //!
-//! # Measured (release build, 2 shared cores, E0 = 0.003, `cargo bench --bench motion`)
-//! K0 is the paper's plain decimation (`refine_passes: 0`), K the default; "paper" is the
-//! skinning paper's Table 1 (same E0). resid/motion is the bench's residual energy of the 17-bit
-//! piecewise affine predictor over the raw motion energy; k-means is the default K = 20.
-//!
-//! | sequence | V × F | paper K | K0 | K | seconds | resid/motion | k-means K=20 (seconds) |
-//! |---|---|---|---|---|---|---|---|
-//! | chickenCrossing | 3030 × 400 | 85 | 82 | 70 | 0.79 | 2.27e-6 | 5.18e-5 (1.68) |
-//! | pdance | 7061 × 201 | 21 | 18 | 15 | 1.00 | 7.49e-5 | 6.88e-5 (5.32) |
-//! | pcow | 2904 × 204 | 64 | 66 | 46 | 0.37 | 2.23e-5 | 8.28e-5 (1.86) |
-//! | horse-gallop | 8431 × 48 | 39 | 33 | 25 | 0.52 | 8.63e-4 | 3.06e-3 (4.30) |
-//! | horse-collapse | 8431 × 53 | 135 | 96 | 67 | 0.55 | 1.64e-4 | 1.32e-3 (6.17) |
-//!
-//! At the K decimation found, k-means (`CLUSTERS=K`) predicts worse on all five: 7.76e-6 (chicken,
-//! K = 65 after dissolving), 9.35e-5, 2.79e-5, 2.51e-3, 3.06e-4 (horse-collapse, 32.7 s).
-//! BrainStem (34159 × 1310, frames subsampled to 58): K = 391, its welded components (each moves
-//! rigidly, E_l ≈ 0), in 2.5 s (segmentation only: not encoded, so the partition coder's path for
-//! more than 256 clusters is untested by this).
+//! # Measured
+//! Border refinement leaves fewer clusters than plain decimation at the same E0, and k-means at
+//! the K decimation finds predicts worse (`cargo bench --bench motion`;
+//! docs/design.md, "Decimation: border refinement").
 
 mod collapse;
 mod normal_equations;
