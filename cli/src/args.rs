@@ -123,9 +123,8 @@ pub struct EncodeArgs {
     #[arg(long, value_parser = clap::value_parser!(u8).range(0..=63))]
     pub qp: Option<u8>,
     /// hevc, av1: bits a sample of the residual pictures, 10, 12 or auto: 10 below --quality 90,
-    /// 12 from 90 (measured at equal error: below 90, 12 bits cost as much as 10 or up to 20 %
-    /// more; from 90 as much or less, and they reach errors 10 bits cannot on sequences with large
-    /// residuals; docs/results.md).
+    /// 12 from 90 (at equal error 12 bits cost more below 90; from 90 as much or less, and they
+    /// reach errors 10 bits cannot; docs/design.md, "Sample depth: 12 bits from quality 90").
     #[arg(long, default_value = "auto", value_parser = parse_bit_depth)]
     pub bit_depth: BitDepth,
     /// JPEG's own quality 1..100 for the residual pictures; overrides the one --quality sets.
@@ -182,8 +181,8 @@ pub struct EncodeArgs {
     /// codecs: the fewer bits at equal error).
     #[arg(long, value_enum, default_value_t = PredictorChoice::Auto)]
     pub predictor: PredictorChoice,
-    /// Bits per quantised skinning weight, sign included (the paper's 16; the motion bench saw
-    /// the same residual energy at 12 for about 60 % of the weights' bits).
+    /// Bits per quantised skinning weight, sign included (the paper's 16; fewer can predict as
+    /// well for fewer bits: docs/design.md, "Skinning weights: 16 bits").
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u8).range(2..=31))]
     pub weight_bits: u8,
     /// Bits per texture coordinate over each UV set's bounding box (inputs with UVs only).
@@ -191,8 +190,8 @@ pub struct EncodeArgs {
     pub uv_bits: u8,
     /// Frames per temporal segment: a longer clip is coded as segments of N frames, each with its
     /// own temporal DCT or groups of pictures, sharing the first frame, clusters and atlas (the
-    /// automatic choices are made on the first segment); 0 codes any clip as one segment
-    /// [default: 128].
+    /// automatic choices are made on one segment's length of frames spread over the whole clip);
+    /// 0 codes any clip as one segment [default: 128].
     #[arg(long, value_name = "N")]
     pub segment_frames: Option<u64>,
     /// Print the result as one JSON object.
