@@ -6,9 +6,9 @@
 //! edge-connected part is examined again, up to [`MAX_DEPTH`] times. A piece whose whole
 //! flattening fails (folds, or area distortion beyond `uvunwrap`'s bound), or that is still not a
 //! disk after those splits, goes to `uvunwrap`'s own segmentation, as every piece did before.
-//! Splitting failed pieces recursively too was measured and rejected: those are big curved
-//! pieces, and the principal-axis halves fall apart into many small parts (dance: 95 charts at
-//! depth 4 against 67 with the segmentation; chickenCrossing 154 against 98).
+//! Failed pieces are not split recursively: those are big curved pieces, and the principal-axis
+//! halves fall apart into many more charts than the segmentation makes
+//! (docs/design.md, "Atlas: whole-piece charts and packing").
 
 use crate::seed::components;
 use crate::unwrap::{flatten_once, split_faces, Flattening};

@@ -50,9 +50,9 @@
 //!    rescaled to surface units and packed below. Left to its segmentation,
 //!    uvunwrap grows charts within a normal cone, so a tube band came back in
 //!    several charts, and a band passed whole (an annulus cannot be flattened)
-//!    was shredded into slivers: a skinned snake made 414 charts for 20
-//!    clusters. A generated snake (4322 vertices, K = 20) now has 23 charts
-//!    (41 before), a torus 22 (41); see the measured table below.
+//!    was shredded into slivers; pieces flattened whole make far fewer charts
+//!    on tubes and tori
+//!    (docs/design.md, "Atlas: whole-piece charts and packing").
 //! 3. **Vertex ownership.** A vertex shared by several charts is owned by one:
 //!    among the charts with a face on it, the one with most faces among those
 //!    whose face is in the vertex's own cluster, else the one with most faces
@@ -84,69 +84,21 @@
 //! # Interior pixels
 //! [`Interior::Rasterised`] (default, as the paper) fixes the chart triangles'
 //! pixels to barycentric blends of the corner values; [`Interior::Free`]
-//! fixes only vertex pixels and leaves the rest to padding. Measured with
-//! JPEG (8-bit, one channel) on the x displacement between frames 1 and 11,
-//! free pixels filled by 300 Jacobi sweeps (a stand-in for the padding
-//! crate), Rasterised codes smaller at equal vertex error on all four
-//! sequences tried (rmse relative to the signal range):
+//! fixes only vertex pixels and leaves the rest to padding. Rasterised codes
+//! smaller at equal vertex error on every sequence tried
+//! (docs/design.md, "Chart interiors and seams"; `cargo run --release -p
+//! atlas --example measure -- --jpeg DIR`).
 //!
-//! | mesh | Rasterised q50 | Free q50 | Free q75 |
-//! |---|---|---|---|
-//! | pdance | 3895 B, 0.0089 | 3657 B, 0.0112 | 5150 B, 0.0092 |
-//! | pcow | 3600 B, 0.0096 | 3510 B, 0.0148 | 4855 B, 0.0121 |
-//! | horse-gallop | 2234 B, 0.0064 | 2161 B, 0.0070 | 2824 B, 0.0055 |
-//! | chickenCrossing | 4774 B, 0.0186 | 4181 B, 0.0222 | 5966 B, 0.0183 |
-//!
-//! With a plain mean fill instead, Free is far worse (dance q50: 0.0597 vs
-//! 0.0278). Command: `cargo run --release -p atlas --example measure --
-//! --jpeg bench-out/media/pdance` (and the other folders; the OBJ sequences
-//! as `make bench` unpacks them from `../shared/media`).
-//!
-//! # Charts and packing in the encoder (motion k-means, K = 20, auto lattice)
-//! `mcgv-video encode IN -o s.mcgv --codec jpeg --quality 50 --quiet` then
-//! `mcgv-video inspect s.mcgv --json` (`charts`, `packing_efficiency`); snake
-//! and torus are generated OBJ sequences (a closed bending tube of 24 × 180
-//! quads with capped ends, 40 frames; a 96 × 32 torus whose cross-section
-//! breathes), before → after whole-piece charts (glTF rows: after, then with
-//! [`AtlasOptions::weld`]):
-//!
-//! | mesh | V | charts | packing |
-//! |---|---|---|---|
-//! | snake (generated) | 4322 | 41 → 23 | 58.8% → 57.9% |
-//! | torus (generated) | 3072 | 41 → 22 | 49.6% → 45.3% |
-//! | CesiumMan | 3273 | 327 → 341; 44 | 41.6% → 39.3%; 52.7% |
-//! | Fox | 1728 | 576 → 576; 109 | 15.2% → 15.2%; 42.0% |
-//! | RiggedFigure | 370 | 87 → 87; 43 | 31.9% → 32.0%; 46.1% |
-//! | pdance | 7061 | 73 → 69 | 51.3% → 51.1% |
-//! | pcow | 2904 | 61 → 55 | 47.2% → 50.5% |
-//! | chickenCrossing | 3030 | 98 → 116 | 46.8% → 50.9% |
-//! | horse-gallop | 8431 | 106 → 93 | 48.5% → 49.8% |
-//!
-//! Long unrolled bands pack no better than the pieces they replace: the
-//! packer places bounding frames on the block grid, and a slanted band
-//! leaves empty blocks in its frame.
-//!
-//! The table below was measured before those changes, with the measuring
-//! example's stand-in partition.
-//!
-//! # Measured (256×256, K = 20 k-means partition, release build)
-//! `cargo run --release -p atlas --example measure -- bench-out/media/pdance ...`
-//!
-//! | mesh | V | charts | packing | moved | L2 stretch | build |
-//! |---|---|---|---|---|---|---|
-//! | chickenCrossing | 3030 | 145 | 40.7% | 400 | 1.001 | 0.16 s |
-//! | pcow | 2904 | 54 | 49.8% | 108 | 1.001 | 0.11 s |
-//! | pdance | 7061 | 82 | 49.1% | 1728 | 1.001 | 0.20 s |
-//! | horse-gallop | 8431 | 85 | 49.8% | 2294 | 1.001 | 0.21 s |
-//! | horse-collapse | 8431 | 92 | 48.9% | 2303 | 1.001 | 0.22 s |
-//! | walking_cat | 1297 | 57 | 45.6% | 122 | 1.002 | 0.08 s |
-//!
+//! # Packing and moved vertices
 //! Packing is chart pixels (covered by a chart triangle or a vertex) over
-//! lattice pixels. Moved vertices are many on dense meshes: at one common
-//! scale, regions with more vertices than pixels must spill: with
-//! `--lattice 512` dance moves 289 and horse-gallop 613 (packing 58.5%,
-//! 59.0%), with 1024 14 and 137. BrainStem (32559 welded vertices, 995
-//! charts) needs 512×512: 40.8% packing, 9457 moved, 2.1 s.
+//! lattice pixels. Long unrolled bands pack no better than the pieces they
+//! replace: the packer places bounding frames on the block grid, and a
+//! slanted band leaves empty blocks in its frame. Moved vertices are many on
+//! dense meshes: at one common scale, regions with more vertices than pixels
+//! must spill, fewer on larger lattices. Charts, packing, moved vertices,
+//! stretch and time per mesh: `cargo run --release -p atlas --example measure
+//! -- INPUT...`, or `mcgv-video inspect STREAM --json` for the encoder's
+//! atlas (docs/design.md, "Atlas: whole-piece charts and packing").
 
 // `!(x > t)` is deliberate: unlike `x <= t` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

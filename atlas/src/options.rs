@@ -31,10 +31,9 @@ pub struct AtlasOptions {
     /// Rounds of stretch-driven splitting at most.
     pub max_split_rounds: u32,
     /// Grow and flatten charts on the mesh with vertices at bit-identical positions welded (glTF
-    /// meshes split at UV seams, or not indexed). Off by default: measured at JPEG quality 50,
-    /// CesiumMan went from 327 to 41 charts and 21.1 bpvf / RMSE 2.57e-4 to 21.5 / 1.77e-4, but
-    /// Fox (576 loose triangles) from 27.2 / 2.69e-5 to 23.5 / 3.71e-5, worse at equal rate, and
-    /// RiggedSimple's error rose 2.6×: the copies of a position are coded apart and crack apart.
+    /// meshes split at UV seams, or not indexed). Off by default: far fewer charts, but the copies
+    /// of a position are coded apart and crack apart, worse at equal rate on some meshes
+    /// (docs/design.md, "Chart interiors and seams").
     pub weld: bool,
 }
 

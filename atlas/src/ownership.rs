@@ -50,8 +50,8 @@ pub(crate) fn assign_owners(
 /// mean of those neighbours' 2D positions: a chart of a few vertices would
 /// otherwise hold a whole block alone. A chart takes in at most as many
 /// vertices as it owns, so that on coarse meshes made of small charts one
-/// chart does not swallow the rest onto a few pixels (measured on
-/// RiggedFigure: without the cap 116 of 130 vertices had to move). Returns how many
+/// chart does not swallow the rest onto a few pixels
+/// (docs/design.md, "Atlas: whole-piece charts and packing"). Returns how many
 /// vertices changed chart.
 pub(crate) fn absorb_small_charts(
     triangles: &[[u32; 3]],

@@ -65,8 +65,8 @@ fn unwrap(
         padding: 0,
         // Wider normal cones and a tighter area-distortion bound than the
         // lightmap defaults (70°, 4): fewer, larger charts with lower stretch
-        // (measured: dance 80 -> 82 charts but packing 48.1% -> 49.1%,
-        // horse-gallop 97 -> 85 charts, 48.5% -> 49.8%, max stretch 1.10 -> 1.07).
+        // and better packing
+        // (docs/design.md, "Atlas: whole-piece charts and packing").
         max_chart_angle: 89.0,
         max_area_distortion: 2.0,
         packing: uvunwrap::Packing::Fast,

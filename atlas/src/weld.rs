@@ -3,10 +3,10 @@
 //!
 //! Meshes read from glTF are often split at UV seams and hard edges, or not indexed at all (Fox:
 //! 1728 vertices for 576 separate triangles). Charting on the split connectivity makes every
-//! seam a chart border and every loose triangle a chart (Fox: 576 charts, 15 % packing). The
-//! charts are therefore grown, cut and flattened on the welded triangles; every vertex still gets
-//! its own pixel (the copies of a position share its 2D point, and the lattice moves all but
-//! one to the nearest free pixels of their chart).
+//! seam a chart border and every loose triangle a chart. With `AtlasOptions::weld` the charts are
+//! grown, cut and flattened on the welded triangles instead; every vertex still gets its own pixel
+//! (the copies of a position share its 2D point, and the lattice moves all but one to the nearest
+//! free pixels of their chart).
 
 use std::collections::HashMap;
 

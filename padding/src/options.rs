@@ -119,10 +119,10 @@ pub enum EmptyBlocks {
 
 /// Settings of [`crate::pad`]. `Default` is what the encoder should use: [`Method::Snap`] with
 /// [`EmptyBlocks::RasterPrevious`], which needed the fewest JPEG bytes at equal error on the fixed
-/// pixels in the crate's bench (README.md): 5.6–8.4 % below the paper's [`Method::Cg`] on average over
-/// the errors of qualities 50/75/90, and below it at each of them. Set `jpeg_quality` to the quality
-/// the image is coded at; for a codec other than JPEG (MPEG-4 P-frames), [`Method::Biharmonic`] is
-/// the quality-independent runner-up (2.4–4.8 % below `cg`).
+/// pixels in the crate's bench, below the paper's [`Method::Cg`] at every quality (README.md,
+/// "Bench"; docs/design.md, "Padding per codec"). Set `jpeg_quality` to the quality the image is
+/// coded at; for a codec other than JPEG (MPEG-4 P-frames), [`Method::Biharmonic`] is the
+/// quality-independent runner-up.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PaddingOptions {
     /// Which filler to run.
@@ -133,9 +133,9 @@ pub struct PaddingOptions {
     /// well under 0.01 grey level from the exact minimiser, far below the 0.5 of 8-bit rounding.
     pub tolerance: f32,
     /// Cap on conjugate gradient iterations per system. A block system has at most 64 unknowns, so
-    /// CG ends in ≤ 64 steps in exact arithmetic (measured on the bench images: 12 steps per block
-    /// on average for `cg`, 31 for `biharmonic`); the whole-image system (`laplace`) is the one the
-    /// cap could bound, and there the push–pull warm start leaves ~100 steps to do.
+    /// CG ends in ≤ 64 steps in exact arithmetic (far fewer on the bench images: README.md); the
+    /// whole-image system (`laplace`) is the one the cap could bound, and there the push–pull warm
+    /// start leaves ~100 steps to do.
     pub max_iterations: usize,
     /// Fill of blocks without fixed pixels in intra frames (block methods only).
     pub empty_blocks: EmptyBlocks,
