@@ -75,7 +75,7 @@ bench: deps
 # libFuzzer through cargo-fuzz: a nightly toolchain when there is one (with AddressSanitizer), else the
 # stable compiler unlocked by RUSTC_BOOTSTRAP and no sanitizer (safe Rust needs none to find panics).
 # Seeds are small real streams and meshes made from media/; new inputs libFuzzer finds accumulate in
-# fuzz/corpus/TARGET, crashers land in fuzz/artifacts/TARGET (replay them with tests/fuzz_regressions.rs).
+# fuzz/corpus/TARGET, crashers land in fuzz/artifacts/TARGET (replay them with tests/it/fuzz_regressions.rs).
 # One process per target, overflow checks on, 10 s per input at most, 2 GB of memory at most.
 FUZZ_SECONDS ?= 300
 FUZZ_TARGETS ?= decode_stream read_mesh

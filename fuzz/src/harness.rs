@@ -1,5 +1,6 @@
 //! The fuzz targets' bodies. Uses only `mcgv_video` and `crc32fast`, so the regression test
-//! (`tests/fuzz_regressions.rs`) includes this file by path and replays crashers through the same code.
+//! (`tests/it/fuzz_regressions.rs`, through `tests/common/mod.rs`) includes this file by path and
+//! replays crashers through the same code.
 
 use mcgv_video::codec::tdct::index::BandIndex;
 use mcgv_video::first_frame::{self, FirstFrameOptions};

@@ -12,7 +12,7 @@ use mcgv_video::stream::container::{Checksum, ContainerReader, Tag};
 use mcgv_video::PaddingMethod;
 use std::io::Cursor;
 
-/// As in `tests/roundtrip.rs`: CG padding keeps the debug-build tests fast.
+/// As in `tests/it/roundtrip.rs`: CG padding keeps the debug-build tests fast.
 fn opts(codec: Codec, quality: u8, predictor: PredictorKind) -> EncodeOptions {
     EncodeOptions {
         codec: config(codec, None, Some(PaddingMethod::Cg), Some(10)),
