@@ -7,6 +7,7 @@
 
 mod attributes;
 mod summary;
+pub(crate) mod vector;
 internal! {
     frames;
     gltf_write;

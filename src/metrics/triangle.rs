@@ -5,23 +5,11 @@
 //! take plain arrays, stay in `f64`, and never divide by zero on the degenerate triangles real meshes
 //! contain.
 
-/// A point or vector in `f64`.
-pub type Vec3 = [f64; 3];
-
-pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
+pub use crate::mesh::vector::Vec3;
+use crate::mesh::vector::{cross, sub};
 
 fn dot(a: Vec3, b: Vec3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// `a + s·u + t·v`.

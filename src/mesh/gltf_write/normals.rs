@@ -6,7 +6,7 @@
 //! stream does not say which split vertices were hard edges.
 
 use crate::mesh::{Point, Triangle};
-use crate::metrics::triangle::{cross, sub};
+use crate::mesh::vector::{cross, sub};
 use rustc_hash::FxHashMap;
 
 /// Vertices grouped by identical frame-0 position: `group[v]` is the group of vertex `v`.
