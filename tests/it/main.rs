@@ -16,6 +16,7 @@ mod first_frame_bits;
 mod fuzz_regressions;
 mod gltf_write;
 mod hostile_meshes;
+mod layering;
 mod mesh_io;
 mod metrics_reference;
 mod motion;
