@@ -81,13 +81,20 @@ pub(crate) trait ResidualDecoder<R> {
         frame: &mut [Point],
     ) -> Result<()>;
 
-    /// Adds every frame's residuals to the predictions, in order.
+    /// Adds every frame's residuals to the predictions, in order: by default frame by frame; a
+    /// codec whose frames share work (a group of pictures, an inverse transform) does it once.
     fn add_all(
         &mut self,
         reader: &mut ContainerReader<R>,
         frames: &mut [Vec<Point>],
         progress: &dyn Progress,
-    ) -> Result<()>;
+    ) -> Result<()> {
+        for (f, frame) in frames.iter_mut().enumerate() {
+            self.add_frame(reader, f, frame)?;
+            progress.frames(1);
+        }
+        Ok(())
+    }
 
     /// What the codec stored: its settings, and its bands or pictures.
     fn describe(&self) -> Description;

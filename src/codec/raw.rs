@@ -10,7 +10,6 @@ use super::{CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
 use crate::error::{Error, Result};
 use crate::mesh::Point;
 use crate::motion::DEFAULT_AFFINE_PRECISION;
-use crate::progress::Progress;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
 use crate::stream::frame_index::{FrameChunk, FrameIndex};
@@ -116,19 +115,6 @@ impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
             *value += (level as f64 * f64::from(self.step)) as f32;
         }
         r.finish()
-    }
-
-    fn add_all(
-        &mut self,
-        reader: &mut ContainerReader<R>,
-        frames: &mut [Vec<Point>],
-        progress: &dyn Progress,
-    ) -> Result<()> {
-        for (f, frame) in frames.iter_mut().enumerate() {
-            self.add_frame(reader, f, frame)?;
-            progress.frames(1);
-        }
-        Ok(())
     }
 
     fn describe(&self) -> Description {

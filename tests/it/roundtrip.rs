@@ -2,7 +2,7 @@
 //! random access and the handling of damaged streams.
 
 use crate::common::{canonical, config, decode_all, decoder, encode_bytes, read_media};
-use mcgv_video::codec::{Codec, CodecConfig, Mpeg4Config, PictureOptions};
+use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::PredictorKind;
@@ -59,20 +59,11 @@ fn jpeg_round_trip_keeps_connectivity_and_bounds_error() {
 #[test]
 fn mpeg4_round_trip_keeps_connectivity_and_bounds_error() {
     let mesh = read_media("RiggedFigure.glb");
-    let bytes = encode_bytes(
-        &mesh,
-        &EncodeOptions {
-            codec: CodecConfig::Mpeg4(Mpeg4Config {
-                qscale: Some(4),
-                gop: 10,
-                pictures: PictureOptions {
-                    padding: Some(PaddingMethod::Cg),
-                    ..PictureOptions::default()
-                },
-            }),
-            ..opts(Codec::Mpeg4, 75)
-        },
-    );
+    let mut options = opts(Codec::Mpeg4, 75);
+    if let Some((_, qscale)) = options.codec.quantiser_mut() {
+        *qscale = Some(4);
+    }
+    let bytes = encode_bytes(&mesh, &options);
     let decoded = decode_all(bytes.clone()).unwrap();
     assert_eq!(canonical(decoded.triangles()), canonical(mesh.triangles()));
     let m = compare(&mesh, &decoded).unwrap();
@@ -166,8 +157,8 @@ fn deep_codecs_round_trip_random_access_and_determinism() {
     for codec in [Codec::Hevc, Codec::Av1] {
         for depth in [10u8, 12] {
             let mut options = opts(codec, 75);
-            if let CodecConfig::Hevc(deep) | CodecConfig::Av1(deep) = &mut options.codec {
-                deep.bit_depth = Some(depth);
+            if let Some(bits) = options.codec.bit_depth_mut() {
+                *bits = Some(depth);
             }
             let bytes = encode_bytes(&mesh, &options);
             let what = format!("{} at {depth} bits", codec.name());

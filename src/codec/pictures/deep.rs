@@ -8,7 +8,7 @@
 //! threads), which makes one key frame, then P-frames, one packet per frame in order; headers are
 //! in-band, so that decoding can start at any key frame.
 
-use super::{PictureOptions, PicturePlan, Resolved, DEFAULT_GOP};
+use super::{PictureOptions, Resolved, DEFAULT_GOP};
 use crate::codec::rate::{PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::{Error, Result};
@@ -76,18 +76,14 @@ impl DeepConfig {
     ) -> Result<RatePlan> {
         let depth = self.bit_depth.unwrap_or_else(|| auto_depth(rate.quality));
         let law = law(rate.quality, depth);
-        let plan = PicturePlan {
+        let resolved = Resolved {
             codec,
+            step_factor: law.step_factor,
             quantiser: self.qp.unwrap_or(law.quantiser),
             gop: self.gop,
             depth,
             padding: deep_padding(self.gop),
-            lattice: self.pictures.lattice,
-        };
-        let resolved = Resolved {
-            step_factor: law.step_factor,
             affine_precision,
-            plan,
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }

@@ -130,18 +130,14 @@ impl JpegConfig {
     /// step, every frame its own key frame and ranges, `snap` padding at the JPEG quality.
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
         let law = jpeg_law(rate.quality);
-        let plan = PicturePlan {
+        let resolved = Resolved {
             codec: Codec::Jpeg,
+            step_factor: law.step_factor,
             quantiser: self.quality.unwrap_or(law.quantiser),
             gop: 1,
             depth: 8,
             padding: padding::Method::Snap,
-            lattice: self.pictures.lattice,
-        };
-        let resolved = Resolved {
-            step_factor: law.step_factor,
             affine_precision: DEFAULT_AFFINE_PRECISION,
-            plan,
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }

@@ -87,18 +87,27 @@ impl PicturePlan {
     }
 }
 
-/// What a picture codec's configuration resolves before the shared part of its plan.
+/// What a picture codec's configuration resolves of an encoding by its law: the rest of its plan
+/// (lattice, padding) is the caller's [`PictureOptions`].
 pub(crate) struct Resolved {
+    /// Which picture codec.
+    pub codec: Codec,
     /// The pixel step as a multiple of the quality's target step.
     pub step_factor: f64,
+    /// The codec's own quantiser.
+    pub quantiser: u8,
+    /// Frames per group of pictures.
+    pub gop: usize,
+    /// Bits a sample.
+    pub depth: u8,
+    /// The padding the codec measured best, unless the caller asks another.
+    pub padding: padding::Method,
     /// The affine precision the codec measured best, unless the caller asks another.
     pub affine_precision: f64,
-    /// The codec's settings; its `padding` method is the default, replaced by the caller's.
-    pub plan: PicturePlan,
 }
 
-/// The rate plan of a picture codec: its pixel step from the law's factor, its padding (the
-/// caller's or the codec's default).
+/// The rate plan of a picture codec: its pixel step from the law's factor, the lattice and
+/// padding of `options` (the padding: the caller's or the codec's default).
 pub(crate) fn plan(
     rate: &Rate,
     diagonal: f64,
@@ -106,11 +115,15 @@ pub(crate) fn plan(
     resolved: Resolved,
 ) -> Result<RatePlan> {
     let step = rate.stored_step("pixel step", diagonal, resolved.step_factor)?;
-    let mut plan = resolved.plan;
-    plan.lattice = options.lattice;
-    plan.padding = options.padding.unwrap_or(plan.padding);
-    let codec = plan.codec;
-    Ok(rate.plan(step, resolved.affine_precision, codec, Some(plan)))
+    let plan = PicturePlan {
+        codec: resolved.codec,
+        quantiser: resolved.quantiser,
+        gop: resolved.gop,
+        depth: resolved.depth,
+        padding: options.padding.unwrap_or(resolved.padding),
+        lattice: options.lattice,
+    };
+    Ok(rate.plan(step, resolved.affine_precision, resolved.codec, Some(plan)))
 }
 
 /// What a picture codec (one file per codec) tells the geometry-video coder. `Sync`: groups of

@@ -8,7 +8,7 @@
 //! Headers are in-band (no global header): each I-frame packet repeats the VOL header, so decoding can
 //! start at any I-frame.
 
-use super::{PictureOptions, PicturePlan, Resolved, DEFAULT_GOP};
+use super::{PictureOptions, Resolved, DEFAULT_GOP};
 use crate::codec::rate::{anchor, read_law, Anchor, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::{Error, Result};
@@ -57,18 +57,14 @@ impl Mpeg4Config {
     /// residual step (coarser maps' quantisation noise spoils P-frame prediction).
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
         let law = mpeg4_law(rate.quality);
-        let plan = PicturePlan {
+        let resolved = Resolved {
             codec: Codec::Mpeg4,
+            step_factor: law.step_factor,
             quantiser: self.qscale.unwrap_or(law.quantiser),
             gop: self.gop,
             depth: 8,
             padding: padding::Method::Biharmonic,
-            lattice: self.pictures.lattice,
-        };
-        let resolved = Resolved {
-            step_factor: law.step_factor,
             affine_precision: 1.0 / 16.0,
-            plan,
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }
