@@ -32,9 +32,9 @@ internal! {
 }
 
 pub use interface::{BandsDescription, Description, PicturesDescription};
-pub(crate) use interface::{
-    CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput, StreamLayout,
-};
+pub(crate) use interface::{ResidualDecoder, StreamLayout};
+#[cfg(feature = "encode")]
+pub(crate) use interface::{CodedResiduals, ResidualEncoder, ResidualInput};
 pub use pictures::deep::DeepConfig;
 pub(crate) use pictures::geometry_video;
 pub use pictures::jpeg::JpegConfig;
@@ -217,6 +217,7 @@ impl Codec {
     }
 
     /// The residual encoder of `plan` (a plan of this codec).
+    #[cfg(feature = "encode")]
     pub(crate) fn encoder(self, plan: &RatePlan) -> Result<Box<dyn ResidualEncoder>> {
         let step = plan.step;
         Ok(match (self.pictures()?, &plan.pictures) {
@@ -390,6 +391,7 @@ impl CodecConfig {
     }
 }
 
+#[cfg(feature = "encode")]
 impl RatePlan {
     /// The residual encoder with this plan's settings.
     pub(crate) fn encoder(&self) -> Result<Box<dyn ResidualEncoder>> {

@@ -236,6 +236,7 @@ impl ContainerWriter {
 
     /// Writes the file to a temporary file beside `path` and renames it into place, so a failure
     /// never leaves a half-written file at `path`.
+    #[cfg(feature = "encode")]
     pub fn write_atomic(&self, path: &Path) -> Result<u64> {
         let bytes = self.to_bytes();
         crate::output::write_atomic(path, &bytes)?;

@@ -126,6 +126,7 @@ pub(crate) trait PictureCodec: Sync {
     fn settings(&self, quantiser: u8, gop: u32, depth: u8) -> Vec<(&'static str, u32)>;
     /// An encoder for `width`×`height` pictures whose first picture is frame `first_frame` of the
     /// sequence (a key frame: every group of pictures gets its own encoder).
+    #[cfg(feature = "encode")]
     fn encoder(
         &self,
         width: u32,
@@ -143,6 +144,7 @@ pub(crate) trait PictureCodec: Sync {
 }
 
 /// Codes pictures in frame order.
+#[cfg(feature = "encode")]
 pub(crate) trait PictureEncoder {
     /// Codes the next frame's picture (samples of the codec's depth).
     fn push(&mut self, plane: &Plane<u16>) -> Result<()>;
