@@ -108,9 +108,9 @@ pub use encoder::{
 pub use error::{Error, Result};
 pub use geometry_image::Lattice;
 pub use limits::DEFAULT_MAX_POSITIONS;
-pub use mesh::{AnimatedMesh, Attributes};
 #[cfg(feature = "encode")]
 pub use mesh::{read_animation, FrameSource, ReadOptions};
+pub use mesh::{AnimatedMesh, Attributes};
 pub use motion::PredictorKind;
 /// How free pixels of the geometry images are filled (the `padding` crate's methods).
 pub use padding::Method as PaddingMethod;

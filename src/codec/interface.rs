@@ -107,6 +107,15 @@ pub(crate) trait ResidualDecoder<R> {
         None
     }
 
+    /// Adds frame `f`'s residuals read from its picture `plane`, decoded outside (x | y | z
+    /// residual images side by side, samples of the stream's depth), for codecs that code images.
+    fn add_picture(&self, _f: usize, _plane: &Plane<u16>, _frame: &mut [Point]) -> Result<()> {
+        Err(Error::Usage(format!(
+            "a {} stream has no pictures",
+            self.describe().codec.name()
+        )))
+    }
+
     /// Frame `f`'s decoded picture (x | y | z residual images side by side, samples of the stream's
     /// depth), for codecs that code images.
     fn picture(&mut self, _reader: &mut ContainerReader<R>, _f: usize) -> Result<Plane<u16>> {

@@ -267,8 +267,8 @@ pub struct ContainerReader<R> {
     source: R,
     parts: Vec<PartEntry>,
     file_len: u64,
-    /// The progressive last part cut short by the end of the file: its tag, segment and the
-    /// length it declared.
+    /// The last part cut short by the end of the file (progressive, or chunked in a partial
+    /// file): its tag, segment and the length it declared.
     truncated: Option<(Tag, Option<u32>, u64)>,
     /// Temporal segments in the stream (0: not segmented).
     segments: u32,
@@ -286,7 +286,18 @@ impl ContainerReader<BufReader<File>> {
 
 impl<R: Read + Seek> ContainerReader<R> {
     /// Reads the part table of a container from any seekable source.
-    pub fn new(mut source: R) -> Result<Self> {
+    pub fn new(source: R) -> Result<Self> {
+        Self::read(source, false)
+    }
+
+    /// Reads the part table of a container still arriving (the prefix of a download): its last
+    /// part may be cut short whether progressive or chunked (a picture codec's frames), so that
+    /// the chunks present decode; a chunk past the end is an error when asked for.
+    pub fn partial(source: R) -> Result<Self> {
+        Self::read(source, true)
+    }
+
+    fn read(mut source: R, partial: bool) -> Result<Self> {
         let file_len = source.seek(SeekFrom::End(0)).map_err(table_io)?;
         source.seek(SeekFrom::Start(0)).map_err(table_io)?;
         let count = read_file_header(&mut source)?;
@@ -296,7 +307,7 @@ impl<R: Read + Seek> ContainerReader<R> {
         let mut truncated = None;
         let mut segments = 0u32;
         for i in 0..count {
-            let mut part = read_part_entry(&mut source, i, count, pos, file_len)?;
+            let mut part = read_part_entry(&mut source, (i, count), pos, file_len, partial)?;
             if part.entry.tag == Tag::SEGMENT {
                 segments += 1;
             }
@@ -333,7 +344,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             .map(|(.., declared)| declared)
     }
 
-    /// Whether the file ends inside its progressive last part.
+    /// Whether the file ends inside its last part (progressive, or chunked in a partial file).
     pub fn cut_short(&self) -> bool {
         self.truncated.is_some()
     }
@@ -439,8 +450,14 @@ impl<R: Read + Seek> ContainerReader<R> {
         what: &str,
     ) -> Result<Vec<u8>> {
         let e = self.entry(tag)?;
-        let within = offset.checked_add(len).is_some_and(|end| end <= e.len);
-        if !within {
+        let end = offset.checked_add(len);
+        if !end.is_some_and(|end| end <= e.len) {
+            let declared = self.truncated(tag);
+            if end.zip(declared).is_some_and(|(end, d)| end <= d) {
+                return Err(Error::Stream(format!(
+                    "{what} is past the end of the file (cut short, or still arriving)"
+                )));
+            }
             return Err(Error::Stream(format!("{what} lies outside part {tag}")));
         }
         let bytes = self.read_at(e.offset + offset, len, tag)?;

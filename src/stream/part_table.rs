@@ -84,13 +84,14 @@ pub(super) struct PartRead {
     pub truncated: Option<(Tag, u64)>,
 }
 
-/// Reads part `i` of `count`, whose 17-byte header starts at `pos`.
+/// Reads part `i` of `count`, whose 17-byte header starts at `pos`. `partial`: the file is still
+/// arriving, so a chunked last part may be cut short too (its chunks are checked one by one).
 pub(super) fn read_part_entry<R: Read>(
     source: &mut R,
-    i: u32,
-    count: u32,
+    (i, count): (u32, u32),
     pos: u64,
     file_len: u64,
+    partial: bool,
 ) -> Result<PartRead> {
     let mut ph = [0u8; 17];
     read_exact_or(source, &mut ph, "a part header")?;
@@ -120,11 +121,17 @@ pub(super) fn read_part_entry<R: Read>(
     let offset = pos + 17;
     let declared_end = offset.checked_add(len);
     let mut truncated = None;
-    // A progressive last part may be cut by the end of the file: its prefix still decodes.
+    // A progressive last part may be cut by the end of the file: its prefix still decodes. So may
+    // a chunked one of a file still arriving: its chunks present still decode.
+    let cut_allowed = match checksum {
+        Checksum::Progressive => true,
+        Checksum::Chunked => partial,
+        Checksum::Whole => false,
+    };
     let (len, declared_end) = match declared_end {
         Some(e)
             if e > file_len
-                && checksum == Checksum::Progressive
+                && cut_allowed
                 && i + 1 == count
                 && offset <= file_len =>
         {

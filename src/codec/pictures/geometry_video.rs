@@ -267,7 +267,11 @@ impl Decoder {
         let (pixel_step, ranges) = quantise::read_ranges(&mut r, frames, depth)?;
         let corrections = Corrections::read(&mut r, frames, v)?;
         r.finish()?;
-        let images_len = reader.entry(Tag::FRAMES)?.len;
+        // A partial stream's images part may be cut short: the index covers the declared length.
+        let images_len = match reader.truncated(Tag::FRAMES) {
+            Some(declared) => declared,
+            None => reader.entry(Tag::FRAMES)?.len,
+        };
         let index = FrameIndex::from_bytes(&reader.part(Tag::FRAME_INDEX)?, frames, images_len)?;
         Ok(Self {
             codec,
@@ -386,6 +390,18 @@ impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
 
     fn images(&self) -> Option<&ImageLayout> {
         Some(&self.layout)
+    }
+
+    fn add_picture(&self, f: usize, plane: &Plane<u16>, frame: &mut [Point]) -> Result<()> {
+        self.layout.index.entry(f)?;
+        let top = quantise::max_level(self.layout.depth());
+        if plane.data.iter().any(|&s| u32::from(s) > top as u32) {
+            return Err(Error::Usage(format!(
+                "frame {f}: a picture sample is above {top}, the largest at {} bits",
+                self.layout.depth()
+            )));
+        }
+        self.add(f, plane, frame)
     }
 
     fn picture(&mut self, reader: &mut ContainerReader<R>, f: usize) -> Result<Plane<u16>> {
