@@ -106,6 +106,36 @@ impl<R: Read + Seek> Decoder<R> {
         Self::from_container(reader, options)
     }
 
+    /// The first frame of a stream of which only the start may have arrived: its header, first
+    /// frame (the stream's first parts, about a third of a 2-second clip at the default
+    /// quality, less of a longer or finer one) and, once arrived, its texture coordinates and
+    /// materials. A player draws it while the rest arrives.
+    pub fn first_frame(source: R, options: &DecodeOptions) -> Result<FirstFrame> {
+        let mut reader = ContainerReader::partial(source)?;
+        let header = Header::from_bytes(&reader.part(Tag::HEADER)?)?;
+        Codec::from_id(header.codec)?;
+        limits::check_stream(header.vertices, header.frames, options.max_positions)?;
+        let (triangles, positions) = first_frame::decode(&reader.part(Tag::FIRST_FRAME)?)?;
+        check_first_frame(&header, &triangles, &positions)?;
+        // The attributes come right after the first frame: a later part tells there are none.
+        let later = |t: Tag| t != Tag::HEADER && t != Tag::FIRST_FRAME && t != Tag::ATTRIBUTES;
+        let attributes = match reader.has(Tag::ATTRIBUTES) {
+            true => Some(decode_attributes(
+                &reader.part(Tag::ATTRIBUTES)?,
+                &triangles,
+                &positions,
+            )?),
+            false if reader.parts().iter().any(|p| later(p.tag)) => Some(Attributes::default()),
+            false => None,
+        };
+        Ok(FirstFrame {
+            header,
+            triangles,
+            positions,
+            attributes,
+        })
+    }
+
     /// Reads and checks every part but the coded residuals (temporal-DCT bands are decoded here),
     /// and of a segmented stream, the first segment's.
     pub fn from_container(mut reader: ContainerReader<R>, options: &DecodeOptions) -> Result<Self> {
@@ -114,14 +144,7 @@ impl<R: Read + Seek> Decoder<R> {
         limits::check_stream(header.vertices, header.frames, options.max_positions)?;
         let (v, f) = (header.vertices as usize, header.frames as usize);
         let (triangles, reference) = first_frame::decode(&reader.part(Tag::FIRST_FRAME)?)?;
-        if reference.len() != v || triangles.len() != header.triangles as usize {
-            return Err(Error::Stream(format!(
-                "first frame has {} vertices and {} triangles, header says {v} and {}",
-                reference.len(),
-                triangles.len(),
-                header.triangles
-            )));
-        }
+        check_first_frame(&header, &triangles, &reference)?;
         let attributes = match reader.has(Tag::ATTRIBUTES) {
             true => decode_attributes(&reader.part(Tag::ATTRIBUTES)?, &triangles, &reference)?,
             false => Attributes::default(),
@@ -489,6 +512,36 @@ impl<R: Read + Seek> Decoder<R> {
             &self.partition,
         )
     }
+}
+
+/// The first frame's counts must be the header's.
+fn check_first_frame(header: &Header, triangles: &[Triangle], reference: &[Point]) -> Result<()> {
+    if reference.len() != header.vertices as usize || triangles.len() != header.triangles as usize {
+        return Err(Error::Stream(format!(
+            "first frame has {} vertices and {} triangles, header says {} and {}",
+            reference.len(),
+            triangles.len(),
+            header.vertices,
+            header.triangles
+        )));
+    }
+    Ok(())
+}
+
+/// What the first parts of a stream hold: enough to draw its first frame before the rest has
+/// arrived ([`Decoder::first_frame`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FirstFrame {
+    /// The stream header.
+    pub header: Header,
+    /// The triangles of every frame, in the decoder's order.
+    pub triangles: Vec<Triangle>,
+    /// Frame 0 as the first-frame coder stored it (the reference every frame is predicted from,
+    /// [`Decoder::reference`]), in the decoder's vertex order: the decoded frame 0 differs from
+    /// it by what the predictor and residuals of frame 0 add (of the order of the step).
+    pub positions: Vec<Point>,
+    /// Texture coordinates and materials; `None` while their part may still be to come.
+    pub attributes: Option<Attributes>,
 }
 
 /// A mesh holds finite coordinates only: a decoded frame with an infinity or NaN is refused.

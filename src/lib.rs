@@ -99,7 +99,7 @@ internal! {
 }
 
 pub use codec::{Codec, CodecConfig, Description};
-pub use decoder::{DecodeOptions, Decoder};
+pub use decoder::{DecodeOptions, Decoder, FirstFrame};
 #[cfg(feature = "encode")]
 pub use encoder::{
     encode, encode_source, encode_with_progress, EncodeOptions, EncodeReport, Encoded,

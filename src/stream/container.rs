@@ -290,9 +290,10 @@ impl<R: Read + Seek> ContainerReader<R> {
         Self::read(source, false)
     }
 
-    /// Reads the part table of a container still arriving (the prefix of a download): its last
-    /// part may be cut short whether progressive or chunked (a picture codec's frames), so that
-    /// the chunks present decode; a chunk past the end is an error when asked for.
+    /// Reads the part table of a container still arriving (the prefix of a download): the parts
+    /// whose bytes have all arrived, and the one the file ends in when its chunks are checked one
+    /// by one (progressive or chunked: a picture codec's frames), so that the chunks present
+    /// decode; a chunk past the end, or a part not there yet, is an error when asked for.
     pub fn partial(source: R) -> Result<Self> {
         Self::read(source, true)
     }
@@ -307,12 +308,20 @@ impl<R: Read + Seek> ContainerReader<R> {
         let mut truncated = None;
         let mut segments = 0u32;
         for i in 0..count {
+            // A file still arriving ends where it ends: the parts after are to come.
+            if partial && pos + PART_HEADER_LEN as u64 > file_len {
+                break;
+            }
             let mut part = read_part_entry(&mut source, (i, count), pos, file_len, partial)?;
             if part.entry.tag == Tag::SEGMENT {
                 segments += 1;
             }
             part.entry.segment = segments.checked_sub(1);
             if let Some((tag, declared)) = part.truncated {
+                // A part whose one CRC covers it whole is of no use until it has all arrived.
+                if part.entry.checksum == Checksum::Whole {
+                    break;
+                }
                 truncated = Some((tag, part.entry.segment, declared));
             }
             parts.push(part.entry);
@@ -320,7 +329,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             source.seek(SeekFrom::Start(pos)).map_err(table_io)?;
         }
         check_scopes(&parts)?;
-        if pos != file_len {
+        if pos != file_len && !partial {
             return Err(Error::Stream(format!(
                 "{} bytes after the last part (file damaged or concatenated?)",
                 file_len - pos

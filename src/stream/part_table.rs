@@ -85,7 +85,7 @@ pub(super) struct PartRead {
 }
 
 /// Reads part `i` of `count`, whose 17-byte header starts at `pos`. `partial`: the file is still
-/// arriving, so a chunked last part may be cut short too (its chunks are checked one by one).
+/// arriving, so any part may be cut short by its end (the caller decides what is of use).
 pub(super) fn read_part_entry<R: Read>(
     source: &mut R,
     (i, count): (u32, u32),
@@ -122,17 +122,12 @@ pub(super) fn read_part_entry<R: Read>(
     let declared_end = offset.checked_add(len);
     let mut truncated = None;
     // A progressive last part may be cut by the end of the file: its prefix still decodes. So may
-    // a chunked one of a file still arriving: its chunks present still decode.
-    let cut_allowed = match checksum {
-        Checksum::Progressive => true,
-        Checksum::Chunked => partial,
-        Checksum::Whole => false,
-    };
+    // any part of a file still arriving (the caller keeps the ones whose chunks are checked alone).
+    let cut_allowed = partial || (checksum == Checksum::Progressive && i + 1 == count);
     let (len, declared_end) = match declared_end {
         Some(e)
             if e > file_len
                 && cut_allowed
-                && i + 1 == count
                 && offset <= file_len =>
         {
             truncated = Some((Tag(tag), len));

@@ -125,3 +125,37 @@ fn a_picture_decoded_outside_gives_the_frame_the_decoder_gives() {
     assert!(t.coded_picture(0).is_err());
     assert!(t.decode_frame_from_picture(0, &plane).is_err());
 }
+
+#[test]
+fn the_first_frame_draws_from_the_first_parts_alone() {
+    let bytes = stream(Codec::Tdct);
+    let whole = open(&bytes, false).unwrap();
+    let reader = ContainerReader::new(Cursor::new(&bytes[..])).unwrap();
+    let mesh = reader.entry(Tag::FIRST_FRAME).unwrap();
+    let partition = reader.entry(Tag::PARTITION).unwrap();
+    let first = |cut: u64| {
+        let source = Cursor::new(&bytes[..cut as usize]);
+        Decoder::first_frame(source, &DecodeOptions::default())
+    };
+    assert!(
+        first(mesh.offset + mesh.len - 1).is_err(),
+        "a cut first frame"
+    );
+    for cut in [mesh.offset + mesh.len, partition.offset - 5] {
+        let f = first(cut).unwrap();
+        assert_eq!(f.positions, whole.reference());
+        assert_eq!(f.triangles, whole.triangles());
+        assert_eq!(f.header, *whole.header());
+        assert_eq!(
+            f.attributes, None,
+            "cut at {cut}: the attributes may still come"
+        );
+    }
+    // Once a later part has arrived, a stream without attributes is known to have none.
+    let f = first(partition.offset + partition.len).unwrap();
+    assert_eq!(f.attributes, Some(Default::default()));
+    assert_eq!(
+        first(bytes.len() as u64).unwrap().positions,
+        whole.reference()
+    );
+}
