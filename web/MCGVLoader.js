@@ -112,7 +112,10 @@ export class MCGVAnimation extends EventDispatcher {
     this.bandsDecoded = 0;
     this.framesDecoded = 0;
     this.decodeMsPerFrame = 0;
-    this.firstFrameBytes = 0; // bytes received when a frame could first be drawn
+    this.firstFrameBytes = 0; // bytes received when a frame could first be drawn (the first frame)
+    this.firstClipBytes = 0; // … when every frame could (a tdct stream's first band)
+    this.previewed = false;
+    this.previewDressed = false;
     this.done = false;
     this.error = null;
     this.current = -1;
@@ -199,16 +202,17 @@ export class MCGVAnimation extends EventDispatcher {
     const s = this.stream_;
     if (!this.opened) {
       if (!last && this.bytesReceived < this.nextOpenAt) return;
+      if (!this.previewed && !last) this.preview();
       try {
         this.info = s.open({ partial: !last });
       } catch (error) {
         if (last || error.panic) throw error;
         // Not enough yet: try again when a little more has come.
-        this.nextOpenAt = this.bytesReceived + Math.max(4096, this.bytesReceived >> 3);
+        this.nextOpenAt = this.bytesReceived + Math.max(1024, this.bytesReceived >> 4);
         return;
       }
       this.opened = true;
-      this.build();
+      if (!this.previewed || !this.previewDressed) this.build();
       if (this.needsPictures()) return;
       this.decodeWhatArrived(last);
       return;
@@ -224,6 +228,36 @@ export class MCGVAnimation extends EventDispatcher {
     } else {
       this.decodeWhatArrived(last);
     }
+  }
+
+  /** Draws the first frame from the stream's first parts (the whole clip needs the predictor's
+   *  and the first band's bytes); its texture coordinates follow when they have arrived. */
+  preview() {
+    let first;
+    try {
+      first = this.stream_.firstFrame();
+    } catch (error) {
+      if (error.panic) throw error;
+      return;
+    }
+    this.info = first.info;
+    this.build();
+    this.previewed = true;
+    this.previewDressed = first.info.attributesKnown;
+    this.geometry.attributes.position.array.set(first.positions);
+    this.geometry.attributes.position.needsUpdate = true;
+    this.geometry.computeVertexNormals();
+    const v = first.info.vertices;
+    const min = [Infinity, Infinity, Infinity];
+    const max = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < 3 * v; i++) {
+      min[i % 3] = Math.min(min[i % 3], first.positions[i]);
+      max[i % 3] = Math.max(max[i % 3], first.positions[i]);
+    }
+    this.geometry.boundingBox = new Box3(new Vector3(...min), new Vector3(...max));
+    this.geometry.boundingSphere = this.geometry.boundingBox.getBoundingSphere(new Sphere());
+    this.firstFrameBytes = this.bytesReceived;
+    this.dispatchEvent({ type: 'frames', preview: true });
   }
 
   /** Decodes the frames the open stream gives now. */
@@ -286,11 +320,12 @@ export class MCGVAnimation extends EventDispatcher {
 
   shown() {
     if (!this.firstFrameBytes) this.firstFrameBytes = this.bytesReceived;
+    if (!this.firstClipBytes) this.firstClipBytes = this.bytesReceived;
     this.updateBounds();
     const x = this.current < 0 ? 0 : this.current;
     this.current = -1;
     this.setFrame(x);
-    this.dispatchEvent({ type: 'frames' });
+    this.dispatchEvent({ type: 'frames', bands: this.bandsDecoded });
   }
 
   /** The geometry of the open stream: index, UVs, material groups; positions to come. */
@@ -303,6 +338,7 @@ export class MCGVAnimation extends EventDispatcher {
     let index = s.triangles();
     const materials = s.materials();
     const g = this.geometry;
+    g.clearGroups();
     if (materials && info.materials.length > 1) {
       // One group per material: the triangles sorted by it.
       const order = [...materials.keys()].sort((a, b) => materials[a] - materials[b]);
@@ -318,7 +354,8 @@ export class MCGVAnimation extends EventDispatcher {
       }
     }
     g.setIndex(new BufferAttribute(index, 1));
-    const positions = new BufferAttribute(new Float32Array(3 * v), 3);
+    const drawn = g.attributes.position?.array;
+    const positions = new BufferAttribute(drawn?.length === 3 * v ? drawn : new Float32Array(3 * v), 3);
     positions.setUsage(DynamicDrawUsage);
     g.setAttribute('position', positions);
     const uv = s.texcoords(0);

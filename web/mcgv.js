@@ -59,6 +59,7 @@ export class MCGVStream {
     this.x = exports;
     this.dead = false;
     this.info = null;
+    this.first = null;
     this.call('mcgv_init');
     this.handle = this.call('mcgv_stream_new');
   }
@@ -117,6 +118,28 @@ export class MCGVStream {
     return this.info;
   }
 
+  /** Reads the first frame of the bytes so far — the stream's first parts suffice — to draw
+   *  while the rest arrives: { info, positions } (info: vertices, frames, triangles, fps, codec,
+   *  uvSets, materials, hasMaterials, attributesKnown: false while the texture coordinates may
+   *  still come). Until the stream opens, triangles(), texcoords() and materials() give its mesh.
+   *  Throws an MCGVError while too few bytes have arrived. */
+  firstFrame() {
+    const ptr = this.check(this.call('mcgv_first_frame', this.handle));
+    const len = this.call('mcgv_text_len', this.handle);
+    const info = JSON.parse(decoder.decode(new Uint8Array(this.x.memory.buffer, ptr, len)));
+    this.first = info;
+    const p = this.check(this.call('mcgv_first_positions', this.handle));
+    const positions = new Float32Array(this.x.memory.buffer, p, 3 * info.vertices).slice();
+    return { info, positions };
+  }
+
+  /** The counts of the open stream, else of its first frame. */
+  get mesh() {
+    const m = this.info ?? this.first;
+    if (!m) throw new MCGVError('the stream is not open');
+    return m;
+  }
+
   readInfo() {
     const ptr = this.check(this.call('mcgv_info', this.handle));
     const len = this.call('mcgv_text_len', this.handle);
@@ -126,21 +149,21 @@ export class MCGVStream {
   /** The triangles: 3 vertex indices each. */
   triangles() {
     const ptr = this.check(this.call('mcgv_triangles', this.handle));
-    return new Uint32Array(this.x.memory.buffer, ptr, 3 * this.info.triangles).slice();
+    return new Uint32Array(this.x.memory.buffer, ptr, 3 * this.mesh.triangles).slice();
   }
 
   /** Texture coordinate set `set` (u, v per vertex), or null. */
   texcoords(set = 0) {
-    if (!this.info || set >= this.info.uvSets) return null;
+    if (set >= this.mesh.uvSets) return null;
     const ptr = this.check(this.call('mcgv_texcoords', this.handle, set));
-    return new Float32Array(this.x.memory.buffer, ptr, 2 * this.info.vertices).slice();
+    return new Float32Array(this.x.memory.buffer, ptr, 2 * this.mesh.vertices).slice();
   }
 
   /** Each triangle's material index (into info.materials), or null. */
   materials() {
-    if (!this.info || !this.info.hasMaterials) return null;
+    if (!this.mesh.hasMaterials) return null;
     const ptr = this.check(this.call('mcgv_materials', this.handle));
-    return new Uint32Array(this.x.memory.buffer, ptr, this.info.triangles).slice();
+    return new Uint32Array(this.x.memory.buffer, ptr, this.mesh.triangles).slice();
   }
 
   /** Decodes frame `f` into `out` (a Float32Array of 3 × vertices: x, y, z per vertex). */

@@ -1,7 +1,7 @@
 // A static file server on 127.0.0.1 for the example page and its tests (Node's standard library
 // only). Serves ROOT; `--mount /PREFIX=DIR` serves DIR under /PREFIX/ too (three.js, media);
 // `--throttle BYTES_PER_SECOND` sends `.mcgv` files no faster than that, in 50 slices a second,
-// as a slow network would; `--port N` (default 0: a free one). Prints the port on the first line
+// in 500 slices a second, as a slow network would; `--port N` (default 0: a free one). Prints the port on the first line
 // of stdout, then serves until killed.
 //
 //   node web/serve.mjs web --mount /three=scripts/node/node_modules/three --port 8080
@@ -78,15 +78,15 @@ const server = http.createServer((req, res) => {
     res.end(body);
     return;
   }
-  // 50 slices a second at the asked rate.
-  const slice = Math.max(1, Math.round(throttle / 50));
+  // 500 slices a second at the asked rate (2 KB every 2 ms at 1 MB/s).
+  const slice = Math.max(1, Math.round(throttle / 500));
   let sent = 0;
   const next = () => {
     if (res.destroyed) return;
     const end = Math.min(body.length, sent + slice);
     res.write(body.subarray(sent, end));
     sent = end;
-    if (sent < body.length) setTimeout(next, 20);
+    if (sent < body.length) setTimeout(next, 2);
     else res.end();
   };
   next();

@@ -58,6 +58,8 @@ const state = {
   bytesReceived: 0,
   bytesTotal: 0,
   firstFrameBytes: 0,
+  firstClipBytes: 0,
+  firstBands: null,
   bandsDecoded: 0,
   bandsTotal: 0,
   framesDecoded: 0,
@@ -91,6 +93,7 @@ function updatePanel() {
     bytesReceived: a.bytesReceived,
     bytesTotal: a.bytesTotal,
     firstFrameBytes: a.firstFrameBytes,
+    firstClipBytes: a.firstClipBytes,
     bandsDecoded: a.bandsDecoded,
     bandsTotal: a.info?.bands?.total ?? 0,
     framesDecoded: a.framesDecoded,
@@ -117,7 +120,7 @@ function open(source, name) {
   }
   $('error').style.display = 'none';
   $('hint').style.display = 'none';
-  Object.assign(state, { phase: 'loading', error: null, firstFrameBytes: 0 });
+  Object.assign(state, { phase: 'loading', error: null, firstFrameBytes: 0, firstClipBytes: 0, firstBands: null });
   framed = false;
   const loader = new MCGVLoader();
   if (like) loader.setLike(like);
@@ -135,7 +138,12 @@ function open(source, name) {
       frame(q.has('bbox') ? q.get('bbox').split(',').map(Number) : [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z]);
       framed = true;
     }
-    if (state.phase === 'loading') state.phase = 'playing';
+    if (state.phase === 'loading' && a.framesDecoded) state.phase = 'playing';
+    // keep=K (tests): frame K as first drawn from bands, to compare with `decode --bands N`.
+    if (q.has('keep') && !state.firstBands && a.bandsDecoded > 0) {
+      const k = Number(q.get('keep'));
+      state.firstBands = { bands: a.bandsDecoded, frame: k, positions: Array.from(a.frame(k)) };
+    }
     updatePanel();
   };
   if (typeof source === 'string') {

@@ -11,7 +11,8 @@
 //! instance is then dropped by the glue.
 
 use mcgv_video::codec::Plane;
-use mcgv_video::{DecodeOptions, Decoder, Error};
+use mcgv_video::mesh::Triangle;
+use mcgv_video::{Attributes, DecodeOptions, Decoder, Error, FirstFrame};
 use std::cell::RefCell;
 use std::io::Cursor;
 use std::sync::Mutex;
@@ -25,6 +26,8 @@ const DEFAULT_MAX_POSITIONS: u64 = 30_000_000;
 struct Stream {
     bytes: Vec<u8>,
     decoder: Option<Decoder<Cursor<Vec<u8>>>>,
+    /// The first frame, read before the stream opens ([`mcgv_first_frame`]).
+    first: Option<FirstFrame>,
     floats: Vec<f32>,
     words: Vec<u32>,
     text: Vec<u8>,
@@ -64,6 +67,15 @@ fn opened(stream: &mut Stream) -> Result<&mut Decoder<Cursor<Vec<u8>>>, Error> {
         .decoder
         .as_mut()
         .ok_or_else(|| Error::Usage("the stream is not open".into()))
+}
+
+/// The triangles and attributes of the open stream, else of its first frame.
+fn mesh(stream: &Stream) -> Result<(&[Triangle], Option<&Attributes>), Error> {
+    match (&stream.decoder, &stream.first) {
+        (Some(d), _) => Ok((d.triangles(), Some(d.attributes()))),
+        (None, Some(f)) => Ok((&f.triangles, f.attributes.as_ref())),
+        (None, None) => Err(Error::Usage("the stream is not open".into())),
+    }
 }
 
 /// Installs the panic hook that keeps a panic's message for [`mcgv_error_ptr`]. Call once.
@@ -155,6 +167,56 @@ pub extern "C" fn mcgv_open(handle: u32, max_bands: i32, partial: u32, max_posit
         Ok(1)
     })
     .unwrap_or(0)
+}
+
+/// Reads the first frame of the bytes so far (the stream's first parts suffice): the address of
+/// its info as JSON (vertices, frames, triangles, fps, codec, uvSets, materials, hasMaterials,
+/// attributesKnown), [`mcgv_text_len`] its length; then [`mcgv_triangles`], [`mcgv_texcoords`],
+/// [`mcgv_materials`] give its mesh until the stream opens, and [`mcgv_first_positions`] its
+/// positions. 0 on failure (not enough bytes yet, or a bad stream).
+#[no_mangle]
+pub extern "C" fn mcgv_first_frame(handle: u32) -> *const u8 {
+    with(handle, |s| {
+        let first = Decoder::first_frame(Cursor::new(&s.bytes[..]), &DecodeOptions::default())?;
+        let h = &first.header;
+        let a = first.attributes.clone().unwrap_or_default();
+        let names: Vec<String> = a.material_names.iter().map(|n| json_string(n)).collect();
+        let json = format!(
+            "{{\"vertices\":{},\"frames\":{},\"triangles\":{},\"fps\":{},\"codec\":{},\
+             \"uvSets\":{},\"materials\":[{}],\"hasMaterials\":{},\"attributesKnown\":{}}}",
+            h.vertices,
+            h.frames,
+            h.triangles,
+            if h.frame_rate.is_finite() { h.frame_rate } else { 0.0 },
+            json_string(codec_name(h.codec)),
+            a.texcoords.len(),
+            names.join(","),
+            !a.materials.is_empty(),
+            first.attributes.is_some()
+        );
+        s.first = Some(first);
+        s.text = json.into_bytes();
+        Ok(s.text.as_ptr())
+    })
+    .unwrap_or(std::ptr::null())
+}
+
+fn codec_name(id: u8) -> &'static str {
+    mcgv_video::Codec::from_id(id).map_or("unknown", |c| c.name())
+}
+
+/// The positions of the first frame [`mcgv_first_frame`] read: `3 × vertices` floats.
+#[no_mangle]
+pub extern "C" fn mcgv_first_positions(handle: u32) -> *const f32 {
+    with(handle, |s| {
+        let first = s
+            .first
+            .as_ref()
+            .ok_or_else(|| Error::Usage("no first frame read".into()))?;
+        s.floats = first.positions.iter().flatten().copied().collect();
+        Ok(s.floats.as_ptr())
+    })
+    .unwrap_or(std::ptr::null())
 }
 
 /// What the open stream holds, as JSON (see `web/mcgv.js`): its address; [`mcgv_text_len`] its
@@ -253,7 +315,7 @@ fn json_string(s: &str) -> String {
 #[no_mangle]
 pub extern "C" fn mcgv_triangles(handle: u32) -> *const u32 {
     with(handle, |s| {
-        let words: Vec<u32> = opened(s)?.triangles().iter().flatten().copied().collect();
+        let words: Vec<u32> = mesh(s)?.0.iter().flatten().copied().collect();
         s.words = words;
         Ok(s.words.as_ptr())
     })
@@ -265,9 +327,9 @@ pub extern "C" fn mcgv_triangles(handle: u32) -> *const u32 {
 #[no_mangle]
 pub extern "C" fn mcgv_texcoords(handle: u32, set: u32) -> *const f32 {
     with(handle, |s| {
-        let d = opened(s)?;
-        let uv = d
-            .attributes()
+        let uv = mesh(s)?
+            .1
+            .ok_or_else(|| Error::Usage("the attributes have not arrived".into()))?
             .texcoords
             .get(set as usize)
             .ok_or_else(|| Error::Usage(format!("no texture coordinate set {set}")))?;
@@ -282,7 +344,7 @@ pub extern "C" fn mcgv_texcoords(handle: u32, set: u32) -> *const f32 {
 #[no_mangle]
 pub extern "C" fn mcgv_materials(handle: u32) -> *const u32 {
     with(handle, |s| {
-        let materials = opened(s)?.attributes().materials.clone();
+        let materials = mesh(s)?.1.map(|a| a.materials.clone()).unwrap_or_default();
         if materials.is_empty() {
             return Err(Error::Usage("the stream has no materials".into()));
         }
