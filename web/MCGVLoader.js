@@ -511,16 +511,23 @@ export async function decodeWithWebCodecs(stream, info, onPicture) {
   });
   decoder.configure(config);
   const frames = info.frames;
+  const what = `${info.pictures.bitDepth}-bit ${info.codec}`;
   for (let f = 0; f < frames; f++) {
     const { data, key } = stream.codedPicture(f);
-    decoder.decode(new EncodedVideoChunk({ type: key ? 'key' : 'delta', timestamp: f, data }));
+    try {
+      decoder.decode(new EncodedVideoChunk({ type: key ? 'key' : 'delta', timestamp: f, data }));
+    } catch (e) {
+      // Chromium 156 says so of 12-bit AV1 (profile 2), whose configuration it claims to support.
+      decoder.close();
+      throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs refused frame ${f} (${e.message})`);
+    }
   }
   await decoder.flush().catch((e) => {
     failure ??= e;
   });
   decoder.close();
   try {
-    if (failure) throw new MCGVError(`WebCodecs could not decode the ${info.codec} pictures: ${failure.message ?? failure}`);
+    if (failure) throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs failed (${failure.message ?? failure})`);
     for (let f = 0; f < frames; f++) {
       const frame = pending.get(f);
       if (!frame) throw new MCGVError(`WebCodecs gave no picture for frame ${f}`);

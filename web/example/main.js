@@ -8,7 +8,7 @@ import { MCGVLoader, MCGVAnimation } from '../MCGVLoader.js';
 
 const q = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
-const fixedFrame = q.has('frame') ? Number(q.get('frame')) : null;
+let fixedFrame = q.has('frame') ? Number(q.get('frame')) : null;
 const size = q.has('size') ? Number(q.get('size')) : 0;
 if (q.get('ui') === '0') {
   $('panel').style.display = 'none';
@@ -213,7 +213,7 @@ window.mcgvPage = {
   /** Shows fractional frame `x` (stops playing) and draws it now. */
   show(x) {
     playing = false;
-    state.frame = x;
+    fixedFrame = x;
     render();
   },
   canvasDataURL() {
