@@ -75,8 +75,8 @@ web-build:
 web: deps web-build
 	$(CARGO) build --release --quiet -p mcgv-video-cli
 	@test -f web/example/CesiumMan.mcgv || target/release/mcgv-video encode media/CesiumMan.glb -o web/example/CesiumMan.mcgv --quiet
-	@echo "open http://127.0.0.1:$(WEB_PORT)/example/?src=CesiumMan.mcgv (or drop a .mcgv on the page); Ctrl-C stops"
-	node web/serve.mjs web --mount /three=$(NODE_DIR)/node_modules/three --port $(WEB_PORT)
+	@echo "open http://127.0.0.1:$(WEB_PORT)/example/?src=CesiumMan.mcgv&like=/media/CesiumMan.glb (or drop a .mcgv on the page); Ctrl-C stops"
+	node web/serve.mjs web --mount /three=$(NODE_DIR)/node_modules/three --mount /media=media --port $(WEB_PORT)
 
 demo: deps
 	$(CARGO) build --release --quiet

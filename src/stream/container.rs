@@ -460,7 +460,7 @@ impl<R: Read + Seek> ContainerReader<R> {
     ) -> Result<Vec<u8>> {
         let e = self.entry(tag)?;
         let end = offset.checked_add(len);
-        if !end.is_some_and(|end| end <= e.len) {
+        if end.is_none_or(|end| end > e.len) {
             let declared = self.truncated(tag);
             if end.zip(declared).is_some_and(|(end, d)| end <= d) {
                 return Err(Error::Stream(format!(

@@ -187,7 +187,11 @@ pub extern "C" fn mcgv_first_frame(handle: u32) -> *const u8 {
             h.vertices,
             h.frames,
             h.triangles,
-            if h.frame_rate.is_finite() { h.frame_rate } else { 0.0 },
+            if h.frame_rate.is_finite() {
+                h.frame_rate
+            } else {
+                0.0
+            },
             json_string(codec_name(h.codec)),
             a.texcoords.len(),
             names.join(","),
