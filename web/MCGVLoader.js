@@ -39,6 +39,13 @@ export class MCGVLoader extends Loader {
     this.wasmURL = new URL('./mcgv_web.wasm', import.meta.url);
     this.like = null;
     this.decoder = null;
+    this.maxBands = -1;
+  }
+
+  /** Decodes no more than `n` temporal-DCT bands (a preview, as `decode --bands N`); -1: all. */
+  setMaxBands(n) {
+    this.maxBands = n;
+    return this;
   }
 
   /** Where the WebAssembly decoder is (default: mcgv_web.wasm beside this module). */
@@ -204,7 +211,7 @@ export class MCGVAnimation extends EventDispatcher {
       if (!last && this.bytesReceived < this.nextOpenAt) return;
       if (!this.previewed && !last) this.preview();
       try {
-        this.info = s.open({ partial: !last });
+        this.info = s.open({ partial: !last, maxBands: this.loader.maxBands });
       } catch (error) {
         if (last || error.panic) throw error;
         // Not enough yet: try again when a little more has come.
@@ -221,9 +228,10 @@ export class MCGVAnimation extends EventDispatcher {
     const segmented = this.info.segments.length > 1;
     if (this.info.codec === 'tdct' || segmented) {
       // Reopen for more bands (or the whole of a segmented stream) at the next milestone.
-      const complete = this.info.bands && this.bandsDecoded >= this.info.bands.total && !segmented;
+      const wanted = this.loader.maxBands >= 0 ? this.loader.maxBands : Infinity;
+      const complete = this.info.bands && this.bandsDecoded >= Math.min(wanted, this.info.bands.total) && !segmented;
       if (complete || (!last && this.bytesReceived < this.nextOpenAt)) return;
-      this.info = s.open({ partial: !last });
+      this.info = s.open({ partial: !last, maxBands: this.loader.maxBands });
       this.decodeWhatArrived(last);
     } else {
       this.decodeWhatArrived(last);

@@ -60,6 +60,7 @@ const state = {
   firstFrameBytes: 0,
   firstClipBytes: 0,
   firstBands: null,
+  steps: [],
   bandsDecoded: 0,
   bandsTotal: 0,
   framesDecoded: 0,
@@ -120,10 +121,11 @@ function open(source, name) {
   }
   $('error').style.display = 'none';
   $('hint').style.display = 'none';
-  Object.assign(state, { phase: 'loading', error: null, firstFrameBytes: 0, firstClipBytes: 0, firstBands: null });
+  Object.assign(state, { phase: 'loading', error: null, firstFrameBytes: 0, firstClipBytes: 0, firstBands: null, steps: [] });
   framed = false;
   const loader = new MCGVLoader();
   if (like) loader.setLike(like);
+  if (q.has('bands')) loader.setMaxBands(Number(q.get('bands')));
   const onFrames = (a) => {
     if (!mesh || mesh.geometry !== a.geometry) {
       let material = a.materials;
@@ -139,6 +141,9 @@ function open(source, name) {
       framed = true;
     }
     if (state.phase === 'loading' && a.framesDecoded) state.phase = 'playing';
+    // What was drawn when: [bytes received, bands decoded, frames decoded].
+    const step = [a.bytesReceived, a.bandsDecoded, a.framesDecoded];
+    if (String(state.steps.at(-1)) !== String(step)) state.steps.push(step);
     // keep=K (tests): frame K as first drawn from bands, to compare with `decode --bands N`.
     if (q.has('keep') && !state.firstBands && a.bandsDecoded > 0) {
       const k = Number(q.get('keep'));
