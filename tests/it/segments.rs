@@ -219,3 +219,23 @@ fn damaged_segmented_streams_are_errors_not_panics() {
         }
     }
 }
+
+#[test]
+fn a_range_of_frames_decodes_as_decode_all_does() {
+    let mesh = clip(23);
+    let bytes = encode_bytes(&mesh, &options(Codec::Tdct, Some(8)));
+    // A decoder that owns its bytes, movable to another thread.
+    fn is_send<T: Send>(_: &T) {}
+    let mut dec =
+        mcgv_video::Decoder::from_reader(std::io::Cursor::new(bytes), &Default::default()).unwrap();
+    is_send(&dec);
+    let all = dec.decode_all().unwrap();
+    for (a, b) in [(0, 23), (3, 5), (6, 17), (16, 16), (22, 23)] {
+        let frames = dec.decode_frames(a..b, &Silent).unwrap();
+        assert_eq!(frames, all.frames()[a..b], "frames {a}..{b}");
+    }
+    for (a, b) in [(0, 24), (5, 3), (23, 30)] {
+        let err = dec.decode_frames(a..b, &Silent).unwrap_err().to_string();
+        assert!(err.contains(&format!("frames {a}..{b}")), "{err}");
+    }
+}
