@@ -243,7 +243,11 @@ fn a_range_of_frames_decodes_as_decode_all_does() {
 #[test]
 fn encoders_resumed_from_one_analysis_make_the_stream_encode_makes() {
     let mesh = clip(20);
-    for (codec, reorder) in [(Codec::Tdct, true), (Codec::Jpeg, false), (Codec::Mpeg4, false)] {
+    for (codec, reorder) in [
+        (Codec::Tdct, true),
+        (Codec::Jpeg, false),
+        (Codec::Mpeg4, false),
+    ] {
         let opts = EncodeOptions {
             reorder,
             ..options(codec, Some(8))
@@ -276,14 +280,21 @@ fn encoders_resumed_from_one_analysis_make_the_stream_encode_makes() {
         let joined = joiner.finish().unwrap();
         assert_eq!(joined.to_bytes(), whole, "{codec:?}");
         assert_eq!(joined.report.segments, 3);
-        assert_eq!(worker.analysis(), shared, "{codec:?}: the analysis survives the trip");
+        assert_eq!(
+            worker.analysis(),
+            shared,
+            "{codec:?}: the analysis survives the trip"
+        );
         // Other options would code segments that do not join: refused.
         let other = EncodeOptions {
             quality: 61,
             ..opts.clone()
         };
         let refused = SegmentedEncoder::resume(&shared, &other).err().unwrap();
-        assert!(refused.to_string().contains("other encoding options"), "{refused}");
+        assert!(
+            refused.to_string().contains("other encoding options"),
+            "{refused}"
+        );
     }
 }
 
@@ -306,9 +317,15 @@ fn damaged_analysis_bytes_are_errors_not_panics() {
     for at in (0..shared.len()).step_by(3) {
         let mut damaged = shared.clone();
         damaged[at] ^= 0x40;
-        assert!(SegmentedEncoder::resume(&damaged, &opts).is_err(), "byte {at}");
+        assert!(
+            SegmentedEncoder::resume(&damaged, &opts).is_err(),
+            "byte {at}"
+        );
     }
     for len in [0, 3, 8, 20, shared.len() - 1] {
-        assert!(SegmentedEncoder::resume(&shared[..len], &opts).is_err(), "{len} bytes");
+        assert!(
+            SegmentedEncoder::resume(&shared[..len], &opts).is_err(),
+            "{len} bytes"
+        );
     }
 }
