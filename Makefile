@@ -88,7 +88,8 @@ test: deps
 # The Python package: `pip install ./python` builds the release wheel with maturin (PEP 517); here
 # with the virtualenv's maturin, into the virtualenv.
 python: venv
-	$(VENV)/bin/pip install -q --disable-pip-version-check --no-build-isolation --force-reinstall --no-deps ./python
+	PATH="$(abspath $(VENV))/bin:$$PATH" $(VENV)/bin/pip install -q --disable-pip-version-check \
+		--no-build-isolation --force-reinstall --no-deps ./python
 
 # The same package built in the dev profile for the tests: the library at the tests' optimisation
 # (its dependencies optimised, shared with `cargo test`), so it builds in a fraction of the time.
@@ -105,7 +106,8 @@ CLUSTER_VERTICES ?= 20000
 CLUSTER_FRAMES ?= 1000
 CLUSTER_SEGMENT ?= 125
 cluster-demo: python
-	$(CARGO) build --release --quiet -p mcgv-video-cli --example long_clip
+	$(CARGO) build --release --quiet -p mcgv-video-cli
+	$(CARGO) build --release --quiet --example long_clip
 	target/release/examples/long_clip demo-out/cluster/clip $(CLUSTER_VERTICES) $(CLUSTER_FRAMES)
 	$(PY) -m mcgv_video.cluster --clip demo-out/cluster/clip/cloth.pc2 \
 		--segment-frames $(CLUSTER_SEGMENT) --compare-with target/release/mcgv-video \
