@@ -80,6 +80,7 @@ def encode_segments(
     *,
     segment_frames: int = 128,
     threads: Optional[int] = None,
+    analysis_threads: Optional[int] = None,
     retries: int = 1,
     read: Optional[dict] = None,
     **options: Any,
@@ -87,8 +88,11 @@ def encode_segments(
     """Encodes the clip at ``path`` in segments of ``segment_frames`` frames on ``client``'s
     cluster: the bytes ``encode`` (and ``mcgv-video encode --segment-frames N``) gives with the
     same options. ``read`` holds ``FrameSource``'s options (``clip``, ``fps``, ``base``);
-    ``threads`` is each task's thread count (default: one per core of its worker)."""
-    path = os.fspath(path)
+    ``threads`` is each segment task's thread count (default: one per core of its worker);
+    ``analysis_threads`` the analysis task's (default: one per core — it runs alone, before any
+    segment can start, and is most of the work of a clip of a few segments)."""
+    # Absolute: a worker's working folder is not the caller's (the files are on a shared folder).
+    path = os.path.abspath(os.fspath(path))
     read = dict(read or {})
     frames = client.submit(_frame_count, path, read, pure=False).result()
     options = dict(options, segment_frames=segment_frames)
@@ -98,7 +102,7 @@ def encode_segments(
         future = client.submit(_encode_whole, path, read, threads, options, key=f"mcgv-whole-{job}", retries=retries)
         return future.result()
     length = segment_frames
-    analysis = client.submit(_analyse, path, length, read, threads, options, key=f"mcgv-analysis-{job}",
+    analysis = client.submit(_analyse, path, length, read, analysis_threads, options, key=f"mcgv-analysis-{job}",
                              retries=retries)
     segments = [
         client.submit(
@@ -167,12 +171,12 @@ def encode_batch(
     retries: int = 1,
     **options: Any,
 ) -> list[dict]:
-    """Encodes each file as a task; one row per file, in the order given: ``file``, ``frames``,
+    """Encodes each file as a task; one row per file, in the order given: ``file`` (absolute), ``frames``,
     ``vertices``, ``bytes``, ``bpvf``, ``rmse`` (a fraction of the bounding-box diagonal),
     ``seconds``, and ``error`` (the exception a file failed with, else ``None``)."""
-    out = None if out_dir is None else os.fspath(out_dir)
+    out = None if out_dir is None else os.path.abspath(os.fspath(out_dir))
     futures = [
-        client.submit(_encode_file, os.fspath(p), out, threads, options, key=f"mcgv-file-{i:05d}-{uuid.uuid4().hex[:8]}",
+        client.submit(_encode_file, os.path.abspath(os.fspath(p)), out, threads, options, key=f"mcgv-file-{i:05d}-{uuid.uuid4().hex[:8]}",
                       retries=retries)
         for i, p in enumerate(paths)
     ]
