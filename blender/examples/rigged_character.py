@@ -121,3 +121,8 @@ def main(out: Path) -> None:
 
 if __name__ == "__main__":
     main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path(tempfile.mkdtemp(prefix="mcgv-blender-")))
+    # bpy 4.2 from PyPI crashes (SIGSEGV) at interpreter exit once its glTF importer has run, with
+    # or without this add-on (`import_scene.gltf` then exit is enough): leave before that teardown.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
