@@ -269,4 +269,9 @@ def _main(argv: Optional[Sequence[str]] = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(_main())
+    # Run with -m this file is __main__, whose functions cloudpickle ships to the workers by value,
+    # globals and all (the encoders' lock cannot be pickled); the imported module's are shipped
+    # by reference, as when a program imports mcgv_video.cluster.
+    from mcgv_video.cluster import _main as main
+
+    sys.exit(main())

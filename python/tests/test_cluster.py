@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
+import sys
 import threading
 import time
 
@@ -78,6 +80,16 @@ def test_a_killed_worker_s_segment_is_retried_and_the_stream_is_the_same(tmp_pat
     # The segment the dead worker was coding went to processing a second time.
     runs = client.run_on_scheduler(_processing_runs, keys=killed)
     assert any(n >= 2 for n in runs.values()), runs
+
+
+def test_the_demo_run_as_a_module_gives_the_cli_s_bytes(cli, clip):
+    # With -m the module is __main__, whose functions would travel to the workers by value,
+    # with the lock they use, which does not pickle: the tasks must be the imported module's.
+    command = [sys.executable, "-m", "mcgv_video.cluster", "--workers", "2", "--clip", str(clip),
+               "--segment-frames", str(SEGMENT), "--compare-with", cli]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "same bytes: yes" in result.stdout, result.stdout
 
 
 def test_a_batch_gives_one_row_per_file_and_a_bad_file_its_error(tmp_path, client):
