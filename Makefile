@@ -9,7 +9,12 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT_PACKAGES := pkg-config clang libclang-dev libavcodec-dev libavformat-dev libavutil-dev \
 	libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev python3-venv openimageio-tools time \
 	fonts-dejavu-core chromium
-PY_PACKAGES := pymeshlab DracoPy numpy zstandard constriction brotli
+# The bench's reference tools, then what the Python package needs to build (maturin) and be tested
+# (pytest), and its cluster helpers (Dask).
+PY_PACKAGES := pymeshlab DracoPy numpy zstandard constriction brotli maturin pytest 'dask[distributed]'
+# bpy from PyPI for the Blender add-on's test: a 519 MB wheel, for CPython 3.11 only, installed
+# into the same virtualenv by its own target (python3 must be 3.11, as on Debian 12).
+BPY := bpy==4.2.0
 # Node tools of the bench's glTF peers (gltfpack, @gltf-transform, meshoptimizer) and of the tests
 # (gltf-validator, three), pinned by its lockfile.
 NODE_DIR := scripts/node
@@ -18,7 +23,7 @@ NODE_DIR := scripts/node
 WEB_WASM := target/wasm32-unknown-unknown/web/mcgv_web.wasm
 WEB_PORT ?= 8080
 
-.PHONY: help deps apt-deps venv node-deps web-deps web-build web demo test bench fuzz install clean
+.PHONY: help deps apt-deps venv bpy node-deps web-deps web-build web demo test python python-dev cluster-demo bench fuzz install clean
 PREFIX ?= /usr/local
 
 help:
@@ -28,6 +33,8 @@ help:
 	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
 	@echo "make install  the binary, shell completions and man page under PREFIX (default /usr/local)"
 	@echo "make web   build the WebAssembly decoder and serve the player (web/example/) on localhost:WEB_PORT (8080)"
+	@echo "make python  build the Python package (release wheel) and install it into .venv"
+	@echo "make cluster-demo  a long clip's segments and a batch of files on a local Dask cluster"
 	@echo "make deps   install Debian packages, the reference-tool virtualenv and the bench's Node tools (done by demo/test)"
 
 deps: apt-deps venv node-deps web-deps
@@ -46,6 +53,14 @@ venv: $(VENV)/.done
 $(VENV)/.done: Makefile
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install -q --disable-pip-version-check $(PY_PACKAGES)
+	touch $@
+
+bpy: $(VENV)/.bpy-done
+
+$(VENV)/.bpy-done: $(VENV)/.done
+	@$(PY) -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' || { \
+		echo "$(BPY) needs CPython 3.11; $(PY) is $$($(PY) -V)"; exit 1; }
+	$(VENV)/bin/pip install -q --disable-pip-version-check $(BPY)
 	touch $@
 
 # Debian's nodejs and npm only when there is no node at all; then the lockfile's packages into
@@ -94,6 +109,36 @@ test: deps
 	$(PY) scripts/test_peers.py
 	$(MAKE) --no-print-directory web-build
 	MCGV_BIN=target/debug/mcgv-video node --test web/test/
+	$(MAKE) --no-print-directory python-dev bpy
+	MCGV_CLI=$(abspath target/debug/mcgv-video) $(PY) -m pytest -q -p no:cacheprovider python/tests blender/tests
+
+# The Python package: `pip install ./python` builds the release wheel with maturin (PEP 517); here
+# with the virtualenv's maturin, into the virtualenv.
+python: venv
+	PATH="$(abspath $(VENV))/bin:$$PATH" $(VENV)/bin/pip install -q --disable-pip-version-check \
+		--no-build-isolation --force-reinstall --no-deps ./python
+
+# The same package built in the dev profile for the tests: the library at the tests' optimisation
+# (its dependencies optimised, shared with `cargo test`), so it builds in a fraction of the time.
+python-dev: venv
+	rm -rf target/wheels-dev
+	$(VENV)/bin/maturin build --quiet --profile dev -m python/Cargo.toml -o target/wheels-dev
+	$(VENV)/bin/pip install -q --disable-pip-version-check --force-reinstall --no-deps target/wheels-dev/*.whl
+
+# A long generated clip (a cloth, CLUSTER_VERTICES × CLUSTER_FRAMES) coded in CLUSTER_SEGMENT-frame
+# segments on a local Dask cluster of two worker processes and compared with `mcgv-video encode`,
+# then media/ coded as a batch, one task per file. MCGV_SCHEDULER=tcp://HOST:8786 uses that
+# cluster instead (the workers must see the files: run it from a shared folder).
+CLUSTER_VERTICES ?= 20000
+CLUSTER_FRAMES ?= 1000
+CLUSTER_SEGMENT ?= 125
+cluster-demo: python
+	$(CARGO) build --release --quiet -p mcgv-video-cli
+	$(CARGO) build --release --quiet --example long_clip
+	target/release/examples/long_clip demo-out/cluster/clip $(CLUSTER_VERTICES) $(CLUSTER_FRAMES)
+	$(PY) -m mcgv_video.cluster --clip demo-out/cluster/clip/cloth.pc2 \
+		--segment-frames $(CLUSTER_SEGMENT) --compare-with target/release/mcgv-video \
+		--batch media --out demo-out/cluster/batch
 
 bench: deps
 	$(CARGO) build --release --quiet

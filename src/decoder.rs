@@ -96,8 +96,10 @@ impl<'a> Decoder<Cursor<&'a [u8]>> {
 }
 
 impl<R: Read + Seek> Decoder<R> {
-    /// Opens a stream from any seekable source (bytes a `Cursor` holds, a file) with decoding
-    /// options; with [`DecodeOptions::partial`], the start of a stream still arriving.
+    /// Opens a stream from any seekable source — a file, or a [`Cursor`] over bytes the decoder
+    /// then owns (`Cursor<Vec<u8>>`, for a decoder that outlives the caller's buffer) — with
+    /// decoding options; with [`DecodeOptions::partial`], the start of a stream still arriving. A
+    /// decoder over a reader that is `Send` is `Send`.
     pub fn from_reader(source: R, options: &DecodeOptions) -> Result<Self> {
         let reader = match options.partial {
             true => ContainerReader::partial(source)?,
@@ -448,6 +450,34 @@ impl<R: Read + Seek> Decoder<R> {
         open.residuals
             .add_frame(&mut self.reader, local, &mut out)?;
         finite(f, &out)?;
+        Ok(out)
+    }
+
+    /// Decodes frames `frames.start` to `frames.end - 1`, in order. Each temporal segment they
+    /// fall in is decoded whole, as [`Decoder::decode_all`] decodes it, so the frames are
+    /// `decode_all`'s, value for value; a range past the last frame is an error.
+    pub fn decode_frames(
+        &mut self,
+        frames: Range<usize>,
+        progress: &dyn Progress,
+    ) -> Result<Vec<Vec<Point>>> {
+        let count = self.header.frames as usize;
+        if frames.start > frames.end || frames.end > count {
+            return Err(Error::Usage(format!(
+                "frames {}..{}: the stream has frames 0..{count}",
+                frames.start, frames.end
+            )));
+        }
+        let mut out = Vec::with_capacity(frames.len());
+        for (s, segment) in self.segments.clone().into_iter().enumerate() {
+            if segment.end <= frames.start || segment.start >= frames.end {
+                continue;
+            }
+            let skip = frames.start.saturating_sub(segment.start);
+            let take = frames.end.min(segment.end) - segment.start - skip;
+            let decoded = self.decode_segment(s, progress)?;
+            out.extend(decoded.into_iter().skip(skip).take(take));
+        }
         Ok(out)
     }
 

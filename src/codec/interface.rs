@@ -82,7 +82,9 @@ pub(crate) struct StreamLayout<'a> {
 }
 
 /// The decoding half of a residual codec: adds the coded residuals to the decoder's prediction.
-pub(crate) trait ResidualDecoder<R> {
+/// `Send`, so that a [`Decoder`](crate::Decoder) can move to another thread (a binding that
+/// releases its interpreter's lock while decoding does).
+pub(crate) trait ResidualDecoder<R>: Send {
     /// Adds frame `f`'s residuals to its prediction, reading no more of the stream than `f` needs.
     fn add_frame(
         &mut self,

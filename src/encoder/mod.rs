@@ -30,7 +30,9 @@ pub use options::{
     EncodeOptions, PredictorChoice, Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS,
     DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
-pub use segments::{analysis_frames, encode_source, CodedSegment, SegmentedEncoder};
+pub use segments::{
+    analysis_clip, analysis_frames, encode_source, segment_ranges, CodedSegment, SegmentedEncoder,
+};
 
 use crate::codec::{Codec, RatePlan, ResidualInput};
 use crate::error::Result;

@@ -260,6 +260,12 @@ impl EncodeOptions {
     }
 
     fn check_ranges(&self) -> Result<()> {
+        if !(1..=100).contains(&self.quality) {
+            return Err(Error::option(
+                "quality",
+                format!("must be between 1 and 100, not {}", self.quality),
+            ));
+        }
         if self.segment_frames == Some(0) {
             return Err(Error::option("segment_frames", "must be at least 1"));
         }
@@ -328,5 +334,37 @@ impl EncodeOptions {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quality_outside_1_to_100_is_refused_by_its_name() {
+        // A triangle is all `check` needs of the mesh.
+        let mesh = AnimatedMesh::new(
+            vec![[0, 1, 2]],
+            vec![vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]],
+        );
+        let mesh = mesh.unwrap();
+        for quality in [0, 101, 255] {
+            let opts = EncodeOptions {
+                quality,
+                ..EncodeOptions::default()
+            };
+            match opts.check(&mesh) {
+                Err(Error::InvalidOption { option, .. }) => assert_eq!(option, "quality"),
+                other => panic!("quality {quality}: {other:?}"),
+            }
+        }
+        for quality in [1, 50, 100] {
+            let opts = EncodeOptions {
+                quality,
+                ..EncodeOptions::default()
+            };
+            assert!(opts.check(&mesh).is_ok(), "quality {quality}");
+        }
     }
 }

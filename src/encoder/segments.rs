@@ -14,14 +14,16 @@
 //! A program can feed segments one by one ([`SegmentedEncoder::start`], [`SegmentedEncoder::push`],
 //! [`SegmentedEncoder::finish`]), e.g. from a reader that never holds the whole clip.
 
-use super::{EncodeOptions, EncodeReport, Encoded, MotionModel, PredictorChoice};
+use super::analysis::SegmentationReport;
+use super::{EncodeOptions, EncodeReport, Encoded, MotionModel, PredictorChoice, Segmentation};
 use crate::codec::{RatePlan, ResidualInput};
 use crate::decoder::Decoder;
 use crate::error::{Error, Result};
 use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::{AnimatedMesh, FrameSource, Point, Triangle};
-use crate::motion::{AffineTrack, Partition, SkinningWeights};
+use crate::motion::{AffineTrack, Partition, PredictorKind, SkinningWeights};
 use crate::progress::Progress;
+use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::container::{ContainerReader, ContainerWriter, Part, Tag};
 use crate::stream::header::Header;
 use crate::stream::segments::SegmentStart;
@@ -33,16 +35,13 @@ use std::time::Instant;
 /// An encoding in progress, one segment at a time.
 pub struct SegmentedEncoder {
     opts: EncodeOptions,
-    /// Frames per segment; every segment but the last has this many.
-    length: usize,
+    /// What [`SegmentedEncoder::start`] decided on the analysis clip, as
+    /// [`SegmentedEncoder::analysis`] ships it.
+    analysis: Analysis,
     /// What the decoder reads of the analysis clip's stream, which every segment is predicted from.
     reference: Vec<Point>,
-    /// The connectivity in the input's vertex order, which pushed frames come in.
-    input_triangles: Vec<Triangle>,
     partition: Partition,
     weights: Option<SkinningWeights>,
-    /// First-frame coder's vertex order (stream index → input index), when it reordered.
-    permutation: Option<Vec<u32>>,
     /// Every step and codec setting, resolved on the first frame (the whole clip's).
     plan: RatePlan,
     atlas: AtlasCache,
@@ -51,8 +50,177 @@ pub struct SegmentedEncoder {
     segments: Vec<Vec<Part>>,
     frames: usize,
     report: EncodeReport,
-    model: MotionModel,
     clock: Instant,
+}
+
+/// What [`SegmentedEncoder::start`] decides on the analysis clip and every segment is coded
+/// from: the analysis clip's stream, and what a decoder of it cannot tell.
+#[derive(Debug, Clone, PartialEq)]
+struct Analysis {
+    /// The analysis clip encoded as a clip of its own: its first frame, partition, weights and
+    /// codec set-up are the whole stream's.
+    stream: Vec<u8>,
+    /// Frames per segment; every segment but the last has this many.
+    length: usize,
+    /// The first frame's bounding-box diagonal, which every step is a fraction of.
+    diagonal: f64,
+    /// The connectivity in the input's vertex order, which segments' frames come in.
+    triangles: Vec<Triangle>,
+    /// First-frame coder's vertex order (stream index → input index), when it reordered.
+    permutation: Option<Vec<u32>>,
+    /// The motion model the analysis kept.
+    model: MotionModel,
+    /// A checksum of the options the analysis was made with: a segment coded with others would
+    /// not join into a valid stream.
+    options: u32,
+}
+
+/// The first bytes of [`SegmentedEncoder::analysis`]'s bytes, with the format's version.
+const ANALYSIS_MAGIC: &[u8; 8] = b"MCGVANL1";
+
+impl Analysis {
+    fn to_bytes(&self) -> Vec<u8> {
+        let mut w = ByteWriter::new();
+        w.raw(ANALYSIS_MAGIC)
+            .u32(self.options)
+            .u32(self.length as u32)
+            .u64(self.diagonal.to_bits())
+            .u8(match self.model.predictor {
+                PredictorKind::Affine => 0,
+                PredictorKind::Skinning => 1,
+            });
+        match self.model.segmentation {
+            Segmentation::KMeans => w.u8(0).u64(0),
+            Segmentation::Decimation { e0 } => w.u8(1).u64(e0.to_bits()),
+        };
+        w.u32(self.model.clusters as u32);
+        w.u8(u8::from(self.permutation.is_some()));
+        if let Some(order) = &self.permutation {
+            w.u32(order.len() as u32);
+            for &v in order {
+                w.u32(v);
+            }
+        }
+        w.u32(self.triangles.len() as u32);
+        for &v in self.triangles.iter().flatten() {
+            w.u32(v);
+        }
+        w.u64(self.stream.len() as u64).raw(&self.stream);
+        let mut bytes = w.into_bytes();
+        let crc = crc32fast::hash(&bytes);
+        bytes.extend_from_slice(&crc.to_le_bytes());
+        bytes
+    }
+
+    /// Reads [`Analysis::to_bytes`]'s bytes, checking their checksum and every count against
+    /// the bytes that must hold it before allocating.
+    fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let damaged = |what: &str| Error::Stream(format!("segment analysis: {what}"));
+        let Some((body, crc)) = bytes.split_last_chunk::<4>() else {
+            return Err(damaged("truncated"));
+        };
+        if !body.starts_with(ANALYSIS_MAGIC) {
+            return Err(damaged("not the bytes of SegmentedEncoder::analysis"));
+        }
+        if crc32fast::hash(body) != u32::from_le_bytes(*crc) {
+            return Err(damaged("checksum mismatch (damaged bytes)"));
+        }
+        let mut r = ByteReader::new(&body[ANALYSIS_MAGIC.len()..], "segment analysis");
+        let options = r.u32()?;
+        let length = r.u32()? as usize;
+        let diagonal = f64::from_bits(r.u64()?);
+        let predictor = match r.u8()? {
+            0 => PredictorKind::Affine,
+            1 => PredictorKind::Skinning,
+            p => return Err(damaged(&format!("unknown predictor {p}"))),
+        };
+        let segmentation = match (r.u8()?, f64::from_bits(r.u64()?)) {
+            (0, _) => Segmentation::KMeans,
+            (1, e0) => Segmentation::Decimation { e0 },
+            (s, _) => return Err(damaged(&format!("unknown segmentation {s}"))),
+        };
+        let clusters = r.u32()? as usize;
+        let u32s = |r: &mut ByteReader, n: usize| -> Result<Vec<u32>> {
+            let raw = r.take(n.checked_mul(4).ok_or_else(|| damaged("count overflows"))?)?;
+            Ok(raw
+                .chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect())
+        };
+        let permutation = match r.u8()? {
+            0 => None,
+            _ => {
+                let n = r.u32()? as usize;
+                Some(u32s(&mut r, n)?)
+            }
+        };
+        let n = r.u32()? as usize;
+        let corners = u32s(&mut r, n.checked_mul(3).ok_or_else(|| damaged("count overflows"))?)?;
+        let triangles = corners.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let len = usize::try_from(r.u64()?).map_err(|_| damaged("stream length"))?;
+        let stream = r.take(len)?.to_vec();
+        r.finish()?;
+        if length == 0 || !(diagonal.is_finite() && diagonal >= 0.0) {
+            return Err(damaged("segment length or diagonal out of range"));
+        }
+        Ok(Self {
+            stream,
+            length,
+            diagonal,
+            triangles,
+            permutation,
+            model: MotionModel {
+                predictor,
+                segmentation,
+                clusters,
+            },
+            options,
+        })
+    }
+}
+
+/// The report of a resumed encoder: the stream's figures are filled in by `finish`; the
+/// analysis' choices and timings stayed with the encoder that made it.
+fn resumed_report(header: &Header, analysis: &Analysis, opts: &EncodeOptions) -> EncodeReport {
+    let model = analysis.model;
+    EncodeReport {
+        header: header.clone(),
+        codec: opts.codec.codec(),
+        parts: Vec::new(),
+        bytes: 0,
+        bpvf: 0.0,
+        charts: 0,
+        packing_efficiency: 0.0,
+        moved_vertices: 0,
+        l2_stretch: 0.0,
+        stage_seconds: Vec::new(),
+        segmentation: SegmentationReport {
+            method: model.segmentation.name(),
+            clusters: header.clusters as usize,
+            seconds: 0.0,
+            e0: match model.segmentation {
+                Segmentation::Decimation { e0 } => Some(e0),
+                Segmentation::KMeans => None,
+            },
+            error: None,
+            components: None,
+        },
+        choice: None,
+        first_frame_trials: Vec::new(),
+        segments: 0,
+        permutation: analysis.permutation.clone(),
+    }
+}
+
+/// A checksum of the options that shape a segment: all but `parallel_segments` (how many are
+/// coded at once) and `segment_frames` (the analysis holds the length).
+fn options_checksum(opts: &EncodeOptions) -> u32 {
+    let shaping = EncodeOptions {
+        parallel_segments: 1,
+        segment_frames: None,
+        ..opts.clone()
+    };
+    crc32fast::hash(format!("{shaping:?}").as_bytes())
 }
 
 impl SegmentedEncoder {
@@ -79,41 +247,106 @@ impl SegmentedEncoder {
             ..opts.clone()
         };
         let encoded = super::encode_with_progress(analysis, &whole, &NoTotal(progress))?;
-        let bytes = encoded.to_bytes();
-        let decoder = Decoder::new(&bytes)?;
+        let shared = Analysis {
+            stream: encoded.to_bytes(),
+            length,
+            diagonal: analysis.bbox_diagonal(),
+            triangles: analysis.triangles().to_vec(),
+            permutation: encoded.report.permutation.clone(),
+            model: encoded.model,
+            options: options_checksum(opts),
+        };
+        Self::from_analysis(shared, opts, Some(encoded.report), clock)
+    }
+
+    /// The analysis [`SegmentedEncoder::start`] made, as bytes (the analysis clip's stream and
+    /// what its decoder cannot tell; about the size of that stream plus 12 bytes a triangle):
+    /// [`SegmentedEncoder::resume`] makes an encoder from them on another thread, process or
+    /// machine without redoing the analysis, which costs more than coding a segment.
+    pub fn analysis(&self) -> Vec<u8> {
+        self.analysis.to_bytes()
+    }
+
+    /// An encoder from [`SegmentedEncoder::analysis`]'s bytes and the options the analysis was
+    /// made with (another `parallel_segments` is fine; other options are an error): it codes
+    /// segments, and adds and finishes them, as the encoder that ran [`SegmentedEncoder::start`]
+    /// does, byte for byte. Its [`Encoded::report`] holds the stream's figures but not the
+    /// analysis' choices and timings, which stay with that encoder.
+    pub fn resume(analysis: &[u8], opts: &EncodeOptions) -> Result<Self> {
+        let analysis = Analysis::from_bytes(analysis)?;
+        if analysis.options != options_checksum(opts) {
+            return Err(Error::Usage(
+                "the analysis was made with other encoding options: resume with the same".into(),
+            ));
+        }
+        Self::from_analysis(analysis, opts, None, Instant::now())
+    }
+
+    /// The encoder of an analysis: everything but the analysis' own figures (`report`, when it
+    /// was just made) is read from the analysis clip's stream as the decoder reads it, so a
+    /// started and a resumed encoder agree.
+    fn from_analysis(
+        analysis: Analysis,
+        opts: &EncodeOptions,
+        report: Option<EncodeReport>,
+        clock: Instant,
+    ) -> Result<Self> {
+        let decoder = Decoder::new(&analysis.stream)?;
         let header = decoder.header().clone();
-        let plan = opts.plan(analysis.bbox_diagonal())?;
+        let report = report.unwrap_or_else(|| resumed_report(&header, &analysis, opts));
+        let vertices = header.vertices as usize;
+        let consistent = analysis.triangles.len() == header.triangles as usize
+            && analysis.triangles.iter().flatten().all(|&v| (v as usize) < vertices)
+            && analysis.permutation.as_ref().is_none_or(|p| p.len() == vertices)
+            && header.predictor == analysis.model.predictor;
+        if !consistent {
+            return Err(Error::Stream(
+                "segment analysis: its connectivity or vertex order does not fit its stream".into(),
+            ));
+        }
+        let plan = opts.plan(analysis.diagonal)?;
         // Every segment repeats the analysis clip's choices instead of making its own.
         let opts = EncodeOptions {
             predictor: PredictorChoice::Fixed(header.predictor),
             first_frame_bits: Some(header.first_frame_bits),
-            segment_frames: Some(length),
+            segment_frames: Some(analysis.length),
             ..opts.clone()
         };
         // The analysis clip's own affine maps and residuals are not the clip's: dropped.
-        let shared = encoded
-            .container
-            .into_parts()
+        let mut reader = ContainerReader::new(std::io::Cursor::new(&analysis.stream[..]))?;
+        let shared = reader
+            .parts()
+            .to_vec()
             .into_iter()
-            .filter(|p| !p.tag.per_segment() && p.tag != Tag::HEADER)
-            .collect();
+            .filter(|e| !e.tag.per_segment() && e.tag != Tag::HEADER)
+            .map(|e| {
+                Ok(Part {
+                    tag: e.tag,
+                    bytes: reader.payload(&e)?,
+                    checksum: e.checksum,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let (reference, partition, weights) = (
+            decoder.reference().to_vec(),
+            decoder.partition().clone(),
+            decoder.weights().cloned(),
+        );
+        drop(decoder);
         Ok(Self {
             opts,
-            length,
-            reference: decoder.reference().to_vec(),
-            input_triangles: analysis.triangles().to_vec(),
-            partition: decoder.partition().clone(),
-            weights: decoder.weights().cloned(),
-            permutation: encoded.report.permutation.clone(),
+            reference,
+            partition,
+            weights,
             plan,
             atlas: AtlasCache::default(),
             header,
             shared,
             segments: Vec::new(),
             frames: 0,
-            report: encoded.report,
-            model: encoded.model,
+            report,
             clock,
+            analysis,
         })
     }
 
@@ -140,16 +373,16 @@ impl SegmentedEncoder {
         frames: Vec<Vec<Point>>,
         progress: &dyn Progress,
     ) -> Result<CodedSegment> {
-        if frames.is_empty() || frames.len() > self.length {
+        if frames.is_empty() || frames.len() > self.analysis.length {
             return Err(Error::Usage(format!(
                 "a segment holds 1 to {} frames, not {}",
-                self.length,
+                self.analysis.length,
                 frames.len()
             )));
         }
         let range = first_frame..first_frame + frames.len();
-        let mut clip = AnimatedMesh::new(self.input_triangles.clone(), frames)?;
-        if let Some(order) = &self.permutation {
+        let mut clip = AnimatedMesh::new(self.analysis.triangles.clone(), frames)?;
+        if let Some(order) = &self.analysis.permutation {
             clip = clip.permuted(order)?;
         }
         let parts = self.code(&clip, &range, progress)?;
@@ -203,7 +436,7 @@ impl SegmentedEncoder {
         Ok(Encoded {
             container,
             report,
-            model: self.model,
+            model: self.analysis.model,
             partition: self.partition,
         })
     }
@@ -276,6 +509,39 @@ pub fn analysis_frames(frames: usize, length: usize) -> Vec<usize> {
     (0..n).map(|i| i * (frames - 1) / (n - 1)).collect()
 }
 
+/// The segments of a clip of `frames` frames cut into runs of `length` (the last one shorter):
+/// the ranges [`SegmentedEncoder::code_segment`] codes and [`SegmentedEncoder::add`] takes, in
+/// order.
+pub fn segment_ranges(frames: usize, length: usize) -> Vec<Range<usize>> {
+    crate::stream::segments::split(frames, length)
+}
+
+/// The analysis clip of `source` cut into segments of `length` frames: its
+/// [`analysis_frames`], with the first frame's connectivity, attributes and frame rate — what
+/// [`SegmentedEncoder::start`] takes, as [`encode_source`] builds it (so that segments coded
+/// elsewhere from it join into the stream `encode_source` writes).
+pub fn analysis_clip(source: &mut FrameSource, length: usize) -> Result<AnimatedMesh> {
+    let (frames, first) = (source.frame_count(), source.first().clone());
+    spread_clip(&first, frames, length, |range| source.read(range))
+}
+
+/// The analysis clip of a clip of `frames` frames read by ranges with `read`, one frame at a
+/// time; `first` gives the connectivity, attributes and frame rate.
+fn spread_clip(
+    first: &AnimatedMesh,
+    frames: usize,
+    length: usize,
+    mut read: impl FnMut(Range<usize>) -> Result<Vec<Vec<Point>>>,
+) -> Result<AnimatedMesh> {
+    let mut spread = Vec::with_capacity(length);
+    for f in analysis_frames(frames, length) {
+        spread.extend(read(f..f + 1)?);
+    }
+    AnimatedMesh::new(first.triangles().to_vec(), spread)?
+        .with_attributes(first.attributes().clone())
+        .map(|mesh| mesh.with_frame_rate(first.frame_rate()))
+}
+
 /// Encodes `mesh` in segments of `length` frames.
 pub fn encode(
     mesh: &AnimatedMesh,
@@ -318,18 +584,12 @@ fn encode_runs(
     progress: &dyn Progress,
     mut read: impl FnMut(Range<usize>) -> Result<Vec<Vec<Point>>>,
 ) -> Result<Encoded> {
-    let mut spread = Vec::with_capacity(length);
-    for f in analysis_frames(frames, length) {
-        spread.extend(read(f..f + 1)?);
-    }
-    let analysis = AnimatedMesh::new(first.triangles().to_vec(), spread)?
-        .with_attributes(first.attributes().clone())?
-        .with_frame_rate(first.frame_rate());
+    let analysis = spread_clip(first, frames, length, &mut read)?;
     progress.total(frames as u64);
     let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
     drop(analysis);
     progress.stage("segments");
-    let ranges = crate::stream::segments::split(frames, length);
+    let ranges = segment_ranges(frames, length);
     for batch in ranges.chunks(opts.parallel_segments.max(1)) {
         let runs = batch
             .iter()

@@ -219,3 +219,113 @@ fn damaged_segmented_streams_are_errors_not_panics() {
         }
     }
 }
+
+#[test]
+fn a_range_of_frames_decodes_as_decode_all_does() {
+    let mesh = clip(23);
+    let bytes = encode_bytes(&mesh, &options(Codec::Tdct, Some(8)));
+    // A decoder that owns its bytes, movable to another thread.
+    fn is_send<T: Send>(_: &T) {}
+    let mut dec =
+        mcgv_video::Decoder::from_reader(std::io::Cursor::new(bytes), &Default::default()).unwrap();
+    is_send(&dec);
+    let all = dec.decode_all().unwrap();
+    for (a, b) in [(0, 23), (3, 5), (6, 17), (16, 16), (22, 23)] {
+        let frames = dec.decode_frames(a..b, &Silent).unwrap();
+        assert_eq!(frames, all.frames()[a..b], "frames {a}..{b}");
+    }
+    for (a, b) in [(0, 24), (5, 3), (23, 30)] {
+        let err = dec.decode_frames(a..b, &Silent).unwrap_err().to_string();
+        assert!(err.contains(&format!("frames {a}..{b}")), "{err}");
+    }
+}
+
+#[test]
+fn encoders_resumed_from_one_analysis_make_the_stream_encode_makes() {
+    let mesh = clip(20);
+    for (codec, reorder) in [
+        (Codec::Tdct, true),
+        (Codec::Jpeg, false),
+        (Codec::Mpeg4, false),
+    ] {
+        let opts = EncodeOptions {
+            reorder,
+            ..options(codec, Some(8))
+        };
+        let whole = encode(&mesh, &opts).unwrap().to_bytes();
+        let spread = analysis_frames(20, 8);
+        let analysis = AnimatedMesh::new(
+            mesh.triangles().to_vec(),
+            spread.iter().map(|&f| mesh.frame(f).to_vec()).collect(),
+        )
+        .unwrap();
+        let started = SegmentedEncoder::start(&analysis, &opts, 8, &Silent).unwrap();
+        let shared = started.analysis();
+        // Workers resume from the bytes (another `parallel_segments` is fine) and code segments
+        // out of order; a joiner resumed alike adds them in order.
+        let threads = EncodeOptions {
+            parallel_segments: 4,
+            ..opts.clone()
+        };
+        let worker = SegmentedEncoder::resume(&shared, &threads).unwrap();
+        let coded: Vec<CodedSegment> = [16..20, 0..8, 8..16]
+            .into_iter()
+            .map(|r| worker.code_segment(r.start, mesh.frames()[r].to_vec(), &Silent))
+            .collect::<Result<_, _>>()
+            .unwrap();
+        let mut joiner = SegmentedEncoder::resume(&shared, &opts).unwrap();
+        for s in [1, 2, 0] {
+            joiner.add(coded[s].clone()).unwrap();
+        }
+        let joined = joiner.finish().unwrap();
+        assert_eq!(joined.to_bytes(), whole, "{codec:?}");
+        assert_eq!(joined.report.segments, 3);
+        assert_eq!(
+            worker.analysis(),
+            shared,
+            "{codec:?}: the analysis survives the trip"
+        );
+        // Other options would code segments that do not join: refused.
+        let other = EncodeOptions {
+            quality: 61,
+            ..opts.clone()
+        };
+        let refused = SegmentedEncoder::resume(&shared, &other).err().unwrap();
+        assert!(
+            refused.to_string().contains("other encoding options"),
+            "{refused}"
+        );
+    }
+}
+
+#[test]
+fn damaged_analysis_bytes_are_errors_not_panics() {
+    let mesh = clip(12);
+    let opts = EncodeOptions {
+        reorder: true,
+        ..options(Codec::Tdct, Some(6))
+    };
+    let spread = analysis_frames(12, 6);
+    let analysis = AnimatedMesh::new(
+        mesh.triangles().to_vec(),
+        spread.iter().map(|&f| mesh.frame(f).to_vec()).collect(),
+    )
+    .unwrap();
+    let shared = SegmentedEncoder::start(&analysis, &opts, 6, &Silent)
+        .unwrap()
+        .analysis();
+    for at in (0..shared.len()).step_by(3) {
+        let mut damaged = shared.clone();
+        damaged[at] ^= 0x40;
+        assert!(
+            SegmentedEncoder::resume(&damaged, &opts).is_err(),
+            "byte {at}"
+        );
+    }
+    for len in [0, 3, 8, 20, shared.len() - 1] {
+        assert!(
+            SegmentedEncoder::resume(&shared[..len], &opts).is_err(),
+            "{len} bytes"
+        );
+    }
+}

@@ -210,8 +210,9 @@ pub(crate) trait PictureEncoder {
     fn finish(self: Box<Self>) -> Result<(Vec<u8>, Vec<FrameChunk>)>;
 }
 
-/// Decodes pictures, starting at a key frame and continuing in order.
-pub(crate) trait PictureDecoder {
+/// Decodes pictures, starting at a key frame and continuing in order (`Send`: see
+/// [`ResidualDecoder`](crate::codec::ResidualDecoder)).
+pub(crate) trait PictureDecoder: Send {
     /// Decodes frame `f` from its chunk.
     fn decode(&mut self, f: usize, chunk: &[u8]) -> Result<Plane<u16>>;
 }
