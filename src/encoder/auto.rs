@@ -115,6 +115,7 @@ pub(super) fn choose(
     let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
     let mut best: Option<Best> = None;
     let segmentations = segmentations(models);
+    let segmenter = analysis::Segmenter::new(mesh);
     let atlases: Vec<AtlasCache> = segmentations
         .iter()
         .map(|_| AtlasCache::default())
@@ -125,7 +126,7 @@ pub(super) fn choose(
             Segmentation::Decimation { .. } => "segmentation (decimation)".to_string(),
         };
         progress.stage(&stage);
-        let (partition, segmented) = analysis::segment(mesh, segmentation, k)?;
+        let (partition, segmented) = segmenter.segment(segmentation, k)?;
         let track = analysis::fit_track(mesh, reference, &partition, settings.plan.affine_step)?;
         clock.lap(&stage);
         let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);

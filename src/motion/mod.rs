@@ -22,6 +22,7 @@ mod affine;
 mod decimate;
 mod fit;
 mod kmeans;
+mod lloyd;
 mod partition;
 mod predictor;
 mod refine;
@@ -36,7 +37,7 @@ pub use affine::{
 #[cfg(any(test, feature = "internals"))]
 pub use decimate::Decimation;
 pub use decimate::{decimate, DecimateOptions, DEFAULT_E0};
-pub use kmeans::{segment, SegmentOptions};
+pub use kmeans::{segment, MotionDescriptors, SegmentOptions};
 pub use partition::Partition;
 pub use predictor::{predict_frame, PredictorKind};
 #[cfg(any(test, feature = "internals"))]

@@ -72,13 +72,31 @@ impl BitModel {
     /// Bits that coding `bit` would cost now (an estimate for rate–distortion choices).
     pub fn cost(&self, bit: bool) -> f64 {
         let p = if bit { self.p_true } else { ONE - self.p_true };
-        -(f64::from(p) / f64::from(ONE)).log2()
+        bit_cost(p)
     }
 
     fn frozen(&self) -> FrozenBit {
         FrozenBit {
             p_true: self.p_true,
         }
+    }
+}
+
+/// −log2(p / ONE) of every probability p the models hold, made once: the rate–distortion choices
+/// of the coders ask for millions of bit costs, and a table gives the same values as the
+/// logarithm (so the same choices) for a small part of its time.
+static BIT_COSTS: std::sync::LazyLock<Vec<f64>> =
+    std::sync::LazyLock::new(|| (0..=ONE).map(|p| exact_bit_cost(p)).collect());
+
+fn exact_bit_cost(p: u32) -> f64 {
+    -(f64::from(p) / f64::from(ONE)).log2()
+}
+
+/// The cost in bits of an outcome of probability `p` (in units of 2^-16).
+fn bit_cost(p: u32) -> f64 {
+    match BIT_COSTS.get(p as usize) {
+        Some(&c) => c,
+        None => exact_bit_cost(p),
     }
 }
 
