@@ -14,7 +14,11 @@ PY_PACKAGES := pymeshlab DracoPy numpy zstandard constriction brotli
 # (gltf-validator, three), pinned by its lockfile.
 NODE_DIR := scripts/node
 
-.PHONY: help deps apt-deps venv node-deps demo test bench fuzz install clean
+# The WebAssembly decoder (web/): its target, its build, the browser tests' Node packages.
+WEB_WASM := target/wasm32-unknown-unknown/web/mcgv_web.wasm
+WEB_PORT ?= 8080
+
+.PHONY: help deps apt-deps venv node-deps web-deps web-build web demo test bench fuzz install clean
 PREFIX ?= /usr/local
 
 help:
@@ -23,9 +27,10 @@ help:
 	@echo "make bench  rate-distortion and speed tables and plots (bench-out/)"
 	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
 	@echo "make install  the binary, shell completions and man page under PREFIX (default /usr/local)"
+	@echo "make web   build the WebAssembly decoder and serve the player (web/example/) on localhost:WEB_PORT (8080)"
 	@echo "make deps   install Debian packages, the reference-tool virtualenv and the bench's Node tools (done by demo/test)"
 
-deps: apt-deps venv node-deps
+deps: apt-deps venv node-deps web-deps
 
 # Skipped when every package is already installed; apt-get update only when something is missing.
 apt-deps:
@@ -53,6 +58,26 @@ $(NODE_DIR)/node_modules/.done: $(NODE_DIR)/package.json $(NODE_DIR)/package-loc
 	cd $(NODE_DIR) && npm ci --no-audit --no-fund --loglevel=error
 	touch $@
 
+# The wasm32 target (rustup's; skipped when installed) and playwright-core, which drives the system
+# Chromium in the browser tests (web/test/), pinned by web/package-lock.json.
+web-deps: web/node_modules/.done
+	@rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown || rustup target add wasm32-unknown-unknown
+
+web/node_modules/.done: web/package.json web/package-lock.json
+	cd web && npm ci --no-audit --no-fund --loglevel=error
+	touch $@
+
+# The decoder alone (tdct and JPEG, no FFmpeg) for WebAssembly, small: the `web` profile.
+web-build:
+	$(CARGO) build --profile web --target wasm32-unknown-unknown -p mcgv-web --quiet
+	cp $(WEB_WASM) web/mcgv_web.wasm
+
+web: deps web-build
+	$(CARGO) build --release --quiet -p mcgv-video-cli
+	@test -f web/example/CesiumMan.mcgv || target/release/mcgv-video encode media/CesiumMan.glb -o web/example/CesiumMan.mcgv --quiet
+	@echo "open http://127.0.0.1:$(WEB_PORT)/example/?src=CesiumMan.mcgv&like=/media/CesiumMan.glb (or drop a .mcgv on the page); Ctrl-C stops"
+	node web/serve.mjs web --mount /three=$(NODE_DIR)/node_modules/three --mount /media=media --port $(WEB_PORT)
+
 demo: deps
 	$(CARGO) build --release --quiet
 	bash scripts/demo.sh
@@ -67,6 +92,8 @@ test: deps
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps -p mcgv-video --quiet
 	MCGV_PYTHON=$(abspath $(PY)) $(CARGO) test --workspace --quiet
 	$(PY) scripts/test_peers.py
+	$(MAKE) --no-print-directory web-build
+	MCGV_BIN=target/debug/mcgv-video node --test web/test/
 
 bench: deps
 	$(CARGO) build --release --quiet
@@ -120,4 +147,4 @@ install: apt-deps
 
 clean:
 	$(CARGO) clean
-	rm -rf $(VENV) bench-out demo-out $(NODE_DIR)/node_modules
+	rm -rf $(VENV) bench-out demo-out $(NODE_DIR)/node_modules web/node_modules web/mcgv_web.wasm

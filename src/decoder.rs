@@ -31,6 +31,11 @@ pub struct DecodeOptions {
     /// Refuse a stream whose header promises more positions (vertices × frames) than this, before
     /// reading anything else (default [`DEFAULT_MAX_POSITIONS`]).
     pub max_positions: u64,
+    /// The bytes are the start of a stream still arriving (a download): its last part may be cut
+    /// short whatever its kind, so a JPEG stream's frames decode as their chunks arrive (a frame
+    /// whose chunk has not is an error until it has), as a temporal-DCT stream's bands always do.
+    /// Only with [`Decoder::from_reader`]; a stream cut in any other part is an error either way.
+    pub partial: bool,
 }
 
 impl Default for DecodeOptions {
@@ -38,6 +43,7 @@ impl Default for DecodeOptions {
         Self {
             max_bands: None,
             max_positions: DEFAULT_MAX_POSITIONS,
+            partial: false,
         }
     }
 }
@@ -90,6 +96,46 @@ impl<'a> Decoder<Cursor<&'a [u8]>> {
 }
 
 impl<R: Read + Seek> Decoder<R> {
+    /// Opens a stream from any seekable source (bytes a `Cursor` holds, a file) with decoding
+    /// options; with [`DecodeOptions::partial`], the start of a stream still arriving.
+    pub fn from_reader(source: R, options: &DecodeOptions) -> Result<Self> {
+        let reader = match options.partial {
+            true => ContainerReader::partial(source)?,
+            false => ContainerReader::new(source)?,
+        };
+        Self::from_container(reader, options)
+    }
+
+    /// The first frame of a stream of which only the start may have arrived: its header, first
+    /// frame (the stream's first parts, about a third of a 2-second clip at the default
+    /// quality, less of a longer or finer one) and, once arrived, its texture coordinates and
+    /// materials. A player draws it while the rest arrives.
+    pub fn first_frame(source: R, options: &DecodeOptions) -> Result<FirstFrame> {
+        let mut reader = ContainerReader::partial(source)?;
+        let header = Header::from_bytes(&reader.part(Tag::HEADER)?)?;
+        Codec::from_id(header.codec)?;
+        limits::check_stream(header.vertices, header.frames, options.max_positions)?;
+        let (triangles, positions) = first_frame::decode(&reader.part(Tag::FIRST_FRAME)?)?;
+        check_first_frame(&header, &triangles, &positions)?;
+        // The attributes come right after the first frame: a later part tells there are none.
+        let later = |t: Tag| t != Tag::HEADER && t != Tag::FIRST_FRAME && t != Tag::ATTRIBUTES;
+        let attributes = match reader.has(Tag::ATTRIBUTES) {
+            true => Some(decode_attributes(
+                &reader.part(Tag::ATTRIBUTES)?,
+                &triangles,
+                &positions,
+            )?),
+            false if reader.parts().iter().any(|p| later(p.tag)) => Some(Attributes::default()),
+            false => None,
+        };
+        Ok(FirstFrame {
+            header,
+            triangles,
+            positions,
+            attributes,
+        })
+    }
+
     /// Reads and checks every part but the coded residuals (temporal-DCT bands are decoded here),
     /// and of a segmented stream, the first segment's.
     pub fn from_container(mut reader: ContainerReader<R>, options: &DecodeOptions) -> Result<Self> {
@@ -98,14 +144,7 @@ impl<R: Read + Seek> Decoder<R> {
         limits::check_stream(header.vertices, header.frames, options.max_positions)?;
         let (v, f) = (header.vertices as usize, header.frames as usize);
         let (triangles, reference) = first_frame::decode(&reader.part(Tag::FIRST_FRAME)?)?;
-        if reference.len() != v || triangles.len() != header.triangles as usize {
-            return Err(Error::Stream(format!(
-                "first frame has {} vertices and {} triangles, header says {v} and {}",
-                reference.len(),
-                triangles.len(),
-                header.triangles
-            )));
-        }
+        check_first_frame(&header, &triangles, &reference)?;
         let attributes = match reader.has(Tag::ATTRIBUTES) {
             true => decode_attributes(&reader.part(Tag::ATTRIBUTES)?, &triangles, &reference)?,
             false => Attributes::default(),
@@ -347,6 +386,46 @@ impl<R: Read + Seek> Decoder<R> {
         open.residuals.picture(&mut self.reader, local)
     }
 
+    /// Frame `f`'s coded picture as the stream holds it, and whether it is a key frame (decoding
+    /// may start there), for codecs that code pictures: an MPEG-4, HEVC or AV1 packet (an AV1
+    /// temporal unit with the sequence header on key frames), or JPEG's scan with its tables.
+    /// With [`Decoder::decode_frame_from_picture`] a picture decoder outside the library (a
+    /// browser's WebCodecs) does what this build's cannot.
+    pub fn coded_picture(&mut self, f: usize) -> Result<(Vec<u8>, bool)> {
+        let local = self.seek_frame(f)?;
+        let Some(images) = self.images() else {
+            return Err(Error::Usage(format!(
+                "a {} stream has no pictures",
+                self.codec.name()
+            )));
+        };
+        let e = images.index.entry(local)?;
+        let what = format!("frame {f}");
+        let bytes = self
+            .reader
+            .chunk(Tag::FRAMES, e.offset, e.len, e.crc, &what)?;
+        Ok((bytes, e.key))
+    }
+
+    /// Decodes frame `f` from its picture decoded outside the library (x | y | z residual images
+    /// side by side: for HEVC and AV1 the Y, U and V planes of the 4:4:4 picture, each
+    /// [`PicturesDescription::lattice`](crate::codec::PicturesDescription) wide, samples of the
+    /// stream's bit depth); the rest — prediction, dequantisation, corrections — as
+    /// [`Decoder::decode_frame`] does. A picture of another size, or a sample above the depth's
+    /// largest, is an error.
+    pub fn decode_frame_from_picture(
+        &mut self,
+        f: usize,
+        picture: &Plane<u16>,
+    ) -> Result<Vec<Point>> {
+        let local = self.seek_frame(f)?;
+        let mut out = self.predict(local)?;
+        let open = self.open.as_ref().ok_or_else(closed)?;
+        open.residuals.add_picture(local, picture, &mut out)?;
+        finite(f, &out)?;
+        Ok(out)
+    }
+
     /// Opens the segment of frame `f`; returns `f`'s index in it.
     fn seek_frame(&mut self, f: usize) -> Result<usize> {
         let s = segments::segment_of(&self.segments, f).ok_or_else(|| {
@@ -433,6 +512,36 @@ impl<R: Read + Seek> Decoder<R> {
             &self.partition,
         )
     }
+}
+
+/// The first frame's counts must be the header's.
+fn check_first_frame(header: &Header, triangles: &[Triangle], reference: &[Point]) -> Result<()> {
+    if reference.len() != header.vertices as usize || triangles.len() != header.triangles as usize {
+        return Err(Error::Stream(format!(
+            "first frame has {} vertices and {} triangles, header says {} and {}",
+            reference.len(),
+            triangles.len(),
+            header.vertices,
+            header.triangles
+        )));
+    }
+    Ok(())
+}
+
+/// What the first parts of a stream hold: enough to draw its first frame before the rest has
+/// arrived ([`Decoder::first_frame`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FirstFrame {
+    /// The stream header.
+    pub header: Header,
+    /// The triangles of every frame, in the decoder's order.
+    pub triangles: Vec<Triangle>,
+    /// Frame 0 as the first-frame coder stored it (the reference every frame is predicted from,
+    /// [`Decoder::reference`]), in the decoder's vertex order: the decoded frame 0 differs from
+    /// it by what the predictor and residuals of frame 0 add (of the order of the step).
+    pub positions: Vec<Point>,
+    /// Texture coordinates and materials; `None` while their part may still be to come.
+    pub attributes: Option<Attributes>,
 }
 
 /// A mesh holds finite coordinates only: a decoded frame with an infinity or NaN is refused.

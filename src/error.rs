@@ -38,6 +38,7 @@ pub enum Error {
     #[error("{0}")]
     Usage(String),
     /// The atlas could not be built.
+    #[cfg(feature = "encode")]
     #[error("atlas: {0}")]
     Atlas(#[from] atlas::AtlasError),
     /// Padding the free pixels of a geometry image failed.

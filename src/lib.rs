@@ -49,12 +49,21 @@
 //!   picture codec coded).
 //! - Writing meshes: [`mesh`] (OBJ, PC2, glTF).
 //!
-//! Every failure is one typed [`Error`]. The cargo feature `ffmpeg` (default) adds the MPEG-4,
-//! HEVC and AV1 codecs through FFmpeg; without it JPEG and the temporal DCT remain. The feature
-//! `internals` makes the pipeline's inner modules public for the project's own tests, benches,
-//! fuzzing and examples: they are not a stable API.
+//! Every failure is one typed [`Error`]. The cargo feature `encode` (default) holds the encoder
+//! and what only it needs — the mesh readers and writers, the segmentation, the atlas, the JPEG
+//! encoder, [`metrics`] and [`inspect`]; without it the library is a decoder of tdct and JPEG
+//! streams in pure Rust, which builds for `wasm32-unknown-unknown` (the project's `web/` crate).
+//! The feature `ffmpeg` (default, implies `encode`) adds the MPEG-4, HEVC and AV1 codecs through
+//! FFmpeg; without it JPEG and the temporal DCT remain. The feature `internals` makes the
+//! pipeline's inner modules public for the project's own tests, benches, fuzzing and examples:
+//! they are not a stable API.
 
 #![deny(missing_docs)]
+// A decode-only build (without `encode`) keeps the codecs' option types and laws, pure code, so
+// that its API reads as the full one; what only the encoder reaches is unused there.
+#![cfg_attr(not(feature = "encode"), allow(dead_code, unused_imports))]
+// Its front page still describes the whole library, encoder included.
+#![cfg_attr(not(feature = "encode"), allow(rustdoc::broken_intra_doc_links))]
 
 /// Declares modules the public API does not expose: crate-private, or public (and unstable) with
 /// the `internals` feature.
@@ -71,10 +80,13 @@ macro_rules! internal {
 
 pub mod codec;
 mod decoder;
+#[cfg(feature = "encode")]
 pub mod encoder;
 mod error;
+#[cfg(feature = "encode")]
 pub mod inspect;
 pub mod mesh;
+#[cfg(feature = "encode")]
 pub mod metrics;
 mod progress;
 
@@ -83,12 +95,14 @@ internal! {
     geometry_image;
     limits;
     motion;
+    #[cfg(feature = "encode")]
     output;
     stream;
 }
 
 pub use codec::{Codec, CodecConfig, Description};
-pub use decoder::{DecodeOptions, Decoder};
+pub use decoder::{DecodeOptions, Decoder, FirstFrame};
+#[cfg(feature = "encode")]
 pub use encoder::{
     encode, encode_source, encode_with_progress, EncodeOptions, EncodeReport, Encoded,
     PredictorChoice, Segmentation, SegmentationChoice,
@@ -96,7 +110,9 @@ pub use encoder::{
 pub use error::{Error, Result};
 pub use geometry_image::Lattice;
 pub use limits::DEFAULT_MAX_POSITIONS;
-pub use mesh::{read_animation, AnimatedMesh, Attributes, FrameSource, ReadOptions};
+#[cfg(feature = "encode")]
+pub use mesh::{read_animation, FrameSource, ReadOptions};
+pub use mesh::{AnimatedMesh, Attributes};
 pub use motion::PredictorKind;
 /// How free pixels of the geometry images are filled (the `padding` crate's methods).
 pub use padding::Method as PaddingMethod;

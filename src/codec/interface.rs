@@ -4,17 +4,24 @@
 use super::pictures::geometry_video::ImageLayout;
 use super::Codec;
 use crate::error::{Error, Result};
+#[cfg(feature = "encode")]
 use crate::geometry_image::lattice::AtlasCache;
 use crate::geometry_image::Plane;
-use crate::mesh::{AnimatedMesh, Point, Triangle};
+#[cfg(feature = "encode")]
+use crate::mesh::AnimatedMesh;
+use crate::mesh::{Point, Triangle};
+#[cfg(feature = "encode")]
 use crate::motion::Partition;
 use crate::progress::Progress;
-use crate::stream::container::{ContainerReader, Part, Tag};
+use crate::stream::container::ContainerReader;
+#[cfg(feature = "encode")]
+use crate::stream::container::{Part, Tag};
 use crate::stream::header::Header;
 
 /// What the encoder hands a residual coder: the animation, the decoder's reference frame and
 /// partition, and every frame's residual against the quantised predictor. The coder's settings
 /// were given when it was made (from the encoding's rate plan).
+#[cfg(feature = "encode")]
 pub(crate) struct ResidualInput<'a> {
     /// The animation (vertices in the stream's order): the clip, or one temporal segment of it.
     pub mesh: &'a AnimatedMesh,
@@ -32,6 +39,7 @@ pub(crate) struct ResidualInput<'a> {
 }
 
 /// What a residual coder produced: its set-up and its parts, in file order.
+#[cfg(feature = "encode")]
 pub(crate) struct CodedResiduals {
     /// The payload of the codec's set-up part (whole stream, first of the codec's parts): its
     /// own version and settings.
@@ -47,6 +55,7 @@ pub(crate) struct CodedResiduals {
     pub stage_seconds: Vec<(String, f64)>,
 }
 
+#[cfg(feature = "encode")]
 impl CodedResiduals {
     /// The codec's parts around the predictor's, in file order: the set-up part and the other
     /// whole-stream parts before, a segment's own after.
@@ -58,6 +67,7 @@ impl CodedResiduals {
 }
 
 /// The encoding half of a residual codec.
+#[cfg(feature = "encode")]
 pub(crate) trait ResidualEncoder {
     /// Codes every frame's residuals.
     fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals>;
@@ -102,6 +112,15 @@ pub(crate) trait ResidualDecoder<R> {
     /// The geometry-image side of the stream, for codecs that code images.
     fn images(&self) -> Option<&ImageLayout> {
         None
+    }
+
+    /// Adds frame `f`'s residuals read from its picture `plane`, decoded outside (x | y | z
+    /// residual images side by side, samples of the stream's depth), for codecs that code images.
+    fn add_picture(&self, _f: usize, _plane: &Plane<u16>, _frame: &mut [Point]) -> Result<()> {
+        Err(Error::Usage(format!(
+            "a {} stream has no pictures",
+            self.describe().codec.name()
+        )))
     }
 
     /// Frame `f`'s decoded picture (x | y | z residual images side by side, samples of the stream's

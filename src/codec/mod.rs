@@ -32,9 +32,9 @@ internal! {
 }
 
 pub use interface::{BandsDescription, Description, PicturesDescription};
-pub(crate) use interface::{
-    CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput, StreamLayout,
-};
+#[cfg(feature = "encode")]
+pub(crate) use interface::{CodedResiduals, ResidualEncoder, ResidualInput};
+pub(crate) use interface::{ResidualDecoder, StreamLayout};
 pub use pictures::deep::DeepConfig;
 pub(crate) use pictures::geometry_video;
 pub use pictures::jpeg::JpegConfig;
@@ -216,7 +216,25 @@ impl Codec {
         })
     }
 
+    /// The picture codec a stream's decoder reads pictures with: [`Codec::pictures`], or without
+    /// the `ffmpeg` feature for MPEG-4, HEVC and AV1 one whose pictures are decoded outside.
+    fn decoded_pictures(self) -> Result<Option<&'static dyn PictureCodec>> {
+        #[cfg(not(feature = "ffmpeg"))]
+        {
+            static OUTSIDE: [pictures::Outside; 3] = [
+                pictures::Outside(Codec::Mpeg4),
+                pictures::Outside(Codec::Hevc),
+                pictures::Outside(Codec::Av1),
+            ];
+            if let Some(outside) = OUTSIDE.iter().find(|o| o.0 == self) {
+                return Ok(Some(outside));
+            }
+        }
+        self.pictures()
+    }
+
     /// The residual encoder of `plan` (a plan of this codec).
+    #[cfg(feature = "encode")]
     pub(crate) fn encoder(self, plan: &RatePlan) -> Result<Box<dyn ResidualEncoder>> {
         let step = plan.step;
         Ok(match (self.pictures()?, &plan.pictures) {
@@ -243,7 +261,7 @@ impl Codec {
         max_bands: Option<usize>,
     ) -> Result<Box<dyn ResidualDecoder<R>>> {
         let setup = reader.part(Tag::CODEC_SETUP)?;
-        Ok(match self.pictures()? {
+        Ok(match self.decoded_pictures()? {
             Some(pictures) => Box::new(geometry_video::Decoder::open(
                 (self, pictures),
                 &setup,
@@ -266,7 +284,7 @@ impl std::fmt::Display for Codec {
 }
 
 #[cfg(not(feature = "ffmpeg"))]
-fn unavailable(codec: Codec) -> Error {
+pub(crate) fn unavailable(codec: Codec) -> Error {
     Error::Codec(format!(
         "this build has no {} codec (built without the `ffmpeg` feature)",
         codec.name()
@@ -390,6 +408,7 @@ impl CodecConfig {
     }
 }
 
+#[cfg(feature = "encode")]
 impl RatePlan {
     /// The residual encoder with this plan's settings.
     pub(crate) fn encoder(&self) -> Result<Box<dyn ResidualEncoder>> {

@@ -51,9 +51,11 @@ pub fn check(w: u16, h: u16) -> Result<()> {
 /// An atlas built once and handed to every encoding on the same first frame, partition and
 /// lattice option: the automatic choice codes several predictors on one partition, and building
 /// the atlas costs as much as coding a dozen frames' pictures.
+#[cfg(feature = "encode")]
 #[derive(Debug, Default)]
 pub struct AtlasCache(std::sync::OnceLock<((u16, u16), atlas::Atlas)>);
 
+#[cfg(feature = "encode")]
 impl AtlasCache {
     /// The cached atlas, or `build`'s result (kept for the next call).
     pub fn get_or_build(
@@ -72,6 +74,7 @@ impl AtlasCache {
 
 /// Builds the atlas on the requested lattice, or for `Lattice::Auto` on the smallest lattice from
 /// [`auto_side`] upwards on which the charts fit.
+#[cfg(feature = "encode")]
 pub fn build_atlas(
     reference: &[Point],
     triangles: &[[u32; 3]],

@@ -8,6 +8,7 @@
 //! - [`tile`]: the x | y | z images side by side in one picture ([`Plane`]), and back.
 
 pub mod corrections;
+#[cfg(feature = "encode")]
 pub mod images;
 pub mod lattice;
 mod plane;
@@ -15,6 +16,7 @@ pub mod quantise;
 pub mod tile;
 
 pub use corrections::Corrections;
+#[cfg(feature = "encode")]
 pub use images::GeometryImages;
 pub use lattice::Lattice;
 pub use plane::Plane;

@@ -6,31 +6,43 @@
 //! writers give OBJ frames, PC2 caches and glTF with a morph target per frame.
 
 mod attributes;
+#[cfg(feature = "encode")]
 mod summary;
 pub(crate) mod vector;
 internal! {
+    #[cfg(feature = "encode")]
     frames;
+    #[cfg(feature = "encode")]
     gltf_write;
+    #[cfg(feature = "encode")]
     io;
     topology;
 }
 
+#[cfg(feature = "encode")]
 mod gltf;
+#[cfg(feature = "encode")]
 mod obj;
+#[cfg(feature = "encode")]
 mod pc2;
 
 pub use attributes::Attributes;
+#[cfg(feature = "encode")]
 pub use frames::FrameSource;
 
 /// Frames per second of a glTF output when the source's rate is unknown (OBJ and PC2 inputs).
 pub const DEFAULT_FPS: f64 = 30.0;
+#[cfg(feature = "encode")]
 pub use gltf::Clip;
+#[cfg(feature = "encode")]
 pub use gltf_write::{is_gltf_path, write_gltf, GltfOptions, MANY_MORPH_TARGETS};
+#[cfg(feature = "encode")]
 pub use io::{
     clips, input_files, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame,
     write_obj_mesh_frame, write_obj_sequence, write_obj_sequence_from, write_pc2, ObjFrameWriter,
     Pc2Writer, ReadOptions,
 };
+#[cfg(feature = "encode")]
 pub use summary::Summary;
 
 use crate::error::{Error, Result};

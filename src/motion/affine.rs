@@ -12,10 +12,13 @@
 //! about `s`. The decoder derives centroids and spreads from the decoded frame 0 and the
 //! partition, which it has before the maps.
 
-use super::fit::{apply, AffineCoefficients, AffineSolver, UnitFrame};
+use super::fit::{apply, AffineCoefficients, UnitFrame};
+#[cfg(feature = "encode")]
+use super::fit::AffineSolver;
 use super::partition::Partition;
 use crate::error::{Error, Result};
 use crate::mesh::Point;
+#[cfg(feature = "encode")]
 use rayon::prelude::*;
 
 /// Regularisation of the cluster fits, relative to the cluster's spread: only there to give flat or
@@ -223,6 +226,7 @@ impl AffineTrack {
     /// Fits `H_i^k` (eq. 2) for every frame `i` of `frames` and cluster `k`, from `reference` (the
     /// frame 0 the decoder will have) to the original frame, then quantises with base step `step`
     /// (unit frame, see [`QuantisedAffine::step`]; rounded to the `f32` the stream stores).
+    #[cfg(feature = "encode")]
     pub fn fit(
         frames: &[Vec<Point>],
         reference: &[Point],

@@ -4,6 +4,7 @@
 //! frames against the same frame-0 points, so the normal matrix is factored once per source set.
 
 use crate::mesh::Point;
+#[cfg(feature = "encode")]
 use nalgebra::{Matrix3, Vector3};
 
 /// An affine map `x ↦ A x + b` as 12 coefficients, row by row: `[a00 a01 a02 b0 a10 … b2]`.
@@ -62,6 +63,7 @@ impl UnitFrame {
 /// Least-squares affine fits from a fixed source set, with Tikhonov regularisation toward the identity:
 /// minimises `Σ‖A p + b − q‖² + λ‖A − I‖²`. Coplanar, colinear or single-point sources thus get the
 /// identity in their unconstrained directions (a single point gets a pure translation) instead of NaN.
+#[cfg(feature = "encode")]
 #[derive(Debug, Clone)]
 pub struct AffineSolver {
     mean: Vector3<f64>,
@@ -77,6 +79,7 @@ pub struct AffineSolver {
 /// Smallest regularisation per source point, in unit coordinates: keeps a single point invertible.
 const LAMBDA_FLOOR: f64 = 1e-12;
 
+#[cfg(feature = "encode")]
 impl AffineSolver {
     /// Factors the normal matrix of `source` (unit coordinates). `relative_lambda` scales the
     /// regularisation by the source's mean squared spread; an empty source gives the identity map.
@@ -152,6 +155,7 @@ impl AffineSolver {
 }
 
 /// The plane of a source whose scatter has exactly one direction the regularisation dominates.
+#[cfg(feature = "encode")]
 fn flat_plane(scatter: &Matrix3<f64>, lambda: f64) -> Option<[Vector3<f64>; 3]> {
     let eigen = scatter.symmetric_eigen();
     let mut order = [0usize, 1, 2];

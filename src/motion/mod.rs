@@ -19,14 +19,20 @@
 //! - `residual`: prediction residuals and their energy
 
 mod affine;
+#[cfg(feature = "encode")]
 mod decimate;
 mod fit;
+#[cfg(feature = "encode")]
 mod kmeans;
+#[cfg(feature = "encode")]
 mod lloyd;
 mod partition;
 mod predictor;
+#[cfg(feature = "encode")]
 mod refine;
+#[cfg(feature = "encode")]
 mod residual;
+#[cfg(feature = "encode")]
 mod sampled_motion;
 mod skinning;
 
@@ -34,13 +40,16 @@ pub use affine::{
     identity_levels, AffineTrack, ClusterGeometry, QuantisedAffine, DEFAULT_AFFINE_PRECISION,
     MAX_AFFINE_LEVEL, MAX_AFFINE_STEP, MIN_AFFINE_STEP,
 };
-#[cfg(any(test, feature = "internals"))]
+#[cfg(all(feature = "encode", any(test, feature = "internals")))]
 pub use decimate::Decimation;
+#[cfg(feature = "encode")]
 pub use decimate::{decimate, DecimateOptions, DEFAULT_E0};
+#[cfg(feature = "encode")]
 pub use kmeans::{segment, MotionDescriptors, SegmentOptions};
 pub use partition::Partition;
 pub use predictor::{predict_frame, PredictorKind};
-#[cfg(any(test, feature = "internals"))]
+#[cfg(all(feature = "encode", any(test, feature = "internals")))]
 pub use residual::energy;
+#[cfg(feature = "encode")]
 pub use residual::residuals;
 pub use skinning::{cluster_neighbours, SkinningWeights, DEFAULT_RIDGE, WEIGHT_BITS};

@@ -28,7 +28,9 @@ use super::fit::{apply, AffineCoefficients, UnitFrame};
 use super::partition::Partition;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
+#[cfg(feature = "encode")]
 use nalgebra::{DMatrix, DVector};
+#[cfg(feature = "encode")]
 use rayon::prelude::*;
 
 /// Bits per quantised weight, sign included (the paper's 16).
@@ -135,6 +137,7 @@ impl SkinningWeights {
 
     /// Fits the weights of every vertex (eq. 9 under eq. 10 and `Σα = 1`) from `reference` (the
     /// decoded frame 0) to the original `frames`, with the dequantised maps of `track`, and quantises them.
+    #[cfg(feature = "encode")]
     pub fn fit(
         frames: &[Vec<Point>],
         reference: &[Point],
@@ -155,6 +158,7 @@ impl SkinningWeights {
 
     /// [`SkinningWeights::fit`] with another relative ridge and bits per weight (2..=31; the
     /// motion bench measures their effect on residual energy and weight bits).
+    #[cfg(feature = "encode")]
     #[allow(clippy::too_many_arguments)]
     pub fn fit_with(
         frames: &[Vec<Point>],
@@ -293,6 +297,7 @@ impl SkinningWeights {
 }
 
 /// What every vertex's weight fit shares.
+#[cfg(feature = "encode")]
 struct VertexFit<'a> {
     frames: &'a [Vec<Point>],
     reference: &'a [Point],
@@ -303,6 +308,7 @@ struct VertexFit<'a> {
     ridge: f64,
 }
 
+#[cfg(feature = "encode")]
 impl VertexFit<'_> {
     /// The unconstrained weights `β` of vertex `v` of cluster `k`: least squares of
     /// `Σ_i ‖Σ_j β_j (p_j^i − p_k^i) − (x_i − p_k^i)‖²` plus the ridge.

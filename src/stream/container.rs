@@ -236,6 +236,7 @@ impl ContainerWriter {
 
     /// Writes the file to a temporary file beside `path` and renames it into place, so a failure
     /// never leaves a half-written file at `path`.
+    #[cfg(feature = "encode")]
     pub fn write_atomic(&self, path: &Path) -> Result<u64> {
         let bytes = self.to_bytes();
         crate::output::write_atomic(path, &bytes)?;
@@ -266,8 +267,8 @@ pub struct ContainerReader<R> {
     source: R,
     parts: Vec<PartEntry>,
     file_len: u64,
-    /// The progressive last part cut short by the end of the file: its tag, segment and the
-    /// length it declared.
+    /// The last part cut short by the end of the file (progressive, or chunked in a partial
+    /// file): its tag, segment and the length it declared.
     truncated: Option<(Tag, Option<u32>, u64)>,
     /// Temporal segments in the stream (0: not segmented).
     segments: u32,
@@ -285,7 +286,19 @@ impl ContainerReader<BufReader<File>> {
 
 impl<R: Read + Seek> ContainerReader<R> {
     /// Reads the part table of a container from any seekable source.
-    pub fn new(mut source: R) -> Result<Self> {
+    pub fn new(source: R) -> Result<Self> {
+        Self::read(source, false)
+    }
+
+    /// Reads the part table of a container still arriving (the prefix of a download): the parts
+    /// whose bytes have all arrived, and the one the file ends in when its chunks are checked one
+    /// by one (progressive or chunked: a picture codec's frames), so that the chunks present
+    /// decode; a chunk past the end, or a part not there yet, is an error when asked for.
+    pub fn partial(source: R) -> Result<Self> {
+        Self::read(source, true)
+    }
+
+    fn read(mut source: R, partial: bool) -> Result<Self> {
         let file_len = source.seek(SeekFrom::End(0)).map_err(table_io)?;
         source.seek(SeekFrom::Start(0)).map_err(table_io)?;
         let count = read_file_header(&mut source)?;
@@ -295,12 +308,20 @@ impl<R: Read + Seek> ContainerReader<R> {
         let mut truncated = None;
         let mut segments = 0u32;
         for i in 0..count {
-            let mut part = read_part_entry(&mut source, i, count, pos, file_len)?;
+            // A file still arriving ends where it ends: the parts after are to come.
+            if partial && pos + PART_HEADER_LEN as u64 > file_len {
+                break;
+            }
+            let mut part = read_part_entry(&mut source, (i, count), pos, file_len, partial)?;
             if part.entry.tag == Tag::SEGMENT {
                 segments += 1;
             }
             part.entry.segment = segments.checked_sub(1);
             if let Some((tag, declared)) = part.truncated {
+                // A part whose one CRC covers it whole is of no use until it has all arrived.
+                if part.entry.checksum == Checksum::Whole {
+                    break;
+                }
                 truncated = Some((tag, part.entry.segment, declared));
             }
             parts.push(part.entry);
@@ -308,7 +329,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             source.seek(SeekFrom::Start(pos)).map_err(table_io)?;
         }
         check_scopes(&parts)?;
-        if pos != file_len {
+        if pos != file_len && !partial {
             return Err(Error::Stream(format!(
                 "{} bytes after the last part (file damaged or concatenated?)",
                 file_len - pos
@@ -332,7 +353,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             .map(|(.., declared)| declared)
     }
 
-    /// Whether the file ends inside its progressive last part.
+    /// Whether the file ends inside its last part (progressive, or chunked in a partial file).
     pub fn cut_short(&self) -> bool {
         self.truncated.is_some()
     }
@@ -438,8 +459,14 @@ impl<R: Read + Seek> ContainerReader<R> {
         what: &str,
     ) -> Result<Vec<u8>> {
         let e = self.entry(tag)?;
-        let within = offset.checked_add(len).is_some_and(|end| end <= e.len);
-        if !within {
+        let end = offset.checked_add(len);
+        if end.is_none_or(|end| end > e.len) {
+            let declared = self.truncated(tag);
+            if end.zip(declared).is_some_and(|(end, d)| end <= d) {
+                return Err(Error::Stream(format!(
+                    "{what} is past the end of the file (cut short, or still arriving)"
+                )));
+            }
             return Err(Error::Stream(format!("{what} lies outside part {tag}")));
         }
         let bytes = self.read_at(e.offset + offset, len, tag)?;

@@ -84,13 +84,14 @@ pub(super) struct PartRead {
     pub truncated: Option<(Tag, u64)>,
 }
 
-/// Reads part `i` of `count`, whose 17-byte header starts at `pos`.
+/// Reads part `i` of `count`, whose 17-byte header starts at `pos`. `partial`: the file is still
+/// arriving, so any part may be cut short by its end (the caller decides what is of use).
 pub(super) fn read_part_entry<R: Read>(
     source: &mut R,
-    i: u32,
-    count: u32,
+    (i, count): (u32, u32),
     pos: u64,
     file_len: u64,
+    partial: bool,
 ) -> Result<PartRead> {
     let mut ph = [0u8; 17];
     read_exact_or(source, &mut ph, "a part header")?;
@@ -120,12 +121,13 @@ pub(super) fn read_part_entry<R: Read>(
     let offset = pos + 17;
     let declared_end = offset.checked_add(len);
     let mut truncated = None;
-    // A progressive last part may be cut by the end of the file: its prefix still decodes.
+    // A progressive last part may be cut by the end of the file: its prefix still decodes. So may
+    // any part of a file still arriving (the caller keeps the ones whose chunks are checked alone).
+    let cut_allowed = partial || (checksum == Checksum::Progressive && i + 1 == count);
     let (len, declared_end) = match declared_end {
         Some(e)
             if e > file_len
-                && checksum == Checksum::Progressive
-                && i + 1 == count
+                && cut_allowed
                 && offset <= file_len =>
         {
             truncated = Some((Tag(tag), len));

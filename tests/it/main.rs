@@ -20,6 +20,7 @@ mod layering;
 mod mesh_io;
 mod metrics_reference;
 mod motion;
+mod partial;
 mod roundtrip;
 mod segments;
 mod skinning;

@@ -19,6 +19,7 @@ pub fn decode_options(bands: Option<u64>, max_positions: Option<u64>) -> DecodeO
     DecodeOptions {
         max_bands: bands.map(|n| usize::try_from(n).unwrap_or(usize::MAX)),
         max_positions: max_positions.unwrap_or(mcgv_video::DEFAULT_MAX_POSITIONS),
+        ..DecodeOptions::default()
     }
 }
 

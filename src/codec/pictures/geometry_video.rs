@@ -10,10 +10,15 @@
 use super::setup::PictureSetup;
 use super::{PictureCodec, PictureDecoder, PicturePlan, Plane};
 use crate::codec::{BandsDescription, Codec, Description, PicturesDescription};
-use crate::codec::{CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput, StreamLayout};
+use crate::codec::{ResidualDecoder, StreamLayout};
+#[cfg(feature = "encode")]
+use crate::codec::{CodedResiduals, ResidualEncoder, ResidualInput};
 use crate::error::{Error, Result};
+#[cfg(feature = "encode")]
 use crate::geometry_image::lattice::AtlasCache;
-use crate::geometry_image::{lattice, quantise, tile, Corrections, FrameRanges, GeometryImages};
+use crate::geometry_image::{lattice, quantise, tile, Corrections, FrameRanges};
+#[cfg(feature = "encode")]
+use crate::geometry_image::GeometryImages;
 use crate::mesh::Point;
 use crate::motion::Partition;
 use crate::progress::Progress;
@@ -21,12 +26,14 @@ use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
 use crate::stream::frame_index::{FrameChunk, FrameIndex};
 use crate::stream::side_info;
+#[cfg(feature = "encode")]
 use rayon::prelude::*;
 use std::io::{Read, Seek};
 use std::time::Instant;
 
 /// The residual images `plan` makes of `residuals` at pixel step `pixel_step` on the atlas of
 /// `reference`, `triangles` and `partition`, built afresh or taken from `atlas`.
+#[cfg(feature = "encode")]
 pub(crate) fn images(
     (codec, plan): (&dyn PictureCodec, &PicturePlan),
     pixel_step: f32,
@@ -50,12 +57,14 @@ pub(crate) fn images(
 }
 
 /// The geometry-video residual encoder over one picture codec, with the plan's settings.
+#[cfg(feature = "encode")]
 pub(crate) struct Encoder {
     codec: &'static dyn PictureCodec,
     plan: PicturePlan,
     pixel_step: f32,
 }
 
+#[cfg(feature = "encode")]
 impl Encoder {
     /// The encoder of `plan` on `codec` at `pixel_step`.
     pub fn new(codec: &'static dyn PictureCodec, plan: PicturePlan, pixel_step: f32) -> Self {
@@ -67,6 +76,7 @@ impl Encoder {
     }
 }
 
+#[cfg(feature = "encode")]
 impl ResidualEncoder for Encoder {
     fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals> {
         let clock = Instant::now();
@@ -129,6 +139,7 @@ impl ResidualEncoder for Encoder {
 /// Groups are independent by construction (a group starts at a key frame and its padding starts
 /// afresh), so they run on rayon's threads; each gets its own picture encoder and the chunks are
 /// joined in frame order. The encoders' set-up parts must agree, as one encoder's frames do.
+#[cfg(feature = "encode")]
 fn code_pictures(
     coder: &Encoder,
     images: &GeometryImages,
@@ -172,6 +183,7 @@ fn code_pictures(
 }
 
 /// Pads, tiles and codes the frames of one group of pictures in order, from its key frame.
+#[cfg(feature = "encode")]
 fn code_group(
     coder: &Encoder,
     images: &GeometryImages,
@@ -255,7 +267,11 @@ impl Decoder {
         let (pixel_step, ranges) = quantise::read_ranges(&mut r, frames, depth)?;
         let corrections = Corrections::read(&mut r, frames, v)?;
         r.finish()?;
-        let images_len = reader.entry(Tag::FRAMES)?.len;
+        // A partial stream's images part may be cut short: the index covers the declared length.
+        let images_len = match reader.truncated(Tag::FRAMES) {
+            Some(declared) => declared,
+            None => reader.entry(Tag::FRAMES)?.len,
+        };
         let index = FrameIndex::from_bytes(&reader.part(Tag::FRAME_INDEX)?, frames, images_len)?;
         Ok(Self {
             codec,
@@ -374,6 +390,18 @@ impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
 
     fn images(&self) -> Option<&ImageLayout> {
         Some(&self.layout)
+    }
+
+    fn add_picture(&self, f: usize, plane: &Plane<u16>, frame: &mut [Point]) -> Result<()> {
+        self.layout.index.entry(f)?;
+        let top = quantise::max_level(self.layout.depth());
+        if plane.data.iter().any(|&s| u32::from(s) > top as u32) {
+            return Err(Error::Usage(format!(
+                "frame {f}: a picture sample is above {top}, the largest at {} bits",
+                self.layout.depth()
+            )));
+        }
+        self.add(f, plane, frame)
     }
 
     fn picture(&mut self, reader: &mut ContainerReader<R>, f: usize) -> Result<Plane<u16>> {

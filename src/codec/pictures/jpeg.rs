@@ -7,7 +7,9 @@
 //! the same bytes decode to the same samples on every machine. JPEG decoders legitimately differ by ±1
 //! (IDCT rounding); the encoder and decoder of mcgv must use this one function to agree exactly.
 
-use super::{abbreviated, PictureCodec, PictureDecoder, PictureEncoder, PictureOptions, Plane};
+use super::{abbreviated, PictureCodec, PictureDecoder, PictureOptions, Plane};
+#[cfg(feature = "encode")]
+use super::PictureEncoder;
 use super::{PicturePlan, PictureSetup, Resolved};
 use crate::codec::rate::{anchor, read_law, Anchor, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
@@ -15,6 +17,7 @@ use crate::motion::DEFAULT_AFFINE_PRECISION;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::frame_index::FrameChunk;
 use crate::{Error, Result};
+#[cfg(feature = "encode")]
 use jpeg_encoder::{ColorType, Encoder, QuantizationTableType};
 use zune_core::bytestream::ZCursor;
 use zune_core::colorspace::ColorSpace;
@@ -33,6 +36,7 @@ pub const TABLE: padding::JpegTable = padding::JpegTable::Flat;
 const END_OF_IMAGE: [u8; 2] = [0xFF, 0xD9];
 
 /// Codes `plane` as a baseline grayscale JPEG at `quality` (1..=100, higher = better).
+#[cfg(feature = "encode")]
 pub fn encode(plane: &Plane, quality: u8) -> Result<Vec<u8>> {
     plane.check()?;
     if !(1..=100).contains(&quality) {
@@ -174,6 +178,7 @@ impl PictureCodec for Pictures {
         }
     }
 
+    #[cfg(feature = "encode")]
     fn encoder(
         &self,
         _width: u32,
@@ -206,6 +211,7 @@ impl PictureCodec for Pictures {
     }
 }
 
+#[cfg(feature = "encode")]
 struct FrameEncoder {
     quality: u8,
     /// The header every frame shares (tables aside), from the first frame.
@@ -213,6 +219,7 @@ struct FrameEncoder {
     chunks: Vec<FrameChunk>,
 }
 
+#[cfg(feature = "encode")]
 impl PictureEncoder for FrameEncoder {
     fn push(&mut self, plane: &Plane<u16>) -> Result<()> {
         let jpeg = encode(&plane.to_8bit()?, self.quality)?;

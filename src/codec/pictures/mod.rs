@@ -139,6 +139,7 @@ pub(crate) trait PictureCodec: Sync {
     fn settings(&self, quantiser: u8, gop: u32, depth: u8) -> Vec<(&'static str, u32)>;
     /// An encoder for `width`×`height` pictures whose first picture is frame `first_frame` of the
     /// sequence (a key frame: every group of pictures gets its own encoder).
+    #[cfg(feature = "encode")]
     fn encoder(
         &self,
         width: u32,
@@ -155,7 +156,53 @@ pub(crate) trait PictureCodec: Sync {
     ) -> Result<Box<dyn PictureDecoder>>;
 }
 
+/// A picture codec this build cannot decode (MPEG-4, HEVC and AV1 without the `ffmpeg` feature):
+/// its streams open all the same, and their pictures, decoded outside (a browser's WebCodecs),
+/// come back through `Decoder::decode_frame_from_picture`.
+#[cfg(not(feature = "ffmpeg"))]
+pub(crate) struct Outside(pub Codec);
+
+#[cfg(not(feature = "ffmpeg"))]
+impl PictureCodec for Outside {
+    fn settings(&self, quantiser: u8, gop: u32, depth: u8) -> Vec<(&'static str, u32)> {
+        match self.0 {
+            Codec::Mpeg4 => vec![("qscale", quantiser.into()), ("gop", gop)],
+            _ => vec![
+                ("qp", quantiser.into()),
+                ("gop", gop),
+                ("bit_depth", depth.into()),
+            ],
+        }
+    }
+
+    #[cfg(feature = "encode")]
+    fn encoder(
+        &self,
+        _width: u32,
+        _height: u32,
+        _first_frame: usize,
+        _plan: &PicturePlan,
+    ) -> Result<Box<dyn PictureEncoder>> {
+        Err(super::unavailable(self.0))
+    }
+
+    fn decoder(
+        &self,
+        _width: u32,
+        _height: u32,
+        _setup: &PictureSetup,
+    ) -> Result<Box<dyn PictureDecoder>> {
+        Err(Error::Codec(format!(
+            "this build has no {} decoder (built without the `ffmpeg` feature): decode the \
+             pictures outside (Decoder::coded_picture) and hand them to \
+             Decoder::decode_frame_from_picture",
+            self.0.name()
+        )))
+    }
+}
+
 /// Codes pictures in frame order.
+#[cfg(feature = "encode")]
 pub(crate) trait PictureEncoder {
     /// Codes the next frame's picture (samples of the codec's depth).
     fn push(&mut self, plane: &Plane<u16>) -> Result<()>;

@@ -14,7 +14,9 @@ pub mod transform;
 use super::rate::{Rate, RatePlan};
 use super::StreamLayout;
 use super::{BandsDescription, Codec, Description};
-use super::{CodedResiduals, ResidualDecoder, ResidualEncoder, ResidualInput};
+use super::ResidualDecoder;
+#[cfg(feature = "encode")]
+use super::{CodedResiduals, ResidualEncoder, ResidualInput};
 use crate::error::{Error, Result};
 use crate::mesh::Point;
 use crate::motion::DEFAULT_AFFINE_PRECISION;
@@ -55,11 +57,13 @@ impl TdctConfig {
 }
 
 /// The temporal-DCT residual encoder at one quantiser step (model units, as stored).
+#[cfg(feature = "encode")]
 pub(crate) struct Encoder {
     /// The quantiser step.
     pub step: f32,
 }
 
+#[cfg(feature = "encode")]
 impl ResidualEncoder for Encoder {
     fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals> {
         let clock = Instant::now();
