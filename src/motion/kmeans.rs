@@ -57,7 +57,7 @@ impl Default for SegmentOptions {
 ///    `ring`-ring, in the unit frame of frame 0 (bounding-box centre at the origin, diagonal 1). The
 ///    linear part is weighted by the RMS radius of the shape so both parts measure displacement: a
 ///    change δ of a linear coefficient moves a typical vertex by about radius × δ.
-/// 2. k-means (k-means++ seeded by `opts.seed`, one run) is trained on the vertices whose ring moves
+/// 2. k-means (k-means++ seeded by `opts.seed`) is trained on the vertices whose ring moves
 ///    affinely (ring misfit ≤ 4 × median) and is not degenerate (flat, on a line); every vertex
 ///    then takes its nearest centroid. Rings straddling differently moving parts give far-off
 ///    descriptors that would otherwise draw centroids away from the parts, and degenerate rings

@@ -86,7 +86,7 @@ impl BitModel {
 /// of the coders ask for millions of bit costs, and a table gives the same values as the
 /// logarithm (so the same choices) for a small part of its time.
 static BIT_COSTS: std::sync::LazyLock<Vec<f64>> =
-    std::sync::LazyLock::new(|| (0..=ONE).map(|p| exact_bit_cost(p)).collect());
+    std::sync::LazyLock::new(|| (0..=ONE).map(exact_bit_cost).collect());
 
 fn exact_bit_cost(p: u32) -> f64 {
     -(f64::from(p) / f64::from(ONE)).log2()
