@@ -206,15 +206,16 @@ const BUCKETS: usize = 65;
 /// the remaining low bits raw.
 #[derive(Clone, Debug)]
 pub struct UIntModel {
-    unary: Vec<BitModel>,
-    top_bit: Vec<BitModel>,
+    // Arrays, not vectors: coders clone whole banks of these models per trial.
+    unary: [BitModel; BUCKETS],
+    top_bit: [BitModel; BUCKETS],
 }
 
 impl Default for UIntModel {
     fn default() -> Self {
         Self {
-            unary: vec![BitModel::default(); BUCKETS],
-            top_bit: vec![BitModel::default(); BUCKETS],
+            unary: std::array::from_fn(|_| BitModel::default()),
+            top_bit: std::array::from_fn(|_| BitModel::default()),
         }
     }
 }
@@ -229,16 +230,23 @@ pub struct IntModel {
 impl UIntModel {
     /// Bits that coding `value` would cost now, without coding it.
     pub fn cost(&self, value: u64) -> f64 {
-        let shifted = u128::from(value) + 1;
-        let length = 127 - shifted.leading_zeros();
-        let unary: f64 = (self.unary.iter().enumerate())
-            .take(length as usize + 1)
-            .map(|(i, m)| m.cost((i as u32) < length))
-            .sum();
+        // value + 1 fits in 64 bits but for u64::MAX, whose length is 64 and top bit 0.
+        let (length, top) = match value.checked_add(1) {
+            Some(shifted) => {
+                let length = 63 - shifted.leading_zeros();
+                let top = length > 0 && (shifted >> (length - 1)) & 1 == 1;
+                (length, top)
+            }
+            None => (64, false),
+        };
+        // The same sum, in the same order, as the iterator form: the same f64.
+        let mut unary = 0.0;
+        for (i, m) in self.unary.iter().enumerate().take(length as usize + 1) {
+            unary += m.cost((i as u32) < length);
+        }
         if length == 0 {
             return unary;
         }
-        let top = ((shifted - (1u128 << length)) >> (length - 1)) & 1 == 1;
         let top_cost = self
             .top_bit
             .get(length as usize)
