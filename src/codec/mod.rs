@@ -186,6 +186,12 @@ impl Codec {
         matches!(self, Codec::Tdct)
     }
 
+    /// Whether the automatic choice estimates each candidate's residual bytes with the codec's
+    /// own cheap estimate ([`ResidualEncoder::estimate_bytes`]) and codes only the winner.
+    pub(crate) fn estimated_trials(self) -> bool {
+        matches!(self, Codec::Tdct)
+    }
+
     /// Whether the automatic choice may estimate a candidate from a sample of frames: the frames
     /// are coded each on its own, whereas spread P-frames cost like I-frames and misrank the
     /// candidates (docs/design.md, "Automatic choice: bits at equal error").
