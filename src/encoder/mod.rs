@@ -28,7 +28,7 @@ pub use options::kmeans_ladder;
 pub(crate) use options::MotionModel;
 pub use options::{
     EncodeOptions, PredictorChoice, Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS,
-    DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
+    DEFAULT_PARALLEL_SEGMENTS, DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
 pub use segments::{analysis_frames, encode_source, CodedSegment, SegmentedEncoder};
 

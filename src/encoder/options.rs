@@ -16,6 +16,9 @@ pub const DEFAULT_FIRST_FRAME_BITS: u8 = 12;
 /// the mesh and the step (docs/design.md, "First-frame bits trials and k-means ladder").
 pub const FIRST_FRAME_BITS_TRIED: [u8; 3] = [DEFAULT_FIRST_FRAME_BITS, 10, 8];
 
+/// Segments coded at once unless asked otherwise ([`EncodeOptions::parallel_segments`]).
+pub const DEFAULT_PARALLEL_SEGMENTS: usize = 2;
+
 /// Default `quality`: the middle of the useful range, a target step of 1/1000 of the first frame's
 /// bounding-box diagonal.
 pub const DEFAULT_QUALITY: u8 = 50;
@@ -62,7 +65,8 @@ pub struct EncodeOptions {
     /// clip as one.
     pub segment_frames: Option<usize>,
     /// Segments coded at once (on rayon's threads): memory holds this many segments' working
-    /// data, so the default, 1, keeps an encoding of any length within one segment's.
+    /// data, so the default, [`DEFAULT_PARALLEL_SEGMENTS`], keeps an encoding of any length
+    /// within two segments' while a 2-core machine codes them side by side.
     pub parallel_segments: usize,
 }
 
@@ -81,7 +85,7 @@ impl Default for EncodeOptions {
             reorder: false,
             uv_bits: 12,
             segment_frames: Some(DEFAULT_SEGMENT_FRAMES),
-            parallel_segments: 1,
+            parallel_segments: DEFAULT_PARALLEL_SEGMENTS,
         }
     }
 }

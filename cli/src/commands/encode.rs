@@ -3,7 +3,7 @@
 use crate::args::{BitDepth, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
 use mcgv_video::codec::{Codec, CodecConfig, PictureOptions};
-use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
+use mcgv_video::encoder::{self, EncodeOptions, Segmentation, DEFAULT_PARALLEL_SEGMENTS};
 use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
 use mcgv_video::mesh::input_files;
 use mcgv_video::mesh::ReadOptions;
@@ -60,7 +60,9 @@ pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions>
             Some(n) => Some(usize::try_from(n).unwrap_or(usize::MAX)),
         },
         // `--threads N` also codes N segments at once (memory: N segments' working data).
-        parallel_segments: threads.map_or(1, |n| usize::try_from(n).unwrap_or(1)),
+        parallel_segments: threads.map_or(DEFAULT_PARALLEL_SEGMENTS, |n| {
+            usize::try_from(n).unwrap_or(1)
+        }),
     })
 }
 
