@@ -9,6 +9,7 @@
 //! other threads or machines join into the same stream.
 
 mod attributes;
+mod budget;
 mod options;
 internal! {
     analysis;
@@ -22,6 +23,10 @@ pub use crate::motion::DEFAULT_E0;
 use analysis::Prediction;
 pub use analysis::SegmentationReport;
 pub use auto::{Candidate, ChoiceReport};
+pub use budget::{
+    encode_to_budget, encode_to_budget_with_progress, Budget, BudgetReport, BudgetTrial, Budgeted,
+    MAX_BUDGET_ENCODES,
+};
 pub use first_frame_bits::FirstFrameTrial;
 #[cfg(feature = "internals")]
 pub use options::kmeans_ladder;

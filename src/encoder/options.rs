@@ -35,6 +35,10 @@ pub struct EncodeOptions {
     pub codec: CodecConfig,
     /// Rate knob 1..100 (higher = better).
     pub quality: u8,
+    /// A quality between the integers, 1.0..=100.0, as a budget search finds it
+    /// ([`super::encode_to_budget`]): every codec's law is read at it instead of at `quality`,
+    /// and the stream header records it rounded. `None` (the default) reads `quality`.
+    pub fine_quality: Option<f64>,
     /// Quantiser step (tdct) or pixel step (one grey level, picture codecs) as a fraction of the
     /// first frame's bounding-box diagonal; `None` derives it from `quality`.
     pub step: Option<f64>,
@@ -75,6 +79,7 @@ impl Default for EncodeOptions {
         Self {
             codec: CodecConfig::default(),
             quality: DEFAULT_QUALITY,
+            fine_quality: None,
             step: None,
             affine_precision: None,
             clusters: 20,
@@ -316,6 +321,7 @@ impl EncodeOptions {
     pub fn plan(&self, diagonal: f64) -> Result<RatePlan> {
         let rate = Rate {
             quality: self.quality,
+            fine_quality: self.fine_quality,
             step: self.step,
             affine_precision: self.affine_precision,
         };
@@ -323,6 +329,14 @@ impl EncodeOptions {
     }
 
     fn check_step(&self) -> Result<()> {
+        if let Some(q) = self.fine_quality {
+            if !(1.0..=100.0).contains(&q) {
+                return Err(Error::option(
+                    "fine_quality",
+                    format!("{q}: expected a quality between 1 and 100"),
+                ));
+            }
+        }
         if let Some(step) = self.step {
             if !(step.is_finite() && step > 0.0 && step <= 1.0) {
                 return Err(Error::option(
