@@ -26,8 +26,8 @@ const MAX_OVERSIZED: usize = 32;
 const MAX_QUERY_CELLS: usize = 27;
 
 /// Cell edge over the mean triangle extent: smaller cells list fewer triangles each, but each
-/// triangle joins more cells and a query crosses more cell walls. On pdance 1 took 7.4 CPU-s for
-/// `eval`, 0.7 and 0.5 took 12, 1.5 and 2 took 7.6-8.
+/// triangle joins more cells and a query crosses more cell walls. On pdance 1 took 7.0-7.4 CPU-s
+/// for `eval`; 0.7 and 0.5 took 9-11 (with 2 to 8 buckets per triangle), 1.5 and 2 took 7.6-8.
 const CELL_OVER_EXTENT: f64 = 1.0;
 
 /// The grid; empty (every query left to the tree) until built over finite triangles.
@@ -59,10 +59,11 @@ struct Entry {
 
 impl Entry {
     fn new(b: &[Vec3; 2], triangle: u32) -> Self {
+        // The nearest f32 on the outer side (`f32::next_down` needs a newer Rust than the MSRV).
         let down = |x: f64| {
             let y = x as f32;
             if f64::from(y) > x {
-                y.next_down()
+                step(y, -1)
             } else {
                 y
             }
@@ -70,7 +71,7 @@ impl Entry {
         let up = |x: f64| {
             let y = x as f32;
             if f64::from(y) < x {
-                y.next_up()
+                step(y, 1)
             } else {
                 y
             }
@@ -85,14 +86,27 @@ impl Entry {
     /// Squared distance from `p` to the (widened) box: never more than to the triangle's box.
     fn distance_squared(&self, p: Vec3) -> f64 {
         let mut d2 = 0.0;
-        for a in 0..3 {
-            let d = (f64::from(self.lo[a]) - p[a])
-                .max(p[a] - f64::from(self.hi[a]))
-                .max(0.0);
+        for ((lo, hi), x) in self.lo.iter().zip(&self.hi).zip(&p) {
+            let d = (f64::from(*lo) - x).max(x - f64::from(*hi)).max(0.0);
             d2 += d * d;
         }
         d2
     }
+}
+
+/// The next `f32` after finite or infinite `y` towards +∞ (`dir` 1) or −∞ (−1); NaN stays NaN.
+fn step(y: f32, dir: i32) -> f32 {
+    if y.is_nan() || (y == f32::INFINITY && dir > 0) || (y == f32::NEG_INFINITY && dir < 0) {
+        return y;
+    }
+    if y == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if dir > 0 { tiny } else { -tiny };
+    }
+    // Away from zero is one more in the bit pattern, towards zero one less, whatever the sign.
+    let away = (y > 0.0) == (dir > 0);
+    let bits = y.to_bits();
+    f32::from_bits(if away { bits + 1 } else { bits - 1 })
 }
 
 /// The cell range `lo..=hi` along each axis.
@@ -342,6 +356,19 @@ mod tests {
         }
         // Far hints span too many cells and are left to the tree; near ones are settled.
         assert!(settled > 1000, "{settled}");
+    }
+
+    #[test]
+    fn widened_boxes_hold_the_exact_ones() {
+        for x in [0.1f64, -0.1, 1e-40, -1e-40, 0.0, 3.0, 1e300, -1e300, 16777217.0] {
+            let e = Entry::new(&[[x; 3], [x; 3]], 0);
+            assert!(f64::from(e.lo[0]) <= x && f64::from(e.hi[0]) >= x, "{x}");
+            assert!(e.hi[0] <= step(step(e.lo[0], 1), 1), "{x}: within two steps");
+        }
+        assert_eq!(step(1.0, 1), 1.0 + f32::EPSILON);
+        assert_eq!(step(-1.0, -1), -1.0 - f32::EPSILON);
+        assert_eq!(step(f32::MAX, 1), f32::INFINITY);
+        assert!(step(0.0, -1) < 0.0 && step(-0.0, 1) > 0.0);
     }
 
     #[test]

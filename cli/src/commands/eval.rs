@@ -72,7 +72,7 @@ pub struct FastMeasures {
 
 /// What `eval` accumulates, a run of frames at a time: every measure, or the vertex ones.
 enum Tally {
-    Full(Option<Comparison>),
+    Full(Option<Box<Comparison>>),
     /// Running sums, the original's first-frame diagonal, vertices, frames so far.
     Fast(Option<(VertexSums, f64, usize, usize)>),
 }
@@ -107,7 +107,7 @@ impl Tally {
     /// Sets the comparison up from the two first frames, unless done already.
     fn start(&mut self, original: Surface<'_>, decoded: Surface<'_>) -> Result<()> {
         match self {
-            Self::Full(c @ None) => *c = Some(Comparison::new(original, decoded)?),
+            Self::Full(c @ None) => *c = Some(Box::new(Comparison::new(original, decoded)?)),
             Self::Fast(f @ None) => {
                 let (v, w) = (original.positions.len(), decoded.positions.len());
                 if v != w {
@@ -148,7 +148,7 @@ impl Tally {
 
     fn finish(self) -> Result<Outcome> {
         match self {
-            Self::Full(Some(c)) => Ok(Outcome::Full(c.finish())),
+            Self::Full(Some(c)) => Ok(Outcome::Full((*c).finish())),
             Self::Fast(Some((sums, diagonal, vertices, frames))) => {
                 let e = sums.errors(vertices as f64 * frames.max(1) as f64);
                 Ok(Outcome::Fast(FastMeasures {
