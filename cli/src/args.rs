@@ -383,6 +383,10 @@ pub struct EvalArgs {
     /// tdct streams: decode only the first N temporal-DCT bands before comparing.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub bands: Option<u64>,
+    /// Vertex RMSE and KG error only (and bpvf), skipping the surface measures (RMSE, Hausdorff)
+    /// that take most of the time; needs the same vertex count on both sides.
+    #[arg(long)]
+    pub fast: bool,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,
