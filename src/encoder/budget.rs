@@ -337,18 +337,9 @@ impl<'a> Search<'a> {
     /// and of the prior's sign), or the prior's slope after one encode.
     fn next_log_scale(&self, aim: f64) -> f64 {
         let prior = self.budget.prior_slope(self.codec);
-        let above = |p: &&(f64, f64)| p.1 > aim;
-        // The nearest encodes on either side of the aim, in log scale.
-        let nearest = |over: bool| {
-            self.points
-                .iter()
-                .filter(|p| above(p) == over)
-                .min_by(|a, b| (a.1 - aim).abs().total_cmp(&(b.1 - aim).abs()))
-                .copied()
-        };
-        if let (Some(hi), Some(lo)) = (nearest(true), nearest(false)) {
-            let t = ((aim - lo.1) / (hi.1 - lo.1)).clamp(0.1, 0.9);
-            return lo.0 + t * (hi.0 - lo.0);
+        if let Some((below, above)) = self.bracket(aim) {
+            let t = ((aim - below.1) / (above.1 - below.1)).clamp(0.1, 0.9);
+            return below.0 + t * (above.0 - below.0);
         }
         let last = self.points[self.points.len() - 1];
         let slope = match self.points.len() {
@@ -364,6 +355,27 @@ impl<'a> Search<'a> {
             _ => prior,
         };
         last.0 + (aim - last.1) / slope
+    }
+
+    /// Two encodes next to each other in log scale whose measures lie on either side of the aim
+    /// (below, above): of such pairs, the one with an end nearest the aim. Adjacent in the step,
+    /// not nearest in the measure, so that a measure that is not monotone (the largest vertex
+    /// error jumps from one quality to the next) still narrows the bracket at each encode.
+    fn bracket(&self, aim: f64) -> Option<((f64, f64), (f64, f64))> {
+        let mut sorted = self.points.clone();
+        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        sorted
+            .windows(2)
+            .filter(|w| (w[0].1 > aim) != (w[1].1 > aim))
+            .map(|w| match w[0].1 > aim {
+                true => (w[1], w[0]),
+                false => (w[0], w[1]),
+            })
+            .min_by(|x, y| {
+                let near =
+                    |p: &((f64, f64), (f64, f64))| (p.0 .1 - aim).abs().min((p.1 .1 - aim).abs());
+                near(x).total_cmp(&near(y))
+            })
     }
 
     /// The model asks for a quality already coded: the search is at an end of the quality range
