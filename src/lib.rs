@@ -42,7 +42,8 @@
 //! - Encoding: [`encode`] with [`EncodeOptions`] — the options every codec shares, and in
 //!   [`EncodeOptions::codec`] a [`CodecConfig`] holding the chosen codec's own ([`codec`]).
 //!   [`Encoded::report`] says what it did; [`encoder::SegmentedEncoder`] codes a long clip's
-//!   temporal segments one by one, on any thread or machine.
+//!   temporal segments one by one, on any thread or machine. [`encode_to_budget`] finds the
+//!   quality whose stream fits a [`Budget`]: bytes, bits per vertex and frame, or an error bound.
 //! - Decoding: [`Decoder`] opens a stream, decodes one frame alone or all of them, and
 //!   [`Decoder::describe`] says what the codec stored.
 //! - Measuring: [`metrics`] (RMSE, Hausdorff, vertex RMSE, KG error), [`inspect`] (the images a
@@ -104,8 +105,8 @@ pub use codec::{Codec, CodecConfig, Description};
 pub use decoder::{DecodeOptions, Decoder, FirstFrame};
 #[cfg(feature = "encode")]
 pub use encoder::{
-    encode, encode_source, encode_with_progress, EncodeOptions, EncodeReport, Encoded,
-    PredictorChoice, Segmentation, SegmentationChoice,
+    encode, encode_source, encode_to_budget, encode_with_progress, Budget, EncodeOptions,
+    EncodeReport, Encoded, PredictorChoice, Segmentation, SegmentationChoice,
 };
 pub use error::{Error, Result};
 pub use geometry_image::Lattice;

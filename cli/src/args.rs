@@ -34,6 +34,8 @@ pub enum Command {
     #[command(after_help = "Examples:
   mcgv-video encode media/CesiumMan.glb -o cesium.mcgv
   mcgv-video encode 'frames/*.obj' -o walk.mcgv --quality 70
+  mcgv-video encode media/CesiumMan.glb -o cesium.mcgv --target-size 30000
+  mcgv-video encode media/CesiumMan.glb -o cesium.mcgv --codec av1 --target-error 2e-4
   mcgv-video encode media/Fox.glb --clip all -o fox.mcgv   # fox-Survey.mcgv, fox-Walk.mcgv, ...")]
     Encode(EncodeArgs),
     /// Decode a .mcgv file to an OBJ sequence (a folder), one OBJ or a PC2 point cache.
@@ -112,9 +114,27 @@ pub struct EncodeArgs {
     /// mpeg4, hevc and av1 (10/12-bit pictures) suit hardware video decoders.
     #[arg(long, default_value_t = Codec::default(), value_parser = codec_names())]
     pub codec: Codec,
-    /// Rate knob for every codec, 1..100 (higher = better quality, more bits; default 50).
-    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
-    pub quality: Option<u8>,
+    /// Rate knob for every codec, 1..100 (higher = better quality, more bits; default 50);
+    /// between the integers too (e.g. 47.31, as a --target-* search reports it). With a --target-*
+    /// flag: where the search starts.
+    #[arg(long, value_parser = parse_quality)]
+    pub quality: Option<f64>,
+    /// Budget: the stream's bytes at most; the encoder searches the quality whose stream lands
+    /// within 2 % under it (at most 10 encodes, usually 2 or 3; docs/design.md, "Budgets").
+    #[arg(long, value_name = "BYTES", group = "target", conflicts_with = "step",
+          value_parser = clap::value_parser!(u64).range(1..))]
+    pub target_size: Option<u64>,
+    /// Budget: bits per vertex and frame at most (as --target-size).
+    #[arg(long, value_name = "X", group = "target", conflicts_with = "step")]
+    pub target_bpvf: Option<f64>,
+    /// Budget: vertex RMSE (as a fraction of the first frame's bounding-box diagonal, eval's
+    /// vertex_rmse) at most; the search lands within 3 % under it.
+    #[arg(long, value_name = "E", group = "target", conflicts_with = "step")]
+    pub target_error: Option<f64>,
+    /// Budget: the largest displacement of any vertex in any frame (a fraction of the diagonal)
+    /// at most; the search lands within 3 % under it.
+    #[arg(long, value_name = "E", group = "target", conflicts_with = "step")]
+    pub target_max_error: Option<f64>,
     /// MPEG-4 quantiser 1..31 (lower = better); overrides the one --quality sets for mpeg4.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=31))]
     pub qscale: Option<u8>,
@@ -209,6 +229,14 @@ pub enum BitDepth {
     Auto,
     /// 10 or 12 bits.
     Bits(u8),
+}
+
+/// `--quality`: 1..=100, between the integers too.
+fn parse_quality(value: &str) -> Result<f64, String> {
+    match value.trim().parse::<f64>() {
+        Ok(q) if (1.0..=100.0).contains(&q) => Ok(q),
+        _ => Err(format!("{value}: expected a quality between 1 and 100")),
+    }
 }
 
 fn parse_bit_depth(value: &str) -> Result<BitDepth, String> {
@@ -355,6 +383,10 @@ pub struct EvalArgs {
     /// tdct streams: decode only the first N temporal-DCT bands before comparing.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub bands: Option<u64>,
+    /// Vertex RMSE and KG error only (and bpvf), skipping the surface measures (RMSE, Hausdorff)
+    /// that take most of the time; needs the same vertex count on both sides.
+    #[arg(long)]
+    pub fast: bool,
     /// Print the result as one JSON object.
     #[arg(long)]
     pub json: bool,

@@ -196,7 +196,8 @@ pub fn encode_options(
         reorder: k.typed::<bool>("reorder", "a bool")?.unwrap_or(false),
         uv_bits: k.int::<u8>("uv_bits")?.unwrap_or(defaults.uv_bits),
         segment_frames,
-        parallel_segments: threads.unwrap_or(1),
+        parallel_segments: threads.unwrap_or(defaults.parallel_segments),
+        fine_quality: None,
     })
 }
 

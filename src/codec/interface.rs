@@ -71,6 +71,13 @@ impl CodedResiduals {
 pub(crate) trait ResidualEncoder {
     /// Codes every frame's residuals.
     fn encode(&self, input: &ResidualInput) -> Result<CodedResiduals>;
+
+    /// The bytes of the parts [`Self::encode`] would give, estimated at a fraction of its cost,
+    /// close enough to rank the automatic choice's candidates; `None` when the codec has no such
+    /// estimate (its trials code in full).
+    fn estimate_bytes(&self, _input: &ResidualInput) -> Result<Option<u64>> {
+        Ok(None)
+    }
 }
 
 /// What every residual decoder may need of the stream, read before it.

@@ -40,8 +40,9 @@ pub(crate) use pictures::geometry_video;
 pub use pictures::jpeg::JpegConfig;
 pub use pictures::mpeg4::Mpeg4Config;
 pub use pictures::{PictureOptions, Plane, DEFAULT_GOP};
+pub(crate) use rate::ijg_scale_percent;
 pub(crate) use rate::Rate;
-pub use rate::{target_step, RatePlan};
+pub use rate::{fine_scale_percent, target_step, RatePlan};
 pub use tdct::TdctConfig;
 
 use crate::error::{Error, Result};
@@ -183,6 +184,12 @@ impl Codec {
     /// plan's step: the automatic choice may then try more candidates (a k-means ladder, coarser
     /// first frames) and compare them by bytes alone.
     pub(crate) fn cheap_exact_trials(self) -> bool {
+        matches!(self, Codec::Tdct)
+    }
+
+    /// Whether the automatic choice estimates each candidate's residual bytes with the codec's
+    /// own cheap estimate ([`ResidualEncoder::estimate_bytes`]) and codes only the winner.
+    pub(crate) fn estimated_trials(self) -> bool {
         matches!(self, Codec::Tdct)
     }
 
@@ -437,6 +444,7 @@ mod tests {
     fn affine_precision_is_fine_only_for_p_frames_that_suffer_from_coarse_maps() {
         let rate = |affine_precision| Rate {
             quality: 50,
+            fine_quality: None,
             step: None,
             affine_precision,
         };

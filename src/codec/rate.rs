@@ -17,6 +17,8 @@ use crate::motion;
 pub(crate) struct Rate {
     /// The rate knob 1..100.
     pub quality: u8,
+    /// A quality between the integers (1.0..=100.0) read instead of `quality` by every law.
+    pub fine_quality: Option<f64>,
     /// An explicit residual step as a fraction of the bounding-box diagonal (overrides the law).
     pub step: Option<f64>,
     /// An explicit affine precision `k` (affine step = k × residual step fraction).
@@ -34,6 +36,19 @@ pub fn ijg_scale_percent(quality: u8) -> u32 {
     }
 }
 
+/// The IJG scale in percent at a quality between the integers (1.0..=100.0, clamped): log-linear
+/// between the scales of the integers around it, so that it meets [`ijg_scale_percent`] (at least
+/// 1) at every integer and falls strictly between them.
+pub fn fine_scale_percent(quality: f64) -> f64 {
+    let q = quality.clamp(1.0, 100.0);
+    let (below, above) = (q.floor(), q.ceil());
+    let at = |q: f64| f64::from(ijg_scale_percent(q as u8).max(1));
+    if below == above {
+        return at(below);
+    }
+    at(below) * (at(above) / at(below)).powf(q - below)
+}
+
 /// The target step of `quality` in model units, for a first frame of bounding-box diagonal
 /// `diagonal`: 1e-3 × diagonal × the IJG scale (1 % at quality 99 and 100, so never 0).
 pub fn target_step(quality: u8, diagonal: f64) -> f64 {
@@ -42,6 +57,33 @@ pub fn target_step(quality: u8, diagonal: f64) -> f64 {
 }
 
 impl Rate {
+    /// The quality every law reads: the fine one when given.
+    pub fn level(&self) -> f64 {
+        self.fine_quality.unwrap_or(f64::from(self.quality))
+    }
+
+    /// The IJG scale in percent of [`Rate::level`] (at least 1).
+    pub fn scale_percent(&self) -> f64 {
+        match self.fine_quality {
+            Some(q) => fine_scale_percent(q),
+            None => f64::from(ijg_scale_percent(self.quality).max(1)),
+        }
+    }
+
+    /// The target step in model units on a first frame of diagonal `diagonal` ([`target_step`]
+    /// at [`Rate::level`]).
+    pub fn target_step(&self, diagonal: f64) -> f64 {
+        diagonal * 1e-3 * self.scale_percent() / 100.0
+    }
+
+    /// The quality the stream header records: the fine one rounded.
+    fn label(&self) -> u8 {
+        match self.fine_quality {
+            Some(q) => q.round().clamp(1.0, 100.0) as u8,
+            None => self.quality,
+        }
+    }
+
     /// The residual step in model units: the explicit `step` × `diagonal`, else `factor` × the
     /// quality's target step; rounded to the `f32` the stream stores, so that the encoder
     /// quantises with exactly the step the decoder reads. `what` names the step in the error a
@@ -49,7 +91,7 @@ impl Rate {
     pub fn stored_step(&self, what: &str, diagonal: f64, factor: f64) -> Result<f32> {
         let step = match self.step {
             Some(fraction) => diagonal * fraction,
-            None => factor * target_step(self.quality, diagonal),
+            None => factor * self.target_step(diagonal),
         };
         let stored = step as f32;
         if !(stored.is_normal() && stored > 0.0) {
@@ -80,10 +122,10 @@ impl Rate {
         pictures: Option<PicturePlan>,
     ) -> RatePlan {
         let affine_precision = self.affine_precision_code(default_affine_precision);
-        let fraction = self.step.unwrap_or_else(|| target_step(self.quality, 1.0));
+        let fraction = self.step.unwrap_or_else(|| self.target_step(1.0));
         let k = f64::from(affine_precision) / 16.0;
         RatePlan {
-            quality: self.quality,
+            quality: self.label(),
             step,
             affine_step: (fraction * k).clamp(motion::MIN_AFFINE_STEP, motion::MAX_AFFINE_STEP),
             affine_precision,
@@ -138,14 +180,18 @@ pub(crate) const fn anchor(quality: u8, step_factor: f64, quantiser: u8) -> Anch
     }
 }
 
-/// The law given by `anchors` (in rising quality, the first at quality 1) read at `quality`.
-pub(crate) fn read_law(anchors: &[Anchor], quality: u8) -> PictureLaw {
-    let q = quality.clamp(1, 100);
-    let i = anchors.iter().rposition(|a| a.quality <= q).unwrap_or(0);
+/// The law given by `anchors` (in rising quality, the first at quality 1) read at `quality`
+/// (between the integers too).
+pub(crate) fn read_law(anchors: &[Anchor], quality: f64) -> PictureLaw {
+    let q = quality.clamp(1.0, 100.0);
+    let i = anchors
+        .iter()
+        .rposition(|a| f64::from(a.quality) <= q)
+        .unwrap_or(0);
     let here = &anchors[i];
     let step_factor = match anchors.get(i + 1) {
         Some(next) => {
-            let t = f64::from(q - here.quality) / f64::from(next.quality - here.quality);
+            let t = (q - f64::from(here.quality)) / f64::from(next.quality - here.quality);
             here.step_factor * (next.step_factor / here.step_factor).powf(t)
         }
         None => here.step_factor,
@@ -174,6 +220,7 @@ mod tests {
     fn the_affine_step_follows_the_residual_step_and_the_precision() {
         let rate = |step, affine_precision| Rate {
             quality: 50,
+            fine_quality: None,
             step,
             affine_precision,
         };

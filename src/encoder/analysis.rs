@@ -7,7 +7,8 @@ use crate::error::{Error, Result};
 use crate::first_frame::{self, EncodedFirstFrame, FirstFrameOptions};
 use crate::mesh::{AnimatedMesh, Point};
 use crate::motion::{
-    self, AffineTrack, DecimateOptions, Partition, PredictorKind, SegmentOptions, SkinningWeights,
+    self, AffineTrack, DecimateOptions, MotionDescriptors, Partition, PredictorKind, SegmentOptions,
+    SkinningWeights,
 };
 use std::time::Instant;
 
@@ -65,33 +66,68 @@ pub fn segment(
     segmentation: Segmentation,
     clusters: usize,
 ) -> Result<(Partition, SegmentationReport)> {
-    let start = Instant::now();
-    let (partition, e0, error, components) = match segmentation {
-        Segmentation::KMeans => {
-            let options = SegmentOptions {
-                clusters,
-                ..SegmentOptions::default()
-            };
-            (motion::segment(mesh, &options)?, None, None, None)
+    Segmenter::new(mesh).segment(segmentation, clusters)
+}
+
+/// Segments one animation several ways, keeping what every K of k-means shares (the motion
+/// descriptors, most of a segmentation's time after k-means itself).
+pub struct Segmenter<'a> {
+    mesh: &'a AnimatedMesh,
+    descriptors: std::sync::OnceLock<MotionDescriptors>,
+}
+
+impl<'a> Segmenter<'a> {
+    /// A segmenter of `mesh`; nothing is computed until a segmentation is asked for.
+    pub fn new(mesh: &'a AnimatedMesh) -> Self {
+        Self {
+            mesh,
+            descriptors: std::sync::OnceLock::new(),
         }
+    }
+
+    /// The motion segmentation `segmentation` (k-means into `clusters`), and what it did.
+    pub fn segment(
+        &self,
+        segmentation: Segmentation,
+        clusters: usize,
+    ) -> Result<(Partition, SegmentationReport)> {
+        let start = Instant::now();
+        let (partition, e0, error, components) = match segmentation {
+            Segmentation::KMeans => (self.kmeans(clusters)?, None, None, None),
         Segmentation::Decimation { e0 } => {
             let options = DecimateOptions {
                 e0,
                 ..DecimateOptions::default()
             };
-            let d = motion::decimate(mesh, &options)?;
+            let d = motion::decimate(self.mesh, &options)?;
             (d.partition, Some(e0), Some(d.error), Some(d.components))
         }
     };
-    let report = SegmentationReport {
-        method: segmentation.name(),
-        clusters: partition.clusters(),
-        seconds: start.elapsed().as_secs_f64(),
-        e0,
-        error,
-        components,
-    };
-    Ok((partition, report))
+        let report = SegmentationReport {
+            method: segmentation.name(),
+            clusters: partition.clusters(),
+            seconds: start.elapsed().as_secs_f64(),
+            e0,
+            error,
+            components,
+        };
+        Ok((partition, report))
+    }
+
+    /// k-means into `clusters` on the descriptors made at the first call.
+    fn kmeans(&self, clusters: usize) -> Result<Partition> {
+        let options = SegmentOptions {
+            clusters,
+            ..SegmentOptions::default()
+        };
+        if clusters.min(self.mesh.vertex_count()) <= 1 {
+            return motion::segment(self.mesh, &options);
+        }
+        let descriptors = self
+            .descriptors
+            .get_or_init(|| MotionDescriptors::new(self.mesh, &options));
+        descriptors.segment(&options)
+    }
 }
 
 /// The quantised predictor `kind` (affine track at base step `affine_step`, skinning weights of

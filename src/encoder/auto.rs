@@ -16,7 +16,7 @@
 //! sample's bytes alone can keep a candidate whose whole stream is both larger and worse
 //! (docs/design.md, "Automatic choice: bits at equal error").
 
-use super::{analysis, assemble, code, distortion, header, Analysed, Encoded, Settings, Stopwatch};
+use super::{analysis, assemble, code, distortion, estimate, header, Analysed, Encoded, Settings, Stopwatch};
 use crate::codec::ResidualInput;
 use crate::encoder::{MotionModel, Segmentation};
 use crate::error::{Error, Result};
@@ -26,6 +26,7 @@ use crate::mesh::{AnimatedMesh, Point};
 use crate::motion::{Partition, PredictorKind};
 use crate::progress::Progress;
 use crate::stream::container::Part;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Frames the picture codecs' trials code per candidate when the animation has more than twice
@@ -55,8 +56,15 @@ pub struct Candidate {
     pub segmentation: &'static str,
     /// Clusters its segmentation found.
     pub clusters: usize,
-    /// Its stream's bytes (estimated when the trial coded a sample of frames).
+    /// Its stream's bytes: measured for the one kept; for the others, estimated when the trials
+    /// estimate (tdct's from one cheap pass over the bands, the picture codecs' from a sample of
+    /// frames).
     pub bytes: u64,
+    /// Whether `bytes` is an estimate.
+    pub estimated: bool,
+    /// The estimate the choice ranked it by, when tdct's trials estimated it (the kept one's too,
+    /// whose `bytes` are then measured).
+    pub estimate: Option<u64>,
     /// Its decoded stream's RMS vertex error over the first frame's bounding-box diagonal, when
     /// the choice weighed errors (picture codecs; a sampled trial's over its sample's frames).
     pub vertex_rmse: Option<f64>,
@@ -88,6 +96,10 @@ type Trial<'a> = (
 
 /// Tries every motion model of `models` on `mesh` (already in the stream's vertex order, its
 /// first frame coded as `ff`) and returns the smallest stream, its report saying why.
+///
+/// Each segmentation and the candidates on it are one job, the jobs run on rayon's threads, and
+/// the winner is the lowest cost, the earliest candidate on a tie, whatever order the jobs end
+/// in: the same stream on any number of threads.
 pub(super) fn choose(
     mesh: &AnimatedMesh,
     ff: &EncodedFirstFrame,
@@ -100,7 +112,8 @@ pub(super) fn choose(
     let sample = Sample::of(mesh, settings)?;
     let frames = mesh.frame_count();
     let trial_frames = sample.as_ref().map_or(frames, |s| s.frames.len());
-    let final_frames = if sample.is_some() { frames } else { 0 };
+    let estimated = sample.is_some() || settings.opts.codec.codec().estimated_trials();
+    let final_frames = if estimated { frames } else { 0 };
     progress.total((models.len() * trial_frames + final_frames) as u64);
     let shared = Shared {
         mesh,
@@ -109,27 +122,100 @@ pub(super) fn choose(
         settings,
         sample: sample.as_ref(),
     };
-    let reference = &ff.decoded_positions;
-    let mut candidates = Vec::with_capacity(models.len());
-    let mut costs = Vec::with_capacity(models.len());
-    let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
-    let mut best: Option<Best> = None;
+    let segmenter = analysis::Segmenter::new(mesh);
     let segmentations = segmentations(models);
     let atlases: Vec<AtlasCache> = segmentations
         .iter()
         .map(|_| AtlasCache::default())
         .collect();
+    let mut jobs = Vec::with_capacity(segmentations.len());
     for (&(segmentation, k), atlas) in segmentations.iter().zip(&atlases) {
+        let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);
+        let first = jobs.iter().map(|j: &Job| j.models.len()).sum();
+        let models = models.iter().filter(same).copied().collect();
+        jobs.push(Job {
+            segmentation: (segmentation, k),
+            models,
+            first,
+            atlas,
+        });
+    }
+    let outcomes = jobs
+        .par_iter()
+        .map(|job| job.run(&shared, &segmenter, progress))
+        .collect::<Result<Vec<Outcome>>>()?;
+    let (mut candidates, mut costs, mut best) = (Vec::new(), Vec::new(), None::<Best>);
+    for outcome in outcomes {
+        clock.stages.extend(outcome.stages);
+        candidates.extend(outcome.candidates);
+        costs.extend(outcome.costs);
+        if let Some(b) = outcome.best {
+            if best.as_ref().is_none_or(|best| b.cost < best.cost) {
+                best = Some(b);
+            }
+        }
+    }
+    let best = best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
+    let model = models[best.index];
+    let reason = reason(&candidates, &costs, best.index, (trial_frames, frames));
+    let mut encoded = keep(&shared, model, best.kept, progress, clock)?;
+    if sample.is_none() && candidates[best.index].estimated {
+        // The kept one's size is its stream's now, not an estimate.
+        candidates[best.index].bytes = encoded.report.bytes;
+        candidates[best.index].estimated = false;
+    }
+    encoded.report.choice = Some(ChoiceReport {
+        chosen: model.name(),
+        trial_frames,
+        reason,
+        candidates,
+    });
+    Ok(encoded)
+}
+
+/// One segmentation and the candidates that use it, numbered from `first` among all.
+struct Job<'a> {
+    segmentation: (Segmentation, usize),
+    models: Vec<MotionModel>,
+    first: usize,
+    atlas: &'a AtlasCache,
+}
+
+/// What a job measured: its candidates and their costs, its stages' seconds, its best.
+struct Outcome<'a> {
+    candidates: Vec<Candidate>,
+    costs: Vec<f64>,
+    stages: Vec<(String, f64)>,
+    best: Option<Best<'a>>,
+}
+
+impl<'a> Job<'a> {
+    /// Segments, fits the affine track every predictor builds on, and tries each candidate.
+    fn run(
+        &self,
+        shared: &Shared,
+        segmenter: &analysis::Segmenter,
+        progress: &dyn Progress,
+    ) -> Result<Outcome<'a>> {
+        let (segmentation, k) = self.segmentation;
+        let (mesh, settings) = (shared.mesh, shared.settings);
         let stage = match segmentation {
             Segmentation::KMeans => format!("segmentation (kmeans, K = {k})"),
             Segmentation::Decimation { .. } => "segmentation (decimation)".to_string(),
         };
         progress.stage(&stage);
-        let (partition, segmented) = analysis::segment(mesh, segmentation, k)?;
+        let start = Instant::now();
+        let (partition, segmented) = segmenter.segment(segmentation, k)?;
+        let reference = &shared.ff.decoded_positions;
         let track = analysis::fit_track(mesh, reference, &partition, settings.plan.affine_step)?;
-        clock.lap(&stage);
-        let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);
-        for &model in models.iter().filter(same) {
+        let mut outcome = Outcome {
+            candidates: Vec::new(),
+            costs: Vec::new(),
+            stages: vec![(stage, start.elapsed().as_secs_f64())],
+            best: None,
+        };
+        let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
+        for (i, &model) in self.models.iter().enumerate() {
             let start = Instant::now();
             let progress = Labelled {
                 inner: progress,
@@ -144,43 +230,40 @@ pub(super) fn choose(
                 partition: &partition,
                 segmentation: segmented.clone(),
                 prediction: &prediction,
-                atlas: Some(atlas),
+                atlas: Some(self.atlas),
             };
-            let (bytes, encoded, error) = trial(&shared, &analysed, &progress)?;
+            let (bytes, encoded, error) = trial(shared, &analysed, &progress)?;
             let cost = distortion::cost(8.0 * bytes as f64, error);
-            let kept = match encoded {
-                Some(encoded) => Kept::Stream(Box::new(encoded)),
-                None => {
-                    let analysis = (partition.clone(), segmented.clone(), prediction, atlas);
-                    Kept::Analysis(Box::new(analysis))
-                }
-            };
-            clock.lap(&format!("trial {}", model.name()));
-            candidates.push(Candidate {
+            outcome.candidates.push(Candidate {
                 predictor: model.predictor,
                 segmentation: segmentation.name(),
                 clusters: partition.clusters(),
                 bytes,
+                estimated: encoded.is_none(),
+                estimate: (encoded.is_none() && shared.sample.is_none()).then_some(bytes),
                 vertex_rmse: error.map(|e| e / diagonal),
                 seconds: start.elapsed().as_secs_f64(),
             });
-            costs.push(cost);
-            if best.as_ref().is_none_or(|b| cost < b.cost) {
-                let index = candidates.len() - 1;
-                best = Some(Best { index, cost, kept });
+            let seconds = start.elapsed().as_secs_f64();
+            outcome.stages.push((format!("trial {}", model.name()), seconds));
+            outcome.costs.push(cost);
+            if outcome.best.as_ref().is_none_or(|b| cost < b.cost) {
+                let kept = match encoded {
+                    Some(encoded) => Kept::Stream(Box::new(encoded)),
+                    None => {
+                        let analysis = (partition.clone(), segmented.clone(), prediction);
+                        Kept::Analysis(Box::new((analysis.0, analysis.1, analysis.2, self.atlas)))
+                    }
+                };
+                outcome.best = Some(Best {
+                    index: self.first + i,
+                    cost,
+                    kept,
+                });
             }
         }
+        Ok(outcome)
     }
-    let best = best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
-    let model = models[best.index];
-    let mut encoded = keep(&shared, model, best.kept, progress, clock)?;
-    encoded.report.choice = Some(ChoiceReport {
-        chosen: model.name(),
-        trial_frames,
-        reason: reason(&candidates, &costs, best.index, (trial_frames, frames)),
-        candidates,
-    });
-    Ok(encoded)
 }
 
 /// What every trial shares: the animation (in the stream's vertex order), its coded first frame
@@ -204,6 +287,11 @@ fn trial(
         mesh, ff, settings, ..
     } = *shared;
     match shared.sample {
+        None if settings.opts.codec.codec().estimated_trials() => {
+            let ff_and_leading = (shared.ff, shared.leading);
+            let bytes = estimate(mesh, ff_and_leading, settings, analysed, progress)?;
+            Ok((bytes, None, None))
+        }
         None => {
             let leading = shared.leading.to_vec();
             let encoded = code(
@@ -304,8 +392,13 @@ fn reason(
         ),
         (Some(next), None) => {
             let next = &candidates[next];
+            let what = match winner.estimated {
+                true => "smallest estimate (one cheap pass over the residuals; the kept one then \
+                         coded in full)",
+                false => "smallest stream",
+            };
             format!(
-                "smallest stream at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
+                "{what} at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
                 winner.bytes,
                 100.0 * (1.0 - winner.bytes as f64 / next.bytes.max(1) as f64),
                 name(next),

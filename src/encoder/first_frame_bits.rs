@@ -10,7 +10,7 @@
 //! the other precisions are coded with it fixed: the model follows the motion, the precision the
 //! first frame's shape.
 
-use super::{encode_once, EncodeOptions, Encoded, PredictorChoice, Settings};
+use super::{encode_once, estimate_once, EncodeOptions, Encoded, PredictorChoice, Settings};
 use crate::error::Result;
 use crate::mesh::AnimatedMesh;
 use crate::progress::Progress;
@@ -23,8 +23,11 @@ pub use super::options::FIRST_FRAME_BITS_TRIED;
 pub struct FirstFrameTrial {
     /// Bits per coordinate of the first frame.
     pub bits: u8,
-    /// The stream's bytes at that precision.
+    /// The stream's bytes at that precision (estimated, see `estimated`).
     pub bytes: u64,
+    /// Whether `bytes` is the codec's estimate (tdct: a precision whose estimate did not beat
+    /// the kept one's is not coded in full).
+    pub estimated: bool,
 }
 
 /// Codes `mesh` at the precisions of [`FIRST_FRAME_BITS_TRIED`], finer to coarser until one does
@@ -42,6 +45,7 @@ pub(super) fn choose(
         inner: progress,
         extra: others.len() as u64 * frames,
         first: AtomicU64::new(0),
+        grown: AtomicU64::new(0),
         told: AtomicBool::new(false),
     };
     let at = |bits: u8, base: &EncodeOptions| EncodeOptions {
@@ -63,15 +67,47 @@ pub(super) fn choose(
     let mut trials = vec![FirstFrameTrial {
         bits: default,
         bytes: best.report.bytes,
+        estimated: false,
     }];
+    // With a codec that estimates (tdct), precisions are compared by their estimates, and only
+    // one that beats the kept one's is coded in full.
+    let chosen = best.report.choice.as_ref().and_then(|c| {
+        let kept = c.candidates.iter().find(|k| !k.estimated)?;
+        kept.estimate
+    });
+    // A fixed model has no estimate to compare with: its precisions are coded in full.
+    let mut best_estimate = chosen;
     for bits in others {
         progress.stage(&format!("first frame at {bits} bits"));
         let opts = at(bits, &model);
         let settings = Settings { opts: &opts, plan };
-        let encoded = encode_once(mesh, settings, &progress, known.clone())?;
+        let encoded = match best_estimate {
+            Some(estimate_before) => {
+                let fixed = (best.model, known.clone());
+                let Some((estimate, analysis)) = estimate_once(mesh, settings, &progress, fixed)?
+                else {
+                    break;
+                };
+                if estimate >= estimate_before {
+                    trials.push(FirstFrameTrial {
+                        bits,
+                        bytes: estimate,
+                        estimated: true,
+                    });
+                    progress.retell(trials.len() as u64 - 1, frames);
+                    break;
+                }
+                best_estimate = Some(estimate);
+                // Coded in full after its estimate: its frames count twice.
+                progress.grow(frames);
+                analysis.code(settings, &progress)?
+            }
+            None => encode_once(mesh, settings, &progress, known.clone())?,
+        };
         trials.push(FirstFrameTrial {
             bits,
             bytes: encoded.report.bytes,
+            estimated: false,
         });
         if encoded.report.bytes >= best.report.bytes {
             // Coarser has not helped where this did not
@@ -92,6 +128,8 @@ pub(super) fn choose(
 struct Ahead<'a> {
     inner: &'a dyn Progress,
     extra: u64,
+    /// Frames added to the work since it was told ([`Ahead::grow`]).
+    grown: AtomicU64,
     /// The first encoding's own total.
     first: AtomicU64,
     told: AtomicBool,
@@ -100,8 +138,16 @@ struct Ahead<'a> {
 impl Ahead<'_> {
     /// Tells the total again when the trials stop after `run` of them, `frames` frames each.
     fn retell(&self, run: u64, frames: u64) {
+        let grown = self.grown.load(Ordering::Relaxed);
         self.inner
-            .total(self.first.load(Ordering::Relaxed) + run * frames);
+            .total(self.first.load(Ordering::Relaxed) + run * frames + grown);
+    }
+
+    /// Adds `frames` to the work ahead and tells the new total.
+    fn grow(&self, frames: u64) {
+        let grown = self.grown.fetch_add(frames, Ordering::Relaxed) + frames;
+        self.inner
+            .total(self.first.load(Ordering::Relaxed) + self.extra + grown);
     }
 }
 

@@ -9,6 +9,7 @@
 //! other threads or machines join into the same stream.
 
 mod attributes;
+mod budget;
 mod options;
 internal! {
     analysis;
@@ -22,20 +23,24 @@ pub use crate::motion::DEFAULT_E0;
 use analysis::Prediction;
 pub use analysis::SegmentationReport;
 pub use auto::{Candidate, ChoiceReport};
+pub use budget::{
+    encode_to_budget, encode_to_budget_with_progress, Budget, BudgetReport, BudgetTrial, Budgeted,
+    MAX_BUDGET_ENCODES,
+};
 pub use first_frame_bits::FirstFrameTrial;
 #[cfg(feature = "internals")]
 pub use options::kmeans_ladder;
 pub(crate) use options::MotionModel;
 pub use options::{
     EncodeOptions, PredictorChoice, Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS,
-    DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
+    DEFAULT_PARALLEL_SEGMENTS, DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
 pub use segments::{
     analysis_clip, analysis_frames, encode_source, segment_ranges, CodedSegment, SegmentedEncoder,
 };
 
 use crate::codec::{Codec, RatePlan, ResidualInput};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::AnimatedMesh;
@@ -153,37 +158,157 @@ fn encode_once(
     progress: &dyn Progress,
     known: Option<(Partition, SegmentationReport)>,
 ) -> Result<Encoded> {
-    let opts = settings.opts;
     let mut clock = Stopwatch::new();
     progress.stage("first frame");
-    let (ff, permuted) = analysis::first_frame(mesh, opts)?;
+    let (ff, permuted) = analysis::first_frame(mesh, settings.opts)?;
     let mesh = permuted.as_ref().unwrap_or(mesh);
-    let leading = leading_parts(mesh, &ff.bytes, opts)?;
+    let leading = leading_parts(mesh, &ff.bytes, settings.opts)?;
     clock.lap("first frame");
-    let models = opts.motion_models();
+    let models = settings.opts.motion_models();
     let [model] = models[..] else {
         return auto::choose(mesh, &ff, leading, settings, &models, progress, clock);
     };
     progress.total(mesh.frame_count() as u64);
-    progress.stage("segmentation");
-    let (partition, segmentation) = match known {
-        Some(known) => known,
-        None => analysis::segment(mesh, model.segmentation, model.clusters)?,
+    let once = Once::analyse(mesh, &ff, settings, model, known, &mut clock)?;
+    code(
+        mesh,
+        &ff,
+        leading,
+        settings,
+        &once.analysed(),
+        progress,
+        clock,
+    )
+}
+
+/// One motion model's analysis of an animation whose first frame is coded: its segmentation and
+/// prediction.
+struct Once {
+    model: MotionModel,
+    partition: Partition,
+    segmentation: SegmentationReport,
+    prediction: Prediction,
+}
+
+impl Once {
+    fn analyse(
+        mesh: &AnimatedMesh,
+        ff: &EncodedFirstFrame,
+        settings: Settings,
+        model: MotionModel,
+        known: Option<(Partition, SegmentationReport)>,
+        clock: &mut Stopwatch,
+    ) -> Result<Self> {
+        let (partition, segmentation) = match known {
+            Some(known) => known,
+            None => analysis::segment(mesh, model.segmentation, model.clusters)?,
+        };
+        clock.lap("segmentation");
+        let reference = &ff.decoded_positions;
+        let steps = (settings.plan.affine_step, settings.opts.weight_bits);
+        let prediction = analysis::predict(mesh, reference, &partition, steps, model.predictor)?;
+        clock.lap("motion");
+        Ok(Self {
+            model,
+            partition,
+            segmentation,
+            prediction,
+        })
+    }
+
+    fn analysed(&self) -> Analysed<'_> {
+        Analysed {
+            model: self.model,
+            partition: &self.partition,
+            segmentation: self.segmentation.clone(),
+            prediction: &self.prediction,
+            atlas: None,
+        }
+    }
+}
+
+/// The bytes of one motion model's stream at one first-frame precision, its residual parts
+/// estimated by the codec (`None` without an estimate), and what coding it needs; `model` and
+/// its `known` segmentation fixed.
+fn estimate_once(
+    mesh: &AnimatedMesh,
+    settings: Settings,
+    progress: &dyn Progress,
+    (model, known): (MotionModel, Option<(Partition, SegmentationReport)>),
+) -> Result<Option<(u64, Estimated)>> {
+    if !settings.opts.codec.codec().estimated_trials() {
+        return Ok(None);
+    }
+    let mut clock = Stopwatch::new();
+    let (ff, permuted) = analysis::first_frame(mesh, settings.opts)?;
+    let mesh = permuted.unwrap_or_else(|| mesh.clone());
+    let leading = leading_parts(&mesh, &ff.bytes, settings.opts)?;
+    let once = Once::analyse(&mesh, &ff, settings, model, known, &mut clock)?;
+    let bytes = estimate(&mesh, (&ff, &leading), settings, &once.analysed(), progress)?;
+    let estimated = Estimated {
+        mesh,
+        ff,
+        leading,
+        once,
     };
-    clock.lap("segmentation");
-    progress.stage("motion");
-    let reference = &ff.decoded_positions;
-    let steps = (settings.plan.affine_step, opts.weight_bits);
-    let prediction = analysis::predict(mesh, reference, &partition, steps, model.predictor)?;
-    clock.lap("motion");
-    let analysed = Analysed {
-        model,
-        partition: &partition,
-        segmentation,
-        prediction: &prediction,
-        atlas: None,
-    };
-    code(mesh, &ff, leading, settings, &analysed, progress, clock)
+    Ok(Some((bytes, estimated)))
+}
+
+/// What [`estimate_once`] analysed, for coding it in full.
+struct Estimated {
+    mesh: AnimatedMesh,
+    ff: EncodedFirstFrame,
+    leading: Vec<Part>,
+    once: Once,
+}
+
+impl Estimated {
+    fn code(self, settings: Settings, progress: &dyn Progress) -> Result<Encoded> {
+        let analysed = self.once.analysed();
+        let (mesh, ff) = (&self.mesh, &self.ff);
+        code(
+            mesh,
+            ff,
+            self.leading,
+            settings,
+            &analysed,
+            progress,
+            Stopwatch::new(),
+        )
+    }
+}
+
+/// The stream bytes of `analysed` with its residuals' parts estimated by the codec (tdct), the
+/// rest as the stream will hold it.
+fn estimate(
+    mesh: &AnimatedMesh,
+    (ff, leading): (&EncodedFirstFrame, &[Part]),
+    settings: Settings,
+    analysed: &Analysed,
+    progress: &dyn Progress,
+) -> Result<u64> {
+    let (partition, prediction) = (analysed.partition, analysed.prediction);
+    let residuals = settings.plan.encoder()?.estimate_bytes(&ResidualInput {
+        mesh,
+        reference: &ff.decoded_positions,
+        partition,
+        residuals: &prediction.residuals,
+        progress,
+        atlas: analysed.atlas,
+    })?;
+    let residuals = residuals.ok_or_else(|| {
+        Error::Codec("the automatic choice asked for an estimate the codec does not make".into())
+    })?;
+    let header = header(mesh, settings, analysed.model, partition);
+    let side = assemble(
+        &header,
+        leading.to_vec(),
+        mesh,
+        partition,
+        prediction,
+        (vec![], vec![]),
+    )?;
+    Ok(side.len() + residuals)
 }
 
 /// The first frame's part and, for inputs with texture coordinates, the attributes'.

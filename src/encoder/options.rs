@@ -16,6 +16,9 @@ pub const DEFAULT_FIRST_FRAME_BITS: u8 = 12;
 /// the mesh and the step (docs/design.md, "First-frame bits trials and k-means ladder").
 pub const FIRST_FRAME_BITS_TRIED: [u8; 3] = [DEFAULT_FIRST_FRAME_BITS, 10, 8];
 
+/// Segments coded at once unless asked otherwise ([`EncodeOptions::parallel_segments`]).
+pub const DEFAULT_PARALLEL_SEGMENTS: usize = 2;
+
 /// Default `quality`: the middle of the useful range, a target step of 1/1000 of the first frame's
 /// bounding-box diagonal.
 pub const DEFAULT_QUALITY: u8 = 50;
@@ -32,6 +35,10 @@ pub struct EncodeOptions {
     pub codec: CodecConfig,
     /// Rate knob 1..100 (higher = better).
     pub quality: u8,
+    /// A quality between the integers, 1.0..=100.0, as a budget search finds it
+    /// ([`super::encode_to_budget`]): every codec's law is read at it instead of at `quality`,
+    /// and the stream header records it rounded. `None` (the default) reads `quality`.
+    pub fine_quality: Option<f64>,
     /// Quantiser step (tdct) or pixel step (one grey level, picture codecs) as a fraction of the
     /// first frame's bounding-box diagonal; `None` derives it from `quality`.
     pub step: Option<f64>,
@@ -62,7 +69,8 @@ pub struct EncodeOptions {
     /// clip as one.
     pub segment_frames: Option<usize>,
     /// Segments coded at once (on rayon's threads): memory holds this many segments' working
-    /// data, so the default, 1, keeps an encoding of any length within one segment's.
+    /// data, so the default, [`DEFAULT_PARALLEL_SEGMENTS`], keeps an encoding of any length
+    /// within two segments' while a 2-core machine codes them side by side.
     pub parallel_segments: usize,
 }
 
@@ -71,6 +79,7 @@ impl Default for EncodeOptions {
         Self {
             codec: CodecConfig::default(),
             quality: DEFAULT_QUALITY,
+            fine_quality: None,
             step: None,
             affine_precision: None,
             clusters: 20,
@@ -81,7 +90,7 @@ impl Default for EncodeOptions {
             reorder: false,
             uv_bits: 12,
             segment_frames: Some(DEFAULT_SEGMENT_FRAMES),
-            parallel_segments: 1,
+            parallel_segments: DEFAULT_PARALLEL_SEGMENTS,
         }
     }
 }
@@ -318,6 +327,7 @@ impl EncodeOptions {
     pub fn plan(&self, diagonal: f64) -> Result<RatePlan> {
         let rate = Rate {
             quality: self.quality,
+            fine_quality: self.fine_quality,
             step: self.step,
             affine_precision: self.affine_precision,
         };
@@ -325,6 +335,14 @@ impl EncodeOptions {
     }
 
     fn check_step(&self) -> Result<()> {
+        if let Some(q) = self.fine_quality {
+            if !(1.0..=100.0).contains(&q) {
+                return Err(Error::option(
+                    "fine_quality",
+                    format!("{q}: expected a quality between 1 and 100"),
+                ));
+            }
+        }
         if let Some(step) = self.step {
             if !(step.is_finite() && step > 0.0 && step <= 1.0) {
                 return Err(Error::option(

@@ -522,7 +522,7 @@ pub fn segment_ranges(frames: usize, length: usize) -> Vec<Range<usize>> {
 /// elsewhere from it join into the stream `encode_source` writes).
 pub fn analysis_clip(source: &mut FrameSource, length: usize) -> Result<AnimatedMesh> {
     let (frames, first) = (source.frame_count(), source.first().clone());
-    spread_clip(&first, frames, length, |range| source.read(range))
+    spread_clip(&first, frames, length, |list| source.read_list(list))
 }
 
 /// The analysis clip of a clip of `frames` frames read by ranges with `read`, one frame at a
@@ -531,12 +531,9 @@ fn spread_clip(
     first: &AnimatedMesh,
     frames: usize,
     length: usize,
-    mut read: impl FnMut(Range<usize>) -> Result<Vec<Vec<Point>>>,
+    mut read: impl FnMut(&[usize]) -> Result<Vec<Vec<Point>>>,
 ) -> Result<AnimatedMesh> {
-    let mut spread = Vec::with_capacity(length);
-    for f in analysis_frames(frames, length) {
-        spread.extend(read(f..f + 1)?);
-    }
+    let spread = read(&analysis_frames(frames, length))?;
     AnimatedMesh::new(first.triangles().to_vec(), spread)?
         .with_attributes(first.attributes().clone())
         .map(|mesh| mesh.with_frame_rate(first.frame_rate()))
@@ -550,7 +547,7 @@ pub fn encode(
     progress: &dyn Progress,
 ) -> Result<Encoded> {
     let frames = mesh.frame_count();
-    let read = |range: Range<usize>| Ok(mesh.frames()[range].to_vec());
+    let read = |list: &[usize]| Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect());
     encode_runs(mesh, frames, length, opts, progress, read)
 }
 
@@ -568,13 +565,13 @@ pub fn encode_source(
         _ => return super::encode_with_progress(&source.clip(0..frames)?, opts, progress),
     };
     let first = source.first().clone();
-    encode_runs(&first, frames, length, opts, progress, |range| {
-        source.read(range)
+    encode_runs(&first, frames, length, opts, progress, |list| {
+        source.read_list(list)
     })
 }
 
 /// Encodes a clip of `frames` frames in segments of `length`, reading its frames by ranges with
-/// `read`: the analysis clip's frames one by one, then `parallel_segments` segments at a time,
+/// `read`: the analysis clip's frames, then `parallel_segments` segments at a time,
 /// coded on rayon's threads. `first` gives the connectivity, attributes and frame rate.
 fn encode_runs(
     first: &AnimatedMesh,
@@ -582,7 +579,7 @@ fn encode_runs(
     length: usize,
     opts: &EncodeOptions,
     progress: &dyn Progress,
-    mut read: impl FnMut(Range<usize>) -> Result<Vec<Vec<Point>>>,
+    mut read: impl FnMut(&[usize]) -> Result<Vec<Vec<Point>>>,
 ) -> Result<Encoded> {
     let analysis = spread_clip(first, frames, length, &mut read)?;
     progress.total(frames as u64);
@@ -593,7 +590,7 @@ fn encode_runs(
     for batch in ranges.chunks(opts.parallel_segments.max(1)) {
         let runs = batch
             .iter()
-            .map(|r| Ok((r.start, read(r.clone())?)))
+            .map(|r| Ok((r.start, read(&r.clone().collect::<Vec<_>>())?)))
             .collect::<Result<Vec<_>>>()?;
         let coded: Vec<Result<CodedSegment>> = runs
             .into_par_iter()

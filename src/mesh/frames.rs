@@ -2,7 +2,7 @@
 //! caches sample by sample, so that a long clip is never held whole. glTF clips are baked whole
 //! (the baker poses every frame from the clip's channels) and served from memory.
 
-use super::obj::{check_same_mesh, frame_files, read_obj};
+use super::obj::{check_same_mesh, frame_files, read_frames, read_obj};
 use super::{gltf, pc2, AnimatedMesh, Point, ReadOptions};
 use crate::error::{Error, Result};
 use std::fs::File;
@@ -121,32 +121,46 @@ impl FrameSource {
                 self.frames
             )));
         }
+        self.read_list(&frames.collect::<Vec<_>>())
+    }
+
+    /// The positions of the frames `list` names, in its order (OBJ files read on rayon's threads).
+    pub fn read_list(&mut self, list: &[usize]) -> Result<Vec<Vec<Point>>> {
+        if let Some(f) = list.iter().find(|&&f| f >= self.frames) {
+            return Err(Error::Usage(format!(
+                "frame {f}: the animation has {}",
+                self.frames
+            )));
+        }
         match &mut self.origin {
-            Origin::Memory(mesh) => Ok(mesh.frames()[frames].to_vec()),
+            Origin::Memory(mesh) => Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect()),
             Origin::Obj(files) => {
                 let (vertices, triangles) = (self.first.vertex_count(), self.first.triangles());
                 let first_path = &files[0];
-                files[frames]
-                    .iter()
-                    .map(|path| {
-                        let frame = read_obj(path)?;
-                        check_same_mesh(triangles, vertices, first_path, &frame, path)?;
-                        Ok(frame.positions)
-                    })
-                    .collect()
+                let chosen: Vec<PathBuf> = list.iter().map(|&f| files[f].clone()).collect();
+                read_frames(&chosen, |path| {
+                    let frame = read_obj(path)?;
+                    check_same_mesh(triangles, vertices, first_path, &frame, path)?;
+                    Ok(frame.positions)
+                })
             }
             Origin::Pc2 { file, path, points } => {
                 let bytes = *points as u64 * 12;
-                let at = pc2::SAMPLES_START + frames.start as u64 * bytes;
                 let io = |e| Error::io(path.as_path(), e);
-                file.seek(SeekFrom::Start(at)).map_err(io)?;
                 let mut buf = vec![0u8; *points * 12];
-                frames
-                    .map(|_| {
-                        file.read_exact(&mut buf).map_err(io)?;
-                        Ok(pc2::parse_frame(&buf))
-                    })
-                    .collect()
+                let mut next = None;
+                let mut frames = Vec::with_capacity(list.len());
+                for &f in list {
+                    // Consecutive frames read on without seeking.
+                    if next != Some(f) {
+                        let at = pc2::SAMPLES_START + f as u64 * bytes;
+                        file.seek(SeekFrom::Start(at)).map_err(io)?;
+                    }
+                    file.read_exact(&mut buf).map_err(io)?;
+                    frames.push(pc2::parse_frame(&buf));
+                    next = Some(f + 1);
+                }
+                Ok(frames)
             }
         }
     }

@@ -8,6 +8,7 @@
 //! the start; that bound is what makes a 200-frame sequence take seconds. The tree itself is a plain
 //! median split, built once in O(n log n) and refitted to each later frame in O(n).
 
+use super::grid::TriangleGrid;
 use super::triangle::{point_triangle_distance_squared, Vec3};
 use crate::mesh::{Point, Triangle};
 
@@ -67,6 +68,8 @@ pub struct TriangleBvh {
     order: Vec<u32>,
     /// The leaf holding each triangle.
     leaf_of: Vec<u32>,
+    /// Settles most hinted queries without the tree (see [`super::grid`]).
+    grid: TriangleGrid,
 }
 
 impl TriangleBvh {
@@ -111,11 +114,14 @@ impl TriangleBvh {
                 }
             }
         }
+        let mut grid = TriangleGrid::default();
+        grid.rebuild(&corners);
         Some(Self {
             nodes,
             corners,
             order,
             leaf_of,
+            grid,
         })
     }
 
@@ -170,6 +176,7 @@ impl TriangleBvh {
                 node.hi = hi;
             }
         }
+        self.grid.rebuild(&self.corners);
         true
     }
 
@@ -225,7 +232,15 @@ impl TriangleBvh {
                 };
             }
         }
-        // With a hint, climb from its leaf: every other subtree is the sibling of a node on that
+        // A near hint bounds the search to a few grid cells.
+        let mut found = (best.distance_squared, best.triangle);
+        if self.grid.improve(p, &self.corners, &mut found) {
+            return Nearest {
+                triangle: found.1,
+                distance_squared: found.0,
+            };
+        }
+        // Otherwise climb from the hint's leaf: every other subtree is the sibling of a node on that
         // path, and the siblings far from `p` are dismissed by one box test each. That skips the
         // descent from the root, which was most of the cost of a well-hinted query.
         let Some(&start) = self

@@ -8,6 +8,7 @@
 mod running;
 internal! {
     bvh;
+    grid;
     sampling;
     surface;
     triangle;
@@ -123,9 +124,10 @@ pub fn vertex_errors(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Option<
     Some(sums.errors(original.vertex_count() as f64 * original.frame_count() as f64))
 }
 
-/// The running sums behind vertex RMSE and KG error, a frame at a time.
+/// The running sums behind vertex RMSE and KG error, a frame at a time: what `eval --fast`
+/// measures, at the cost of reading the frames.
 #[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct VertexSums {
+pub struct VertexSums {
     /// Squared vertex displacements.
     err: f64,
     /// Squared distances of the original's vertices to their frame's centroid.
@@ -134,7 +136,7 @@ pub(crate) struct VertexSums {
 
 impl VertexSums {
     /// Adds one frame: original `a` against decoded `b` (corresponding vertices).
-    pub(crate) fn add_frame(&mut self, a: &[crate::mesh::Point], b: &[crate::mesh::Point]) {
+    pub fn add_frame(&mut self, a: &[crate::mesh::Point], b: &[crate::mesh::Point]) {
         let n = a.len().max(1) as f64;
         let mut c = [0.0f64; 3];
         for p in a {
@@ -151,7 +153,7 @@ impl VertexSums {
     }
 
     /// The errors over `count` vertex positions (vertices × frames).
-    pub(crate) fn errors(self, count: f64) -> VertexErrors {
+    pub fn errors(self, count: f64) -> VertexErrors {
         VertexErrors {
             rmse: (self.err / count).sqrt(),
             kg: (self.spread > 0.0).then(|| 100.0 * self.err.sqrt() / self.spread.sqrt()),

@@ -6,6 +6,7 @@ use super::sampling::{Sample, SamplingPlan};
 use super::triangle::Vec3;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
+use rustc_hash::FxHashMap;
 use serde::Serialize;
 
 /// One-sided distance from a sampled surface A to a surface B, in the meshes' own units.
@@ -54,13 +55,15 @@ pub struct Surface<'a> {
 }
 
 /// Distance from surface `a`, sampled at `samples` (see [`SamplingPlan::apply`]), to the surface
-/// indexed by `b`. `same_triangles` says that `a`'s face `i` corresponds to `b`'s face `i` (shared
-/// connectivity), which makes it the first candidate for samples on face `i`.
+/// indexed by `b`. `same_triangles` says that `a`'s face `i` is `b`'s face `i` (shared
+/// connectivity); `twins[i]`, when given, is the face of `b` on the same vertices as `a`'s face `i`
+/// (the first candidate for samples on face `i`; [`NO_TWIN`] when there is none).
 pub fn one_sided(
     samples: &[Sample],
     a: Surface<'_>,
     b: &TriangleBvh,
     same_triangles: bool,
+    twins: Option<&[u32]>,
 ) -> Result<OneSided> {
     let (mut area, mut sum, mut sum_sq, mut max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut last = None;
@@ -68,8 +71,11 @@ pub fn one_sided(
     for s in samples {
         // The same-numbered face is right when the surfaces barely differ; the previous sample's
         // answer when they differ a lot (a neighbouring sample has a neighbouring answer).
-        let same_face = if same_triangles { Some(s.face) } else { None };
-        let hints = same_face.into_iter().chain(last);
+        let same_face = match twins {
+            Some(t) => t.get(s.face as usize).copied().filter(|&f| f != NO_TWIN),
+            None => same_triangles.then_some(s.face),
+        };
+        let hints = same_face.into_iter().chain(last.filter(|&l| Some(l) != same_face));
         // A face that did not move holds its samples exactly (a query would add rounding noise).
         let unmoved = same_triangles && b.corners(s.face) == Some(&corners(a, s.face));
         let nearest = if unmoved {
@@ -154,6 +160,9 @@ pub struct SurfacePlans {
     pub first: SamplingPlan,
     /// The second surface's plan.
     pub second: SamplingPlan,
+    /// For each face of the first surface, the second's face on the same vertices ([`NO_TWIN`]
+    /// if none), and the reverse; `None` when no face has a twin.
+    twins: Option<(Vec<u32>, Vec<u32>)>,
 }
 
 impl SurfacePlans {
@@ -163,8 +172,42 @@ impl SurfacePlans {
         Self {
             first: SamplingPlan::new(a.triangles, a.positions, spacing),
             second: SamplingPlan::new(b.triangles, b.positions, spacing),
+            twins: twins(a.triangles, b.triangles),
         }
     }
+}
+
+/// No face on the same vertices.
+pub const NO_TWIN: u32 = u32::MAX;
+
+/// Pairs the faces of `a` and `b` on the same three vertices, in both directions. A decoded
+/// stream's faces are the original's in another order (the first-frame coder renumbers them), so
+/// a sample's own face is found through this map; `None` when nothing pairs.
+fn twins(a: &[Triangle], b: &[Triangle]) -> Option<(Vec<u32>, Vec<u32>)> {
+    let key = |t: &Triangle| {
+        let mut k = *t;
+        k.sort_unstable();
+        k
+    };
+    let mut of_b: FxHashMap<Triangle, u32> = FxHashMap::default();
+    of_b.reserve(b.len());
+    for (i, t) in b.iter().enumerate() {
+        of_b.entry(key(t)).or_insert(i as u32);
+    }
+    let forward: Vec<u32> = a
+        .iter()
+        .map(|t| of_b.get(&key(t)).copied().unwrap_or(NO_TWIN))
+        .collect();
+    let mut backward = vec![NO_TWIN; b.len()];
+    for (i, &f) in forward.iter().enumerate() {
+        if let Some(slot) = backward.get_mut(f as usize) {
+            *slot = i as u32;
+        }
+    }
+    forward
+        .iter()
+        .any(|&f| f != NO_TWIN)
+        .then_some((forward, backward))
 }
 
 #[cfg(any(test, feature = "internals"))]
@@ -188,11 +231,15 @@ pub fn frame_distance_planned(
     plans
         .first
         .apply(a.triangles, a.positions, &mut cache.samples);
-    let forward = one_sided(&cache.samples, a, b_index, same)?;
+    let (a_twins, b_twins) = match &plans.twins {
+        Some((f, b)) => (Some(f.as_slice()), Some(b.as_slice())),
+        None => (None, None),
+    };
+    let forward = one_sided(&cache.samples, a, b_index, same, a_twins)?;
     plans
         .second
         .apply(b.triangles, b.positions, &mut cache.samples);
-    let backward = one_sided(&cache.samples, b, a_index, same)?;
+    let backward = one_sided(&cache.samples, b, a_index, same, b_twins)?;
     Ok(FrameDistance { forward, backward })
 }
 
@@ -262,6 +309,53 @@ mod tests {
         );
         assert!((d.forward.max - 0.5).abs() < 1e-7);
         assert_eq!(d.rms(), d.forward.rms);
+    }
+
+    #[test]
+    fn renumbered_faces_pair_up_and_measure_alike() {
+        // A bumpy sheet, and a copy whose faces are listed backwards with their corners rotated
+        // (as a decoded stream's are): the faces pair up, and the distances do not change.
+        let n = 6u32;
+        let mut t: Vec<Triangle> = Vec::new();
+        for i in 0..n - 1 {
+            for j in 0..n - 1 {
+                let v = i * n + j;
+                t.extend([[v, v + 1, v + n], [v + 1, v + n + 1, v + n]]);
+            }
+        }
+        let at = |z: f32| -> Vec<Point> {
+            (0..n * n)
+                .map(|v| {
+                    let (x, y) = ((v % n) as f32, (v / n) as f32);
+                    [x, y, z * (x * 0.7).sin() * y]
+                })
+                .collect()
+        };
+        let (a, b) = (at(0.1), at(0.12));
+        let renumbered: Vec<Triangle> = t.iter().rev().map(|f| [f[1], f[2], f[0]]).collect();
+        let Some((forward, backward)) = twins(&t, &renumbered) else {
+            panic!("no face paired");
+        };
+        let last = t.len() as u32 - 1;
+        assert!(forward.iter().enumerate().all(|(i, &f)| f == last - i as u32));
+        assert!(backward.iter().enumerate().all(|(i, &f)| f == last - i as u32));
+        assert_eq!(twins(&t, &[[0, 0, 0]]), None);
+        let measure = |bt: &[Triangle]| {
+            let s = |tri, pos| Surface {
+                triangles: tri,
+                positions: pos,
+            };
+            let plans = SurfacePlans::new(s(&t, &a), s(bt, &b), 0.5);
+            frame_distance_planned(s(&t, &a), s(bt, &b), &plans, &mut IndexCache::default())
+                .unwrap_or_else(|e| panic!("{e}"))
+        };
+        let (same, other) = (measure(&t), measure(&renumbered));
+        assert!(same.rms() > 0.0);
+        // Rotated corners round differently in the last bits, nothing more.
+        for (x, y) in [(same.forward, other.forward), (same.backward, other.backward)] {
+            assert!((x.rms - y.rms).abs() <= 1e-12 * x.rms, "{x:?} {y:?}");
+            assert!((x.max - y.max).abs() <= 1e-12 * x.max, "{x:?} {y:?}");
+        }
     }
 
     #[test]

@@ -8,9 +8,7 @@ use super::sampled_motion::{welded_adjacency, SampledMotion, SAMPLED_FIT_LAMBDA}
 use crate::error::{Error, Result};
 use crate::mesh::topology::{KRingScratch, VertexAdjacency};
 use crate::mesh::AnimatedMesh;
-use linfa::traits::{Fit, Predict};
-use linfa::DatasetBase;
-use linfa_clustering::{KMeans, KMeansInit};
+use super::lloyd;
 use ndarray::{Array2, ArrayView1, Axis};
 use rand_xoshiro::rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256Plus;
@@ -59,7 +57,7 @@ impl Default for SegmentOptions {
 ///    `ring`-ring, in the unit frame of frame 0 (bounding-box centre at the origin, diagonal 1). The
 ///    linear part is weighted by the RMS radius of the shape so both parts measure displacement: a
 ///    change δ of a linear coefficient moves a typical vertex by about radius × δ.
-/// 2. k-means (k-means++ seeded by `opts.seed`, one run) is trained on the vertices whose ring moves
+/// 2. k-means (k-means++ seeded by `opts.seed`) is trained on the vertices whose ring moves
 ///    affinely (ring misfit ≤ 4 × median) and is not degenerate (flat, on a line); every vertex
 ///    then takes its nearest centroid. Rings straddling differently moving parts give far-off
 ///    descriptors that would otherwise draw centroids away from the parts, and degenerate rings
@@ -70,6 +68,14 @@ impl Default for SegmentOptions {
 /// 4. Clusters with fewer than [`MIN_CLUSTER_SIZE`] vertices are dissolved, smallest first, into the
 ///    nearest remaining k-means centroid; empty ones vanish; labels are renumbered in order of first vertex.
 pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> {
+    check(opts)?;
+    if opts.clusters.min(mesh.vertex_count()) == 1 {
+        return Partition::from_labels(vec![0; mesh.vertex_count()], 1);
+    }
+    MotionDescriptors::new(mesh, opts).segment(opts)
+}
+
+fn check(opts: &SegmentOptions) -> Result<()> {
     if opts.clusters == 0 {
         return Err(Error::Usage(
             "the number of clusters must be at least 1".into(),
@@ -80,49 +86,78 @@ pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> 
             "segmentation needs at least one feature frame and one k-means iteration".into(),
         ));
     }
-    let v_count = mesh.vertex_count();
-    let k = opts.clusters.min(v_count);
-    if k == 1 {
-        return Partition::from_labels(vec![0; v_count], 1);
+    Ok(())
+}
+
+/// What k-means segments an animation on, whatever K (steps 1 and 2's training set of
+/// [`segment`]): made once, it serves several K (the automatic choice's ladder).
+pub struct MotionDescriptors {
+    sampled: SampledMotion,
+    adjacency: VertexAdjacency,
+    features: Array2<f32>,
+    inliers: Vec<usize>,
+    /// The training rows: the inliers', or every row when fewer than K are inliers.
+    training: Option<Array2<f32>>,
+    spread: f32,
+}
+
+impl MotionDescriptors {
+    /// The descriptors of `mesh` with `opts`'s ring and feature frames.
+    pub fn new(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Self {
+        let sampled = SampledMotion::new(mesh, opts.feature_frames.max(1));
+        let adjacency = welded_adjacency(mesh, &sampled);
+        let (features, misfit) = motion_features(&adjacency, &sampled, opts.ring);
+        let inliers = affine_rings(&misfit);
+        let training = (!inliers.is_empty()).then(|| features.select(Axis(0), &inliers));
+        let spread = feature_spread(training.as_ref().unwrap_or(&features));
+        Self {
+            sampled,
+            adjacency,
+            features,
+            inliers,
+            training,
+            spread,
+        }
     }
-    let sampled = SampledMotion::new(mesh, opts.feature_frames);
-    let adjacency = welded_adjacency(mesh, &sampled);
-    let (features, misfit) = motion_features(&adjacency, &sampled, opts.ring);
-    let inliers = affine_rings(&misfit);
-    let training = if inliers.len() >= k {
-        features.select(Axis(0), &inliers)
-    } else {
-        features.clone()
-    };
-    let spread = feature_spread(&training);
-    if spread == 0.0 {
-        // Every vertex moves alike: k-means would only split ties.
-        return Partition::from_labels(vec![0; v_count], 1);
+
+    /// The partition into `opts.clusters` (steps 2 to 4 of [`segment`]).
+    pub fn segment(&self, opts: &SegmentOptions) -> Result<Partition> {
+        check(opts)?;
+        let v_count = self.features.nrows();
+        let k = opts.clusters.min(v_count);
+        let training = match &self.training {
+            Some(t) if self.inliers.len() >= k => t,
+            _ => &self.features,
+        };
+        let spread = if self.inliers.len() >= k {
+            self.spread
+        } else {
+            feature_spread(&self.features)
+        };
+        if k == 1 || spread == 0.0 {
+            // One cluster, or every vertex moves alike: k-means would only split ties.
+            return Partition::from_labels(vec![0; v_count], 1);
+        }
+        let mut rng = Xoshiro256Plus::seed_from_u64(opts.seed);
+        let tolerance = (1e-4 * spread).max(f32::MIN_POSITIVE);
+        let centroids = lloyd::kmeans(training, k, &mut rng, opts.max_iterations, tolerance);
+        let mut labels = lloyd::nearest(&self.features, &centroids);
+        if self.inliers.len() >= k && self.inliers.len() < v_count {
+            assign_by_trajectory(&mut labels, &self.inliers, &self.sampled, k);
+        }
+        if opts.refine_passes > 0 {
+            refine_borders(
+                &mut labels,
+                &self.adjacency,
+                &self.sampled,
+                k,
+                opts.refine_passes,
+                true,
+            );
+        }
+        let labels = dissolve_small_clusters(labels, &self.features, &centroids, k);
+        compact(labels)
     }
-    let training = DatasetBase::from(training);
-    let model = KMeans::params_with_rng(k, Xoshiro256Plus::seed_from_u64(opts.seed))
-        .init_method(KMeansInit::KMeansPlusPlus)
-        .n_runs(1)
-        .max_n_iterations(opts.max_iterations)
-        .tolerance((1e-4 * spread).max(f32::MIN_POSITIVE))
-        .fit(&training)
-        .map_err(|e| Error::Usage(format!("k-means failed: {e}")))?;
-    let mut labels: Vec<usize> = model.predict(&features).to_vec();
-    if inliers.len() >= k && inliers.len() < v_count {
-        assign_by_trajectory(&mut labels, &inliers, &sampled, k);
-    }
-    if opts.refine_passes > 0 {
-        refine_borders(
-            &mut labels,
-            &adjacency,
-            &sampled,
-            k,
-            opts.refine_passes,
-            true,
-        );
-    }
-    let labels = dissolve_small_clusters(labels, &features, model.centroids(), k);
-    compact(labels)
 }
 
 /// The vertices whose ring moves affinely, up to the typical deviation: those whose ring misfit is

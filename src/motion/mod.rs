@@ -24,6 +24,8 @@ mod decimate;
 mod fit;
 #[cfg(feature = "encode")]
 mod kmeans;
+#[cfg(feature = "encode")]
+mod lloyd;
 mod partition;
 mod predictor;
 #[cfg(feature = "encode")]
@@ -43,7 +45,7 @@ pub use decimate::Decimation;
 #[cfg(feature = "encode")]
 pub use decimate::{decimate, DecimateOptions, DEFAULT_E0};
 #[cfg(feature = "encode")]
-pub use kmeans::{segment, SegmentOptions};
+pub use kmeans::{segment, MotionDescriptors, SegmentOptions};
 pub use partition::Partition;
 pub use predictor::{predict_frame, PredictorKind};
 #[cfg(all(feature = "encode", any(test, feature = "internals")))]

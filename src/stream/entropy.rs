@@ -72,13 +72,31 @@ impl BitModel {
     /// Bits that coding `bit` would cost now (an estimate for rate–distortion choices).
     pub fn cost(&self, bit: bool) -> f64 {
         let p = if bit { self.p_true } else { ONE - self.p_true };
-        -(f64::from(p) / f64::from(ONE)).log2()
+        bit_cost(p)
     }
 
     fn frozen(&self) -> FrozenBit {
         FrozenBit {
             p_true: self.p_true,
         }
+    }
+}
+
+/// −log2(p / ONE) of every probability p the models hold, made once: the rate–distortion choices
+/// of the coders ask for millions of bit costs, and a table gives the same values as the
+/// logarithm (so the same choices) for a small part of its time.
+static BIT_COSTS: std::sync::LazyLock<Vec<f64>> =
+    std::sync::LazyLock::new(|| (0..=ONE).map(exact_bit_cost).collect());
+
+fn exact_bit_cost(p: u32) -> f64 {
+    -(f64::from(p) / f64::from(ONE)).log2()
+}
+
+/// The cost in bits of an outcome of probability `p` (in units of 2^-16).
+fn bit_cost(p: u32) -> f64 {
+    match BIT_COSTS.get(p as usize) {
+        Some(&c) => c,
+        None => exact_bit_cost(p),
     }
 }
 
@@ -188,15 +206,16 @@ const BUCKETS: usize = 65;
 /// the remaining low bits raw.
 #[derive(Clone, Debug)]
 pub struct UIntModel {
-    unary: Vec<BitModel>,
-    top_bit: Vec<BitModel>,
+    // Arrays, not vectors: coders clone whole banks of these models per trial.
+    unary: [BitModel; BUCKETS],
+    top_bit: [BitModel; BUCKETS],
 }
 
 impl Default for UIntModel {
     fn default() -> Self {
         Self {
-            unary: vec![BitModel::default(); BUCKETS],
-            top_bit: vec![BitModel::default(); BUCKETS],
+            unary: std::array::from_fn(|_| BitModel::default()),
+            top_bit: std::array::from_fn(|_| BitModel::default()),
         }
     }
 }
@@ -211,16 +230,23 @@ pub struct IntModel {
 impl UIntModel {
     /// Bits that coding `value` would cost now, without coding it.
     pub fn cost(&self, value: u64) -> f64 {
-        let shifted = u128::from(value) + 1;
-        let length = 127 - shifted.leading_zeros();
-        let unary: f64 = (self.unary.iter().enumerate())
-            .take(length as usize + 1)
-            .map(|(i, m)| m.cost((i as u32) < length))
-            .sum();
+        // value + 1 fits in 64 bits but for u64::MAX, whose length is 64 and top bit 0.
+        let (length, top) = match value.checked_add(1) {
+            Some(shifted) => {
+                let length = 63 - shifted.leading_zeros();
+                let top = length > 0 && (shifted >> (length - 1)) & 1 == 1;
+                (length, top)
+            }
+            None => (64, false),
+        };
+        // The same sum, in the same order, as the iterator form: the same f64.
+        let mut unary = 0.0;
+        for (i, m) in self.unary.iter().enumerate().take(length as usize + 1) {
+            unary += m.cost((i as u32) < length);
+        }
         if length == 0 {
             return unary;
         }
-        let top = ((shifted - (1u128 << length)) >> (length - 1)) & 1 == 1;
         let top_cost = self
             .top_bit
             .get(length as usize)

@@ -1,6 +1,7 @@
-//! `--predictor auto` and `--segmentation auto` (issue 18): the encoder codes every candidate at
-//! the quality's step and keeps the smallest stream (tdct) or the fewest bits at equal error
-//! (picture codecs, whose errors at one step differ), saying so in its report.
+//! `--predictor auto` and `--segmentation auto` (issue 18): the encoder tries every candidate at
+//! the quality's step and keeps the smallest stream (tdct, by its estimates, then codes the
+//! winner) or the fewest bits at equal error (picture codecs, whose errors at one step differ),
+//! saying so in its report.
 
 use crate::common::{animate, config, decode_all, decoder, tube, vertex_rmse, Counter};
 use mcgv_video::codec::Codec;
@@ -98,9 +99,26 @@ fn auto_keeps_skinning_on_a_skinned_bend_and_its_stream_is_the_fixed_ones() {
         .into_iter()
         .map(|p| fixed_bytes(&mesh, &base, (p, Segmentation::KMeans)).len() as u64)
         .collect();
-    let measured: Vec<u64> = choice.candidates.iter().map(|c| c.bytes).collect();
-    assert_eq!(measured, sizes, "tdct codes every candidate whole");
-    assert!(sizes[1] < sizes[0]);
+    // tdct ranks its candidates by estimates, codes only the one kept, and reports its bytes.
+    let estimates: Vec<u64> = choice
+        .candidates
+        .iter()
+        .filter_map(|c| c.estimate)
+        .collect();
+    assert_eq!(estimates.len(), 2, "{choice:?}");
+    assert!(
+        sizes[1] < sizes[0] && estimates[1] < estimates[0],
+        "{choice:?}"
+    );
+    for (estimate, size) in estimates.iter().zip(&sizes) {
+        let ratio = *estimate as f64 / *size as f64;
+        assert!(
+            (0.8..1.25).contains(&ratio),
+            "estimate {estimate}, stream {size}"
+        );
+    }
+    assert!(choice.candidates[0].estimated && !choice.candidates[1].estimated);
+    assert_eq!(choice.candidates[1].bytes, sizes[1]);
     let skinning = fixed_bytes(
         &mesh,
         &base,
@@ -143,7 +161,9 @@ fn auto_keeps_affine_on_rigid_parts_and_the_default_on_a_tie() {
     ]
     .concat();
     assert_eq!(names, expected);
-    let bytes: Vec<u64> = choice.candidates.iter().map(|c| c.bytes).collect();
+    let bytes: Vec<u64> = (choice.candidates.iter())
+        .map(|c| c.estimate.expect("tdct estimates"))
+        .collect();
     assert_eq!(bytes[0], bytes[6], "{bytes:?}");
     assert!(bytes[1] > bytes[0], "{bytes:?}");
     assert!(bytes[2..6].iter().all(|&b| b >= bytes[0]), "{bytes:?}");
@@ -168,9 +188,16 @@ fn tdct_tries_a_ladder_of_cluster_counts_and_keeps_the_smallest() {
         .filter(|c| c.segmentation == "kmeans")
         .collect();
     assert_eq!(kmeans.len(), 3, "{choice:?}");
-    let smallest = choice.candidates.iter().map(|c| c.bytes).min();
-    assert_eq!(Some(encoded.report.bytes), smallest, "{choice:?}");
-    // Each rung is the fixed encoding at that K, and the header records the K asked for.
+    let smallest = choice.candidates.iter().filter_map(|c| c.estimate).min();
+    let kept = choice
+        .candidates
+        .iter()
+        .find(|c| !c.estimated)
+        .expect("kept");
+    assert_eq!(kept.estimate, smallest, "{choice:?}");
+    assert_eq!(encoded.report.bytes, kept.bytes, "{choice:?}");
+    // Each rung's estimate is near the fixed encoding at that K, the kept one is that encoding,
+    // and the header records the K asked for.
     for (c, k) in kmeans.iter().zip([2, 3, 4]) {
         let fixed = EncodeOptions {
             clusters: k,
@@ -181,7 +208,15 @@ fn tdct_tries_a_ladder_of_cluster_counts_and_keeps_the_smallest() {
             )
         };
         let bytes = encode(&mesh, &fixed).expect("encodes").to_bytes();
-        assert_eq!(bytes.len() as u64, c.bytes, "K = {k}");
+        let ratio = c.estimate.expect("estimated") as f64 / bytes.len() as f64;
+        assert!(
+            (0.8..1.25).contains(&ratio),
+            "K = {k}: {c:?}, {}",
+            bytes.len()
+        );
+        if !c.estimated {
+            assert_eq!(bytes.len() as u64, c.bytes, "K = {k}");
+        }
     }
     // The picture codecs, whose trials are whole encodings, try the caller's K only.
     let jpeg = opts(
@@ -291,10 +326,10 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
 fn progress_announces_the_trials_frames_and_reports_them_all() {
     let mesh = skinned_bend();
     let frames = mesh.frame_count() as u64;
-    // tdct and MPEG-4 code every candidate whole (tdct's k-means at three K); JPEG 12 frames each,
-    // then the winner whole.
+    // tdct estimates every candidate (its k-means at three K), then codes the winner; MPEG-4
+    // codes every candidate whole; JPEG 12 frames each, then the winner whole.
     let codecs = [
-        (Codec::Tdct, 8 * frames),
+        (Codec::Tdct, 8 * frames + frames),
         (Codec::Mpeg4, 4 * frames),
         (Codec::Jpeg, 4 * 12 + frames),
     ];

@@ -107,8 +107,9 @@ fn the_trials_are_announced_once_and_picture_codecs_do_not_try() {
     let (total, done) = (counter.total.into_inner(), counter.done.into_inner());
     assert_eq!(total, done);
     let frames = mesh.frame_count() as u64;
-    // 8 model candidates at 12 bits, then the kept model at 10 (and 8) bits.
-    assert!([9, 10].contains(&(total / frames)), "{total}");
+    // 8 model candidates estimated at 12 bits and the kept one coded, then the kept model
+    // estimated at 10 (and 8) bits, and coded when its estimate is the smaller.
+    assert!((10..=13).contains(&(total / frames)), "{total}");
     let jpeg = EncodeOptions {
         codec: Codec::Jpeg.into(),
         ..tdct(50)

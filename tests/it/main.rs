@@ -7,6 +7,7 @@ mod common;
 mod affine_coding;
 mod attributes;
 mod auto;
+mod budget;
 mod cloth;
 mod codec;
 mod decimate;

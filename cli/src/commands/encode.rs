@@ -3,7 +3,8 @@
 use crate::args::{BitDepth, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
 use mcgv_video::codec::{Codec, CodecConfig, PictureOptions};
-use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
+use mcgv_video::encoder::DEFAULT_PARALLEL_SEGMENTS;
+use mcgv_video::encoder::{self, Budget, BudgetReport, EncodeOptions, Encoded, Segmentation};
 use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
 use mcgv_video::mesh::input_files;
 use mcgv_video::mesh::ReadOptions;
@@ -40,7 +41,10 @@ pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions>
     let defaults = EncodeOptions::default();
     Ok(EncodeOptions {
         codec: codec_config(args)?,
-        quality: args.quality.unwrap_or(encoder::DEFAULT_QUALITY),
+        quality: args
+            .quality
+            .map_or(encoder::DEFAULT_QUALITY, |q| q.round() as u8),
+        fine_quality: args.quality.filter(|q| q.fract() != 0.0),
         clusters: args.clusters.unwrap_or(defaults.clusters),
         segmentation,
         affine_precision: args.affine_precision,
@@ -60,7 +64,9 @@ pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions>
             Some(n) => Some(usize::try_from(n).unwrap_or(usize::MAX)),
         },
         // `--threads N` also codes N segments at once (memory: N segments' working data).
-        parallel_segments: threads.map_or(1, |n| usize::try_from(n).unwrap_or(1)),
+        parallel_segments: threads.map_or(DEFAULT_PARALLEL_SEGMENTS, |n| {
+            usize::try_from(n).unwrap_or(1)
+        }),
     })
 }
 
@@ -267,13 +273,17 @@ fn encode_one(
         check_not_input(&args.input, read_options, output)?;
     }
     let start = Instant::now();
-    let spin = progress::spinner("reading", quiet);
-    let source = super::open_source(&args.input, read_options, quiet);
-    spin.finish_and_clear();
-    let mut source = source?;
-    let pb = progress::bar(source.frame_count() as u64, "encode", quiet);
-    let encoded = encoder::encode_source(&mut source, opts, &progress::Reporter(&pb))?;
-    pb.finish_and_clear();
+    let (encoded, search) = match budget(args) {
+        None => (encode_streaming(args, opts, read_options, quiet)?, None),
+        Some(budget) => {
+            let mesh = super::read_input(&args.input, read_options, quiet)?;
+            let spin = progress::spinner("budget search", quiet);
+            let found = encoder::encode_to_budget(&mesh, opts, budget);
+            spin.finish_and_clear();
+            let found = found?;
+            (found.encoded, Some(found.search))
+        }
+    };
     if to_stdout {
         write_stdout_bytes(&encoded.to_bytes())?;
     } else {
@@ -287,6 +297,10 @@ fn encode_one(
         value["seconds"] = serde_json::json!(seconds);
         value["vertices"] = serde_json::json!(r.header.vertices);
         value["frames"] = serde_json::json!(r.header.frames);
+        if let Some(search) = &search {
+            value["budget"] =
+                serde_json::to_value(search).map_err(|e| Error::Usage(e.to_string()))?;
+        }
         return outln!("{value}");
     }
     if quiet {
@@ -307,6 +321,10 @@ fn encode_one(
         seconds,
         r.header.frames as f64 / seconds.max(1e-9)
     );
+    let line = match &search {
+        Some(search) => format!("{line}\n{}", budget_line(search)),
+        None => line,
+    };
     let line = match &r.choice {
         Some(choice) => format!(
             "{line}\nauto: kept {} of {} candidates: {}",
@@ -342,6 +360,82 @@ first frame: kept {} bits of {}",
     } else {
         outln!("{line}")
     }
+}
+
+/// The budget of the `--target-*` flag given (clap lets at most one through).
+fn budget(args: &EncodeArgs) -> Option<Budget> {
+    let targets = (
+        args.target_size,
+        args.target_bpvf,
+        args.target_error,
+        args.target_max_error,
+    );
+    match targets {
+        (Some(bytes), ..) => Some(Budget::Bytes(bytes)),
+        (_, Some(x), ..) => Some(Budget::Bpvf(x)),
+        (_, _, Some(e), _) => Some(Budget::VertexRmse(e)),
+        (_, _, _, Some(e)) => Some(Budget::MaxVertexError(e)),
+        _ => None,
+    }
+}
+
+/// Encodes reading the input a run of frames at a time (a long clip is never held whole).
+fn encode_streaming(
+    args: &EncodeArgs,
+    opts: &EncodeOptions,
+    read_options: &ReadOptions,
+    quiet: bool,
+) -> Result<Encoded> {
+    let spin = progress::spinner("reading", quiet);
+    let source = super::open_source(&args.input, read_options, quiet);
+    spin.finish_and_clear();
+    let mut source = source?;
+    let pb = progress::bar(source.frame_count() as u64, "encode", quiet);
+    let encoded = encoder::encode_source(&mut source, opts, &progress::Reporter(&pb))?;
+    pb.finish_and_clear();
+    Ok(encoded)
+}
+
+/// `budget: vertex RMSE <= 2.0000e-4: quality 62.91 in 2 encodes (q50 31879 bytes, q62.91 35147
+/// bytes); kept 35147 bytes at vertex RMSE 1.9907e-4, largest vertex error 8.4022e-4; model ...`.
+fn budget_line(search: &BudgetReport) -> String {
+    let kept = search.trials.iter().find(|t| t.quality == search.quality);
+    let (bound, what) = match search.budget {
+        Budget::Bytes(_) | Budget::Bpvf(_) => (format!("{}", search.limit), "bytes"),
+        Budget::VertexRmse(_) => (format!("{:.4e}", search.limit), "vertex RMSE"),
+        Budget::MaxVertexError(_) => (format!("{:.4e}", search.limit), "largest vertex error"),
+    };
+    let trials: Vec<String> = search
+        .trials
+        .iter()
+        .map(
+            |t| match t.vertex_rmse.filter(|_| !matches!(what, "bytes")) {
+                Some(e) => format!("q{} {} bytes {e:.4e}", t.quality, t.bytes),
+                None => format!("q{} {} bytes", t.quality, t.bytes),
+            },
+        )
+        .collect();
+    let kept = kept.map_or(String::new(), |t| {
+        format!(
+            "kept {} bytes at vertex RMSE {:.4e}, largest vertex error {:.4e}",
+            t.bytes,
+            t.vertex_rmse.unwrap_or(f64::NAN),
+            t.max_vertex_error.unwrap_or(f64::NAN)
+        )
+    });
+    format!(
+        "budget: {what} <= {bound}: quality {} in {} encodes ({}); {kept}{}; model kept from the \
+         first encode: {}",
+        search.quality,
+        search.encodes,
+        trials.join(", "),
+        if search.within_tolerance {
+            ""
+        } else {
+            " (not within the tolerance: the closest under the budget found)"
+        },
+        search.model
+    )
 }
 
 /// The stream's bytes on stdout (a closed pipe is reported like any write to stdout).

@@ -2,10 +2,12 @@
 
 use crate::args::EvalArgs;
 use crate::progress;
+use mcgv_video::mesh::Point;
 use mcgv_video::mesh::{AnimatedMesh, FrameSource, ReadOptions};
-use mcgv_video::metrics::{same_frame_count, Comparison, Measures, Surface};
+use mcgv_video::metrics::{bpvf, same_frame_count, Comparison, Measures, Surface, VertexSums};
 use mcgv_video::Decoder;
 use mcgv_video::{Error, Result};
+use serde::Serialize;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
@@ -13,7 +15,8 @@ use std::path::Path;
 /// Runs `eval`.
 pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     let opts: ReadOptions = (&args.input_args).into();
-    let measures = if is_mcgv(&args.decoded) {
+    let tally = Tally::new(args.fast);
+    let result = if is_mcgv(&args.decoded) {
         let mut original = super::open_source(&args.original, &opts, quiet)?;
         let options = super::decode::decode_options(args.bands, args.input_args.max_positions);
         let path = Path::new(&args.decoded);
@@ -21,7 +24,7 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
             Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;
         super::decode::warn_if_truncated(&decoder);
         let bits = decoder.file_len() * 8;
-        compare_stream(&mut original, &mut decoder, quiet)
+        compare_stream(&mut original, &mut decoder, tally, quiet)
             .map_err(|e| super::in_file(path, e))?
             .with_bits(bits)
     } else {
@@ -33,14 +36,131 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
         }
         let mut original = super::open_source(&args.original, &opts, quiet)?;
         let mut decoded = super::open_source(&args.decoded, &opts, quiet)?;
-        compare_sources(&mut original, &mut decoded)?
+        compare_sources(&mut original, &mut decoded, tally)?
     };
     if args.json {
-        let json = serde_json::to_string(&measures)
-            .map_err(|e| Error::Usage(format!("cannot write the measures as JSON: {e}")))?;
+        let json = match &result {
+            Outcome::Full(m) => serde_json::to_string(m),
+            Outcome::Fast(m) => serde_json::to_string(m),
+        }
+        .map_err(|e| Error::Usage(format!("cannot write the measures as JSON: {e}")))?;
         outln!("{json}")
     } else {
-        out!("{}", report(&measures))
+        match &result {
+            Outcome::Full(m) => out!("{}", report(m)),
+            Outcome::Fast(m) => out!("{}", fast_report(m)),
+        }
+    }
+}
+
+/// The measures `eval --fast` gives: the vertex ones, which need no surface distances.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FastMeasures {
+    /// RMS vertex displacement over the original's first-frame bbox diagonal.
+    pub vertex_rmse: f64,
+    /// Karni–Gotsman error, percent (`None` when the original never leaves its centroids).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kg_error: Option<f64>,
+    /// Bits per vertex per frame of the stream, when there is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bpvf: Option<f64>,
+    /// Frames compared.
+    pub frames: usize,
+    /// Vertices of the original.
+    pub vertices: usize,
+}
+
+/// What `eval` accumulates, a run of frames at a time: every measure, or the vertex ones.
+enum Tally {
+    Full(Option<Box<Comparison>>),
+    /// Running sums, the original's first-frame diagonal, vertices, frames so far.
+    Fast(Option<(VertexSums, f64, usize, usize)>),
+}
+
+/// What `eval` found.
+enum Outcome {
+    Full(Measures),
+    Fast(FastMeasures),
+}
+
+impl Outcome {
+    fn with_bits(self, bits: u64) -> Self {
+        match self {
+            Self::Full(m) => Self::Full(m.with_bits(bits)),
+            Self::Fast(mut m) => {
+                m.bpvf = Some(bpvf(bits, m.vertices, m.frames));
+                Self::Fast(m)
+            }
+        }
+    }
+}
+
+impl Tally {
+    fn new(fast: bool) -> Self {
+        if fast {
+            Self::Fast(None)
+        } else {
+            Self::Full(None)
+        }
+    }
+
+    /// Sets the comparison up from the two first frames, unless done already.
+    fn start(&mut self, original: Surface<'_>, decoded: Surface<'_>) -> Result<()> {
+        match self {
+            Self::Full(c @ None) => *c = Some(Box::new(Comparison::new(original, decoded)?)),
+            Self::Fast(f @ None) => {
+                let (v, w) = (original.positions.len(), decoded.positions.len());
+                if v != w {
+                    return Err(Error::Usage(format!(
+                        "--fast compares corresponding vertices, but the original has {v} and \
+                         the decoded animation {w}; leave --fast out for the surface measures"
+                    )));
+                }
+                let diagonal = mcgv_video::mesh::bbox_diagonal(original.positions);
+                if diagonal.is_nan() || diagonal <= 0.0 {
+                    return Err(Error::Mesh(
+                        "the original's first frame has a zero bounding-box diagonal, the unit \
+                         of every measure"
+                            .into(),
+                    ));
+                }
+                *f = Some((VertexSums::default(), diagonal, v, 0));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Measures the next frames (after [`Self::start`]).
+    fn add(&mut self, original: &[Vec<Point>], decoded: &[Vec<Point>]) -> Result<()> {
+        match self {
+            Self::Full(Some(c)) => c.add(original, decoded),
+            Self::Fast(Some((sums, _, _, frames))) => {
+                for (a, b) in original.iter().zip(decoded) {
+                    sums.add_frame(a, b);
+                }
+                *frames += original.len().min(decoded.len());
+                Ok(())
+            }
+            _ => Err(Error::Stream("the stream has no frames".into())),
+        }
+    }
+
+    fn finish(self) -> Result<Outcome> {
+        match self {
+            Self::Full(Some(c)) => Ok(Outcome::Full((*c).finish())),
+            Self::Fast(Some((sums, diagonal, vertices, frames))) => {
+                let e = sums.errors(vertices as f64 * frames.max(1) as f64);
+                Ok(Outcome::Fast(FastMeasures {
+                    vertex_rmse: e.rmse / diagonal,
+                    kg_error: e.kg,
+                    bpvf: None,
+                    frames,
+                    vertices,
+                }))
+            }
+            _ => Err(Error::Stream("the stream has no frames".into())),
+        }
     }
 }
 
@@ -49,13 +169,13 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
 fn compare_stream(
     original: &mut FrameSource,
     decoder: &mut Decoder<BufReader<File>>,
+    mut tally: Tally,
     quiet: bool,
-) -> Result<Measures> {
+) -> Result<Outcome> {
     let frames = original.frame_count();
     same_frame_count(frames, decoder.header().frames as usize)?;
     let order = decoder.input_order(original.first())?;
     let pb = progress::bar(frames as u64, "decode", quiet);
-    let mut comparison: Option<Comparison> = None;
     for (s, range) in decoder.segments().to_vec().into_iter().enumerate() {
         let positions = decoder.decode_segment(s, &crate::progress::Reporter(&pb))?;
         let mut decoded = AnimatedMesh::new(decoder.triangles().to_vec(), positions)?;
@@ -63,39 +183,39 @@ fn compare_stream(
             decoded = decoded.permuted(inverse)?;
         }
         let originals = original.read(range)?;
-        let comparison = match &mut comparison {
-            Some(c) => c,
-            None => comparison.insert(Comparison::new(
-                Surface {
-                    triangles: original.first().triangles(),
-                    positions: &originals[0],
-                },
-                Surface {
-                    triangles: decoded.triangles(),
-                    positions: decoded.frame(0),
-                },
-            )?),
-        };
-        comparison.add(&originals, decoded.frames())?;
+        let first = originals.first().map_or(&[][..], |f| f.as_slice());
+        tally.start(
+            Surface {
+                triangles: original.first().triangles(),
+                positions: first,
+            },
+            Surface {
+                triangles: decoded.triangles(),
+                positions: decoded.frame(0),
+            },
+        )?;
+        tally.add(&originals, decoded.frames())?;
     }
     pb.finish_and_clear();
-    comparison
-        .map(Comparison::finish)
-        .ok_or_else(|| Error::Stream("the stream has no frames".into()))
+    tally.finish()
 }
 
 /// The measures of two animations read a run of frames at a time (OBJ and PC2 inputs are never
 /// held whole).
-fn compare_sources(original: &mut FrameSource, decoded: &mut FrameSource) -> Result<Measures> {
+fn compare_sources(
+    original: &mut FrameSource,
+    decoded: &mut FrameSource,
+    mut tally: Tally,
+) -> Result<Outcome> {
     let frames = original.frame_count();
     same_frame_count(frames, decoded.frame_count())?;
-    let mut comparison = Comparison::new(first_surface(original), first_surface(decoded))?;
+    tally.start(first_surface(original), first_surface(decoded))?;
     let run = mcgv_video::encoder::DEFAULT_SEGMENT_FRAMES;
     for start in (0..frames).step_by(run) {
         let range = start..(start + run).min(frames);
-        comparison.add(&original.read(range.clone())?, &decoded.read(range)?)?;
+        tally.add(&original.read(range.clone())?, &decoded.read(range)?)?;
     }
-    Ok(comparison.finish())
+    tally.finish()
 }
 
 /// The first frame of an animation as a surface.
@@ -141,6 +261,25 @@ pub fn report(m: &Measures) -> String {
             s.push_str("KG error     n/a (the original never leaves its centroid)\n")
         }
         (None, None) => s.push_str("KG error     n/a (the vertex counts differ)\n"),
+    }
+    if let Some(b) = m.bpvf {
+        s.push_str(&format!("bpvf         {b:.4}\n"));
+    }
+    s
+}
+
+/// The lines `eval --fast` prints.
+fn fast_report(m: &FastMeasures) -> String {
+    let mut s = format!("vertices     {}\nframes       {}\n", m.vertices, m.frames);
+    s.push_str("RMSE         not measured (--fast)\nHausdorff    not measured (--fast)\n");
+    s.push_str(&format!(
+        "vertex RMSE  {:.6e} of the bbox diagonal = {:.4} ×10⁻⁴\n",
+        m.vertex_rmse,
+        m.vertex_rmse * 1e4
+    ));
+    match m.kg_error {
+        Some(kg) => s.push_str(&format!("KG error     {kg:.6} %\n")),
+        None => s.push_str("KG error     n/a (the original never leaves its centroid)\n"),
     }
     if let Some(b) = m.bpvf {
         s.push_str(&format!("bpvf         {b:.4}\n"));

@@ -85,3 +85,40 @@ fn a_missing_input_fails_naming_it() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/animation.glb"));
 }
+
+#[test]
+fn fast_gives_the_vertex_measures_alone_and_alike() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    write_sheet(&a, 3, 0.0);
+    write_sheet(&b, 3, 0.05);
+    let (a_s, b_s) = (a.to_string_lossy(), b.to_string_lossy());
+    let full = json(&eval(&[&a_s, &b_s, "--json"]));
+    let fast = json(&eval(&[&a_s, &b_s, "--json", "--fast"]));
+    for key in ["vertex_rmse", "kg_error", "frames", "vertices"] {
+        assert_eq!(
+            number(&fast, key),
+            number(&full, key),
+            "{key}: {fast} {full}"
+        );
+    }
+    assert!(
+        fast.get("rmse").is_none() && fast.get("hausdorff").is_none(),
+        "{fast}"
+    );
+    let text = ok(&eval(&[&a_s, &b_s, "--fast"]));
+    assert!(
+        text.contains("not measured (--fast)") && text.contains("vertex RMSE"),
+        "{text}"
+    );
+    // One more vertex in every decoded frame: vertices no longer correspond.
+    for f in 0..3 {
+        let path = b.join(format!("frame_{f}.obj"));
+        let s = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
+        std::fs::write(&path, format!("v 9 9 9\n{s}")).unwrap_or_else(|e| panic!("{e}"));
+    }
+    let out = eval(&[&a_s, &b_s, "--fast"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--fast") && err.contains("36"), "{err}");
+}

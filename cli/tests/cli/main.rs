@@ -5,6 +5,7 @@ mod browser;
 mod common;
 
 mod auto;
+mod budget;
 mod codec;
 mod convert;
 mod eval;

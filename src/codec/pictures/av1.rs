@@ -35,7 +35,7 @@ pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<Ra
         1 => DEFAULT_AFFINE_PRECISION,
         _ => 1.0 / 16.0,
     };
-    let law = (av1_law as fn(u8, u8) -> PictureLaw, affine_precision);
+    let law = (av1_law_at as fn(f64, u8) -> PictureLaw, affine_precision);
     config.plan(Codec::Av1, law, rate, diagonal)
 }
 
@@ -125,8 +125,14 @@ fn av1_crf_of(log2_step: f64, depth: u8) -> f64 {
 /// whose quantiser step is the one of [`AV1_QP_AT_50`] scaled as the target step; a deeper sample
 /// wants a step a quarter as large per 2 bits (the same step in model units, finer rounding), down
 /// to [`AV1_MIN_QP`], below which the pixel step takes the rest.
+#[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn av1_law(quality: u8, depth: u8) -> PictureLaw {
-    let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
+    av1_law_at(f64::from(ijg_scale_percent(quality).max(1)), depth)
+}
+
+/// [`av1_law`] at the IJG scale `scale_percent` of a quality (between the integers too).
+pub(crate) fn av1_law_at(scale_percent: f64, depth: u8) -> PictureLaw {
+    let scale = scale_percent / 100.0;
     let deeper = f64::from(depth) - 10.0;
     let want = av1_log2_step(f64::from(AV1_QP_AT_50), 10) + scale.log2() - deeper;
     // The floor is a `crf`, not a step, at either depth: a floor following the depth sends the
@@ -235,6 +241,7 @@ mod tests {
             };
             let rate = Rate {
                 quality,
+                fine_quality: None,
                 step: None,
                 affine_precision: None,
             };
@@ -274,6 +281,7 @@ mod tests {
     fn affine_maps_are_finer_in_p_frame_groups_only() {
         let rate = Rate {
             quality: 50,
+            fine_quality: None,
             step: None,
             affine_precision: None,
         };

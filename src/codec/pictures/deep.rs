@@ -70,12 +70,14 @@ impl DeepConfig {
     pub(crate) fn plan(
         &self,
         codec: Codec,
-        (law, affine_precision): (fn(u8, u8) -> PictureLaw, f64),
+        (law, affine_precision): (fn(f64, u8) -> PictureLaw, f64),
         rate: &Rate,
         diagonal: f64,
     ) -> Result<RatePlan> {
-        let depth = self.bit_depth.unwrap_or_else(|| auto_depth(rate.quality));
-        let law = law(rate.quality, depth);
+        let depth = self.bit_depth.unwrap_or_else(|| {
+            auto_depth_at(rate.level())
+        });
+        let law = law(rate.scale_percent(), depth);
         let resolved = Resolved {
             codec,
             step_factor: law.step_factor,
@@ -98,8 +100,14 @@ pub const DEEPER_FROM_QUALITY: u8 = 90;
 /// [`DEEPER_FROM_QUALITY`], 12 from it. At equal error the finer rounding of 12 bits buys nothing
 /// at coarse steps; at fine ones it costs as much or less, and reaches errors 10 bits cannot where
 /// large residuals outgrow 1024 levels (docs/design.md, "Sample depth: 12 bits from quality 90").
+#[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn auto_depth(quality: u8) -> u8 {
-    if quality >= DEEPER_FROM_QUALITY {
+    auto_depth_at(f64::from(quality))
+}
+
+/// [`auto_depth`] at a quality between the integers too.
+fn auto_depth_at(quality: f64) -> u8 {
+    if quality >= f64::from(DEEPER_FROM_QUALITY) {
         12
     } else {
         10

@@ -39,7 +39,7 @@ pub(crate) fn check(config: &DeepConfig) -> Result<()> {
 /// (docs/design.md, "Affine precision per codec").
 pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
     let law = (
-        hevc_law as fn(u8, u8) -> PictureLaw,
+        hevc_law_at as fn(f64, u8) -> PictureLaw,
         DEFAULT_AFFINE_PRECISION,
     );
     config.plan(Codec::Hevc, law, rate, diagonal)
@@ -61,8 +61,14 @@ pub const HEVC_MIN_QP: f64 = 10.0;
 /// sample takes the same pixel step and a QP 6 lower per bit over 10: HEVC's QP is relative to the
 /// sample range, so this is the same quantiser step in model units; what 12 bits add is a finer
 /// rounding of the samples. The QP stops at 0.
+#[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn hevc_law(quality: u8, depth: u8) -> PictureLaw {
-    let scale = f64::from(ijg_scale_percent(quality).max(1)) / 100.0;
+    hevc_law_at(f64::from(ijg_scale_percent(quality).max(1)), depth)
+}
+
+/// [`hevc_law`] at the IJG scale `scale_percent` of a quality (between the integers too).
+pub(crate) fn hevc_law_at(scale_percent: f64, depth: u8) -> PictureLaw {
+    let scale = scale_percent / 100.0;
     let deeper = 6.0 * (f64::from(depth) - 10.0);
     let exact = HEVC_QP_AT_50 + 6.0 * scale.log2() - deeper;
     let qp = exact.round().clamp((HEVC_MIN_QP - deeper).max(0.0), 51.0);

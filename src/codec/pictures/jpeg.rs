@@ -133,7 +133,7 @@ impl JpegConfig {
     /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: the law's pixel
     /// step, every frame its own key frame and ranges, `snap` padding at the JPEG quality.
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
-        let law = jpeg_law(rate.quality);
+        let law = read_law(&JPEG_LAW, rate.level());
         let resolved = Resolved {
             codec: Codec::Jpeg,
             step_factor: law.step_factor,
@@ -159,8 +159,9 @@ const JPEG_LAW: [Anchor; 4] = [
 ];
 
 /// JPEG's pixel step factor and JPEG quality for a user quality 1..100.
+#[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn jpeg_law(quality: u8) -> PictureLaw {
-    read_law(&JPEG_LAW, quality)
+    read_law(&JPEG_LAW, f64::from(quality))
 }
 
 /// JPEG as the geometry-video picture codec: every frame a key frame, the tables every frame

@@ -56,7 +56,7 @@ impl Mpeg4Config {
     /// step and qscale, ranges per group, `biharmonic` padding, affine maps at 1/16 of the
     /// residual step (coarser maps' quantisation noise spoils P-frame prediction).
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
-        let law = mpeg4_law(rate.quality);
+        let law = read_law(&MPEG4_LAW, rate.level());
         let resolved = Resolved {
             codec: Codec::Mpeg4,
             step_factor: law.step_factor,
@@ -82,8 +82,9 @@ const MPEG4_LAW: [Anchor; 4] = [
 ];
 
 /// MPEG-4's pixel step factor and qscale for a user quality 1..100.
+#[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn mpeg4_law(quality: u8) -> PictureLaw {
-    read_law(&MPEG4_LAW, quality)
+    read_law(&MPEG4_LAW, f64::from(quality))
 }
 
 /// The FFmpeg encoder and decoder, and their geometry-video glue.

@@ -60,7 +60,8 @@ impl Rounding<'_> {
             e * e + self.lambda * model.cost(l.wrapping_sub(prediction))
         };
         let mut best = (price(0), 0);
-        for l in [below, below + 1] {
+        // Zero is priced already (and is one of the two when |x| < 1); a tie keeps the earlier.
+        for l in [below, below + 1].into_iter().filter(|&l| l != 0) {
             let p = price(l);
             if p < best.0 {
                 best = (p, l);
@@ -195,8 +196,8 @@ impl BandCoder {
         self.encode_among(k, levels, &Spatial::ALL)
     }
 
-    #[cfg(any(test, feature = "internals"))]
-    /// [`Self::encode`] choosing among `candidates` only (for measurements).
+    /// Encodes band `k` with the spatial predictor of `candidates` that codes it smallest (the
+    /// automatic choice's estimates and measurements).
     pub fn encode_among(
         &mut self,
         k: usize,

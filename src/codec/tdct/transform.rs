@@ -7,10 +7,10 @@ use super::coefficients::MAX_LEVEL;
 use crate::error::{Error, Result};
 use rustdct::DctPlanner;
 
-#[cfg(any(test, feature = "internals"))]
 /// The dead-zone offset θ of the quantiser: level = sign(c)·⌊|c|/Δ + 0.5 − θ⌋. Only the encoder
 /// uses it (the decoder reconstructs level·Δ). The encoder rounds by rate and distortion instead;
-/// 0.15, the best θ against plain rounding, is the baseline that rounding is measured against
+/// 0.15, the best θ against plain rounding, is the baseline that rounding is measured against,
+/// and the automatic choice's estimates use it (one pass, no rate–distortion pricing)
 /// (`measure_dead_zone`, `measure_rounding` in `tests/it/tdct.rs`;
 /// docs/design.md, "Temporal-DCT coder (rounding, contexts, spatial prediction)").
 pub const DEAD_ZONE: f64 = 0.15;

@@ -1,0 +1,464 @@
+//! Budgets: the quality whose stream fits a size or an error bound the caller gives.
+//!
+//! Users budget in bytes ("this must fit in 200 KB") or in error ("no vertex may move visibly"),
+//! not in a quality whose error differs per codec and clip. [`encode_to_budget`] searches the
+//! quality — between the integers too ([`EncodeOptions::fine_quality`]) — whose stream stays
+//! within the budget and lands within [`Budget::tolerance`] of it, in as few full encodes as it
+//! can: the first at the caller's quality (with the automatic choices, which the later encodes
+//! keep), then a model of the measure against the log of the target step (a straight line: its
+//! slope a prior per measure and codec, then the secant through the encodes made), then
+//! regula falsi inside the bracket if the model misses. It never returns a stream over the budget
+//! (docs/design.md, "Budgets").
+
+use super::{encode_with_progress, EncodeOptions, Encoded, PredictorChoice, SegmentationChoice};
+use crate::codec::Codec;
+use crate::codec::{fine_scale_percent, ijg_scale_percent};
+use crate::error::{Error, Result};
+use crate::mesh::AnimatedMesh;
+use crate::progress::{Progress, Silent};
+use crate::Decoder;
+use serde::Serialize;
+
+/// Encodes a search may make before it settles for the best stream within the budget so far.
+pub const MAX_BUDGET_ENCODES: usize = 10;
+
+/// What a stream must fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Budget {
+    /// At most this many bytes of `.mcgv` stream.
+    Bytes(u64),
+    /// At most this many bits per vertex and frame (the bytes it allows, rounded down).
+    Bpvf(f64),
+    /// Vertex RMSE over all vertices and frames, as a fraction of the first frame's bounding-box
+    /// diagonal (what `eval` reports as `vertex_rmse`), at most this.
+    VertexRmse(f64),
+    /// The largest displacement of any vertex in any frame, as a fraction of the diagonal, at
+    /// most this.
+    MaxVertexError(f64),
+}
+
+impl Budget {
+    /// How far under the budget a stream may land (a share of it): sizes 2 %, errors 3 %.
+    pub fn tolerance(&self) -> f64 {
+        match self {
+            Budget::Bytes(_) | Budget::Bpvf(_) => 0.02,
+            Budget::VertexRmse(_) | Budget::MaxVertexError(_) => 0.03,
+        }
+    }
+
+    /// Fails, naming the option, on a budget no stream can meet or that means nothing.
+    fn check(&self) -> Result<()> {
+        let (option, value) = match *self {
+            Budget::Bytes(bytes) => ("target_size", bytes as f64),
+            Budget::Bpvf(x) => ("target_bpvf", x),
+            Budget::VertexRmse(e) => ("target_error", e),
+            Budget::MaxVertexError(e) => ("target_max_error", e),
+        };
+        if value.is_finite() && value > 0.0 {
+            return Ok(());
+        }
+        Err(Error::option(
+            option,
+            format!("{value}: expected a positive number"),
+        ))
+    }
+
+    /// The bound in the measure's units: bytes, or a fraction of the diagonal.
+    fn limit(&self, mesh: &AnimatedMesh) -> f64 {
+        match *self {
+            Budget::Bytes(bytes) => bytes as f64,
+            Budget::Bpvf(x) => {
+                let positions = mesh.vertex_count() as f64 * mesh.frame_count() as f64;
+                (x * positions / 8.0).floor()
+            }
+            Budget::VertexRmse(e) | Budget::MaxVertexError(e) => e,
+        }
+    }
+
+    fn is_size(&self) -> bool {
+        matches!(self, Budget::Bytes(_) | Budget::Bpvf(_))
+    }
+
+    /// The measure of a trial this budget bounds.
+    fn measure(&self, trial: &BudgetTrial) -> f64 {
+        match self {
+            Budget::Bytes(_) | Budget::Bpvf(_) => trial.bytes as f64,
+            Budget::VertexRmse(_) => trial.vertex_rmse.unwrap_or(f64::INFINITY),
+            Budget::MaxVertexError(_) => trial.max_vertex_error.unwrap_or(f64::INFINITY),
+        }
+    }
+
+    /// The first guess of d ln(measure) / d ln(target step): sizes fall about as the step's
+    /// 0.7th power; the temporal DCT's error follows the step nearly in proportion, the picture
+    /// codecs' about as its 0.6th power (docs/design.md, "Quality laws").
+    fn prior_slope(&self, codec: Codec) -> f64 {
+        match (self.is_size(), codec) {
+            (true, _) => -0.7,
+            (false, Codec::Tdct) => 0.9,
+            (false, _) => 0.6,
+        }
+    }
+
+    fn what(&self) -> &'static str {
+        match self {
+            Budget::Bytes(_) | Budget::Bpvf(_) => "size",
+            Budget::VertexRmse(_) => "vertex RMSE",
+            Budget::MaxVertexError(_) => "largest vertex error",
+        }
+    }
+}
+
+/// One full encode of a search.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BudgetTrial {
+    /// The quality it was coded at.
+    pub quality: f64,
+    /// Its stream's bytes.
+    pub bytes: u64,
+    /// Its vertex RMSE over the diagonal (measured for error budgets, and for the stream kept).
+    pub vertex_rmse: Option<f64>,
+    /// Its largest vertex error over the diagonal (as `vertex_rmse`).
+    pub max_vertex_error: Option<f64>,
+}
+
+/// What a search did and found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BudgetReport {
+    /// The budget asked.
+    pub budget: Budget,
+    /// The bound in the measure's units (bytes, or a fraction of the diagonal).
+    pub limit: f64,
+    /// The quality of the stream kept (`--quality` with this value codes the same stream when the
+    /// automatic choices are given as `model` says).
+    pub quality: f64,
+    /// The stream kept's measure (bytes, or its error).
+    pub achieved: f64,
+    /// Whether it lies within [`Budget::tolerance`] under the limit (else it is the closest under
+    /// it found in [`MAX_BUDGET_ENCODES`] encodes, or at the end of the quality range).
+    pub within_tolerance: bool,
+    /// Full encodes made.
+    pub encodes: usize,
+    /// Every encode, in order.
+    pub trials: Vec<BudgetTrial>,
+    /// The motion model and first-frame bits of the first encode, kept by the others:
+    /// `predictor+segmentation`, K and bits.
+    pub model: String,
+}
+
+/// A stream within a budget and how it was found.
+pub struct Budgeted {
+    /// The stream kept.
+    pub encoded: Encoded,
+    /// The search.
+    pub search: BudgetReport,
+}
+
+/// Encodes `mesh` at the quality whose stream fits `budget`; `opts.quality` (or
+/// `opts.fine_quality`) is where the search starts. Fails when no quality meets the budget (a
+/// size under quality 1's stream, an error under quality 100's) or `opts.step` fixes the step.
+pub fn encode_to_budget(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    budget: Budget,
+) -> Result<Budgeted> {
+    encode_to_budget_with_progress(mesh, opts, budget, &Silent)
+}
+
+/// [`encode_to_budget`], telling `progress` each encode's stages.
+pub fn encode_to_budget_with_progress(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    budget: Budget,
+    progress: &dyn Progress,
+) -> Result<Budgeted> {
+    budget.check()?;
+    if opts.step.is_some() {
+        return Err(Error::option(
+            "step",
+            "fixes the step, which a budget search chooses: leave it out",
+        ));
+    }
+    opts.check(mesh)?;
+    let mut search = Search::new(mesh, opts, budget);
+    let start = opts.fine_quality.unwrap_or(f64::from(opts.quality));
+    let first = encode_with_progress(mesh, &at_quality(opts, start), progress)?;
+    let pinned = pin_choices(opts, &first);
+    search.model = model_name(&pinned);
+    search.record(first, start)?;
+    while let Some(quality) = search.next_quality()? {
+        let encoded = encode_with_progress(mesh, &at_quality(&pinned, quality), progress)?;
+        search.record(encoded, quality)?;
+    }
+    search.finish()
+}
+
+/// `opts` at `quality` (between the integers too).
+fn at_quality(opts: &EncodeOptions, quality: f64) -> EncodeOptions {
+    let integral = quality.fract() == 0.0;
+    EncodeOptions {
+        quality: quality.round().clamp(1.0, 100.0) as u8,
+        fine_quality: (!integral).then_some(quality),
+        ..opts.clone()
+    }
+}
+
+/// `opts` with the automatic choices fixed to those of `first`: each later encode is then one
+/// fixed encode, and its measure moves with the quality alone.
+fn pin_choices(opts: &EncodeOptions, first: &Encoded) -> EncodeOptions {
+    EncodeOptions {
+        predictor: PredictorChoice::Fixed(first.model.predictor),
+        segmentation: SegmentationChoice::Fixed(first.model.segmentation),
+        clusters: first.model.clusters,
+        first_frame_bits: Some(first.report.header.first_frame_bits),
+        ..opts.clone()
+    }
+}
+
+fn model_name(pinned: &EncodeOptions) -> String {
+    let models = pinned.motion_models();
+    let name = models.first().map_or_else(String::new, |m| m.name());
+    format!(
+        "{name}, K {}, first frame {} bits",
+        pinned.clusters,
+        pinned.first_frame_bits_or_default()
+    )
+}
+
+/// The log of the target step's scale at a quality: what the search's model is linear in.
+fn log_scale(quality: f64) -> f64 {
+    fine_scale_percent(quality).ln()
+}
+
+/// The quality (rounded to hundredths, so that a report's figure codes the same stream) whose
+/// log scale is `u`, within 1..=100.
+fn quality_of(u: f64) -> f64 {
+    let scale = |q: u8| f64::from(ijg_scale_percent(q).max(1)).ln();
+    let q = (1..100u8).find(|&q| scale(q + 1) <= u).unwrap_or(99);
+    let (a, b) = (scale(q), scale(q + 1));
+    let t = if a > b { (a - u) / (a - b) } else { 0.0 };
+    let x = f64::from(q) + t.clamp(0.0, 1.0);
+    ((x * 100.0).round() / 100.0).clamp(1.0, 100.0)
+}
+
+/// The state of one search: every encode's measure, and the best stream within the budget.
+struct Search<'a> {
+    mesh: &'a AnimatedMesh,
+    budget: Budget,
+    codec: Codec,
+    limit: f64,
+    /// (log scale, ln measure) of each encode.
+    points: Vec<(f64, f64)>,
+    trials: Vec<BudgetTrial>,
+    best: Option<(Encoded, usize)>,
+    model: String,
+}
+
+impl<'a> Search<'a> {
+    fn new(mesh: &'a AnimatedMesh, opts: &EncodeOptions, budget: Budget) -> Self {
+        Self {
+            mesh,
+            budget,
+            codec: opts.codec.codec(),
+            limit: budget.limit(mesh),
+            points: Vec::new(),
+            trials: Vec::new(),
+            best: None,
+            model: String::new(),
+        }
+    }
+
+    /// The lowest measure that counts as landed.
+    fn floor(&self) -> f64 {
+        self.limit * (1.0 - self.budget.tolerance())
+    }
+
+    fn landed(&self, measure: f64) -> bool {
+        (self.floor()..=self.limit).contains(&measure)
+    }
+
+    /// Measures `encoded` (coded at `quality`) and keeps it if it is the closest under the limit.
+    fn record(&mut self, encoded: Encoded, quality: f64) -> Result<()> {
+        let errors = if self.budget.is_size() {
+            None
+        } else {
+            Some(vertex_errors(self.mesh, &encoded)?)
+        };
+        let trial = BudgetTrial {
+            quality,
+            bytes: encoded.report.bytes,
+            vertex_rmse: errors.map(|e| e.0),
+            max_vertex_error: errors.map(|e| e.1),
+        };
+        let measure = self.budget.measure(&trial);
+        self.points
+            .push((log_scale(quality), measure.max(1e-300).ln()));
+        self.trials.push(trial);
+        let better = match &self.best {
+            Some((_, i)) => measure > self.budget.measure(&self.trials[*i]),
+            None => true,
+        };
+        if measure <= self.limit && better {
+            self.best = Some((encoded, self.trials.len() - 1));
+        }
+        Ok(())
+    }
+
+    /// The quality to encode next, or `None` when done (landed, out of encodes, or nothing left
+    /// to try); fails when the end of the quality range is over the budget.
+    fn next_quality(&self) -> Result<Option<f64>> {
+        let best = self
+            .best
+            .as_ref()
+            .map(|(_, i)| self.budget.measure(&self.trials[*i]));
+        if best.is_some_and(|m| self.landed(m)) || self.trials.len() >= MAX_BUDGET_ENCODES {
+            return Ok(None);
+        }
+        // Aim at the middle of the window, so that a model off by half the tolerance lands.
+        let aim = (self.limit * (1.0 - 0.5 * self.budget.tolerance())).ln();
+        let u = self.next_log_scale(aim);
+        let (lowest, highest) = (log_scale(100.0), log_scale(1.0));
+        let mut quality = quality_of(u.clamp(lowest, highest));
+        // A quality already coded: step a hundredth at a time towards the budget's side.
+        let towards = if self.budget.is_size() { -0.01 } else { 0.01 };
+        while self.trials.iter().any(|t| t.quality == quality) {
+            let next = ((quality + towards) * 100.0).round() / 100.0;
+            if !(1.0..=100.0).contains(&next) || best.is_some() {
+                return self.at_an_end(quality, best);
+            }
+            quality = next;
+        }
+        Ok(Some(quality))
+    }
+
+    /// Where the model puts the aim: inside the bracket when there is one (the secant through
+    /// its ends, pulled towards the middle if it would land at an end: regula falsi's fix), else
+    /// along the secant of the last two encodes (its slope kept within a factor of 4 of the prior,
+    /// and of the prior's sign), or the prior's slope after one encode.
+    fn next_log_scale(&self, aim: f64) -> f64 {
+        let prior = self.budget.prior_slope(self.codec);
+        if let Some((below, above)) = self.bracket(aim) {
+            let t = ((aim - below.1) / (above.1 - below.1)).clamp(0.1, 0.9);
+            return below.0 + t * (above.0 - below.0);
+        }
+        let last = self.points[self.points.len() - 1];
+        let slope = match self.points.len() {
+            n if n >= 2 => {
+                let before = self.points[n - 2];
+                let s = (last.1 - before.1) / (last.0 - before.0);
+                if s.is_finite() && s * prior > 0.0 {
+                    prior.signum() * s.abs().clamp(prior.abs() / 4.0, prior.abs() * 4.0)
+                } else {
+                    prior
+                }
+            }
+            _ => prior,
+        };
+        last.0 + (aim - last.1) / slope
+    }
+
+    /// Two encodes next to each other in log scale whose measures lie on either side of the aim
+    /// (below, above): of such pairs, the one with an end nearest the aim. Adjacent in the step,
+    /// not nearest in the measure, so that a measure that is not monotone (the largest vertex
+    /// error jumps from one quality to the next) still narrows the bracket at each encode.
+    fn bracket(&self, aim: f64) -> Option<((f64, f64), (f64, f64))> {
+        let mut sorted = self.points.clone();
+        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        sorted
+            .windows(2)
+            .filter(|w| (w[0].1 > aim) != (w[1].1 > aim))
+            .map(|w| match w[0].1 > aim {
+                true => (w[1], w[0]),
+                false => (w[0], w[1]),
+            })
+            .min_by(|x, y| {
+                let near =
+                    |p: &((f64, f64), (f64, f64))| (p.0 .1 - aim).abs().min((p.1 .1 - aim).abs());
+                near(x).total_cmp(&near(y))
+            })
+    }
+
+    /// The model asks for a quality already coded: the search is at an end of the quality range
+    /// (or of the hundredths). Done if a stream within the budget exists, else the budget is out
+    /// of reach.
+    fn at_an_end(&self, quality: f64, best: Option<f64>) -> Result<Option<f64>> {
+        if best.is_some() {
+            return Ok(None);
+        }
+        let measure = self
+            .trials
+            .iter()
+            .find(|t| t.quality == quality)
+            .map_or(f64::NAN, |t| self.budget.measure(t));
+        Err(Error::option(
+            self.option(),
+            format!(
+                "out of reach: the {} of {} at quality {quality} is {measure:.4e}, over {:.4e}",
+                self.budget.what(),
+                self.codec.name(),
+                self.limit
+            ),
+        ))
+    }
+
+    fn option(&self) -> &'static str {
+        match self.budget {
+            Budget::Bytes(_) => "target_size",
+            Budget::Bpvf(_) => "target_bpvf",
+            Budget::VertexRmse(_) => "target_error",
+            Budget::MaxVertexError(_) => "target_max_error",
+        }
+    }
+
+    fn finish(mut self) -> Result<Budgeted> {
+        let Some((encoded, i)) = self.best.take() else {
+            return Err(Error::option(
+                self.option(),
+                format!(
+                    "no stream within {:.4e} in {} encodes",
+                    self.limit,
+                    self.trials.len()
+                ),
+            ));
+        };
+        if self.trials[i].vertex_rmse.is_none() {
+            let (rmse, max) = vertex_errors(self.mesh, &encoded)?;
+            self.trials[i].vertex_rmse = Some(rmse);
+            self.trials[i].max_vertex_error = Some(max);
+        }
+        let achieved = self.budget.measure(&self.trials[i]);
+        let search = BudgetReport {
+            budget: self.budget,
+            limit: self.limit,
+            quality: self.trials[i].quality,
+            achieved,
+            within_tolerance: self.landed(achieved),
+            encodes: self.trials.len(),
+            trials: self.trials,
+            model: self.model,
+        };
+        Ok(Budgeted { encoded, search })
+    }
+}
+
+/// The vertex RMSE and the largest vertex error of `encoded` against `mesh`, as fractions of the
+/// first frame's bounding-box diagonal (`eval`'s `vertex_rmse`).
+fn vertex_errors(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<(f64, f64)> {
+    let bytes = encoded.to_bytes();
+    let decoded = Decoder::new(&bytes)?.decode_all()?;
+    // A reordered stream decodes in its own order: decoded vertex `new` is input vertex `perm[new]`.
+    let order = encoded.report.permutation.as_deref();
+    let (mut sum, mut max) = (0.0f64, 0.0f64);
+    for (original, coded) in mesh.frames().iter().zip(decoded.frames()) {
+        for (new, q) in coded.iter().enumerate() {
+            let old = order.map_or(new, |p| p[new] as usize);
+            let p = original[old];
+            let d2: f64 = (0..3).map(|a| f64::from(p[a] - q[a]).powi(2)).sum();
+            sum += d2;
+            max = max.max(d2);
+        }
+    }
+    let diagonal = mesh.bbox_diagonal();
+    let count = (mesh.vertex_count() * mesh.frame_count()).max(1) as f64;
+    Ok(((sum / count).sqrt() / diagonal, max.sqrt() / diagonal))
+}

@@ -1,0 +1,388 @@
+//! A uniform grid over one frame's triangles that settles a hinted nearest-triangle query locally.
+//!
+//! The surface measures query points that lie a tiny distance from their hint (the same-numbered
+//! face of a decoded frame is usually a fraction of an edge away). In the [`super::bvh`] tree such a
+//! query still climbs from the hint's leaf to the root, testing a sibling box at every level and
+//! descending into the many overlapping boxes a point on the surface lies in: on pdance 29 node
+//! boxes, 11 triangle boxes and 5 exact distances per query. Grid cells do not overlap, so the cube
+//! of half-side `d` around the query meets one to a few cells (1.1 on pdance), and only the
+//! triangles listed there can be nearer than `d` (24 boxes, 3.3 exact distances per query). The grid is rebuilt per frame in O(triangles). Cells are hashed into a table of about two
+//! buckets per triangle, so empty space costs nothing; a collision only adds candidates.
+//!
+//! Written here rather than taken from a crate: the spatial crates (`parry3d-f64`'s QBVH, `rstar`,
+//! `kiddo`) answer unbounded nearest queries over their own shapes and distance code; this one
+//! takes the hint's distance as the bound and reuses [`super::triangle`]'s exact distance, so the
+//! measures stay those of the tree to the last bit.
+
+use super::triangle::{point_triangle_distance_squared, Vec3};
+
+/// Cells one triangle may span before it is kept aside and tested by every query instead.
+const MAX_CELLS_PER_TRIANGLE: usize = 64;
+
+/// Triangles kept aside beyond which the grid gives up (every query would test them all).
+const MAX_OVERSIZED: usize = 32;
+
+/// Cells a query may visit before it is left to the tree.
+const MAX_QUERY_CELLS: usize = 27;
+
+/// Cell edge over the mean triangle extent: smaller cells list fewer triangles each, but each
+/// triangle joins more cells and a query crosses more cell walls. On pdance 1 took 7.0-7.4 CPU-s
+/// for `eval`; 0.7 and 0.5 took 9-11 (with 2 to 8 buckets per triangle), 1.5 and 2 took 7.6-8.
+const CELL_OVER_EXTENT: f64 = 1.0;
+
+/// The grid; empty (every query left to the tree) until built over finite triangles.
+#[derive(Debug, Clone, Default)]
+pub struct TriangleGrid {
+    /// Corner of cell (0, 0, 0).
+    min: Vec3,
+    /// One over the cell edge.
+    inv_cell: f64,
+    /// Cells along each axis.
+    dims: [i64; 3],
+    /// Bucket `b` lists `entries[start[b]..start[b + 1]]`; empty when the grid is off.
+    start: Vec<u32>,
+    entries: Vec<Entry>,
+    /// Triangles too large for cells, tested by every query.
+    oversized: Vec<u32>,
+    /// Bounding box (low, high corner) of each triangle.
+    boxes: Vec<[Vec3; 2]>,
+}
+
+/// A triangle listed in a bucket, with its bounding box widened to `f32` (a query tests the box
+/// where it is listed: half the bytes of `f64`, and no jump to a per-triangle table).
+#[derive(Debug, Clone, Copy, Default)]
+struct Entry {
+    lo: [f32; 3],
+    hi: [f32; 3],
+    triangle: u32,
+}
+
+impl Entry {
+    fn new(b: &[Vec3; 2], triangle: u32) -> Self {
+        // The nearest f32 on the outer side (`f32::next_down` needs a newer Rust than the MSRV).
+        let down = |x: f64| {
+            let y = x as f32;
+            if f64::from(y) > x {
+                step(y, -1)
+            } else {
+                y
+            }
+        };
+        let up = |x: f64| {
+            let y = x as f32;
+            if f64::from(y) < x {
+                step(y, 1)
+            } else {
+                y
+            }
+        };
+        Self {
+            lo: [down(b[0][0]), down(b[0][1]), down(b[0][2])],
+            hi: [up(b[1][0]), up(b[1][1]), up(b[1][2])],
+            triangle,
+        }
+    }
+
+    /// Squared distance from `p` to the (widened) box: never more than to the triangle's box.
+    fn distance_squared(&self, p: Vec3) -> f64 {
+        let mut d2 = 0.0;
+        for ((lo, hi), x) in self.lo.iter().zip(&self.hi).zip(&p) {
+            let d = (f64::from(*lo) - x).max(x - f64::from(*hi)).max(0.0);
+            d2 += d * d;
+        }
+        d2
+    }
+}
+
+/// The next `f32` after finite or infinite `y` towards +∞ (`dir` 1) or −∞ (−1); NaN stays NaN.
+fn step(y: f32, dir: i32) -> f32 {
+    if y.is_nan() || (y == f32::INFINITY && dir > 0) || (y == f32::NEG_INFINITY && dir < 0) {
+        return y;
+    }
+    if y == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if dir > 0 { tiny } else { -tiny };
+    }
+    // Away from zero is one more in the bit pattern, towards zero one less, whatever the sign.
+    let away = (y > 0.0) == (dir > 0);
+    let bits = y.to_bits();
+    f32::from_bits(if away { bits + 1 } else { bits - 1 })
+}
+
+/// The cell range `lo..=hi` along each axis.
+type CellRange = ([i64; 3], [i64; 3]);
+
+impl TriangleGrid {
+    /// Rebuilds the grid over `corners`, reusing its memory.
+    pub fn rebuild(&mut self, corners: &[[Vec3; 3]]) {
+        self.start.clear();
+        self.entries.clear();
+        self.oversized.clear();
+        self.boxes.clear();
+        self.boxes.extend(corners.iter().map(corner_box));
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let mut extent = 0.0;
+        for b in &self.boxes {
+            for a in 0..3 {
+                lo[a] = lo[a].min(b[0][a]);
+                hi[a] = hi[a].max(b[1][a]);
+            }
+            extent += (0..3).map(|a| b[1][a] - b[0][a]).fold(0.0, f64::max);
+        }
+        let cell = CELL_OVER_EXTENT * extent / corners.len().max(1) as f64;
+        if !(cell > 0.0 && cell.is_finite() && lo.iter().chain(&hi).all(|x| x.is_finite())) {
+            return;
+        }
+        self.min = lo;
+        self.inv_cell = 1.0 / cell;
+        // Cells beyond 2²⁰ per axis would overflow the hash's range; a clip that wide against its
+        // triangles is left to the tree.
+        let dims = [0, 1, 2].map(|a| ((hi[a] - lo[a]) * self.inv_cell).floor() as i64 + 1);
+        if dims.iter().any(|&n| n > 1 << 20) {
+            return;
+        }
+        self.dims = dims;
+        self.fill(corners.len());
+    }
+
+    /// Lists each triangle in the buckets of its cells (counting pass, then placing pass).
+    fn fill(&mut self, triangles: usize) {
+        let buckets = (2 * triangles).next_power_of_two();
+        let mut count = vec![0u32; buckets + 1];
+        for (t, b) in self.boxes.iter().enumerate() {
+            let range = self.cells(b[0], b[1]);
+            if cell_count(&range) > MAX_CELLS_PER_TRIANGLE {
+                self.oversized.push(t as u32);
+                continue;
+            }
+            for_each_cell(&range, |c| {
+                if let Some(n) = count.get_mut(bucket(c, buckets) + 1) {
+                    *n += 1;
+                }
+            });
+        }
+        if self.oversized.len() > MAX_OVERSIZED {
+            self.oversized.clear();
+            return;
+        }
+        for b in 1..count.len() {
+            count[b] += count[b - 1];
+        }
+        self.entries
+            .resize(count.last().copied().unwrap_or(0) as usize, Entry::default());
+        // `next[b]`: where bucket b's next entry goes.
+        let mut next = count.clone();
+        for (t, b) in self.boxes.iter().enumerate() {
+            let range = self.cells(b[0], b[1]);
+            if cell_count(&range) > MAX_CELLS_PER_TRIANGLE {
+                continue;
+            }
+            for_each_cell(&range, |c| {
+                if let Some(slot) = next.get_mut(bucket(c, buckets)) {
+                    if let Some(e) = self.entries.get_mut(*slot as usize) {
+                        *e = Entry::new(b, t as u32);
+                    }
+                    *slot += 1;
+                }
+            });
+        }
+        self.start = count;
+    }
+
+    /// The cells a box `lo..hi` meets, clipped to the grid (empty along an axis it misses).
+    fn cells(&self, lo: Vec3, hi: Vec3) -> CellRange {
+        let at = |x: f64, a: usize| -> i64 {
+            let c = (x - self.min[a]) * self.inv_cell;
+            // Rounds down like `floor` (a library call on baseline x86-64) within the clipped
+            // range; the conversion saturates, and clipping keeps indexes in range (a miss gives
+            // lo > hi).
+            let t = c.max(-1.0) as i64;
+            (t - i64::from((t as f64) > c)).min(self.dims[a])
+        };
+        let lo = [
+            at(lo[0], 0).max(0),
+            at(lo[1], 1).max(0),
+            at(lo[2], 2).max(0),
+        ];
+        let hi = [
+            at(hi[0], 0).min(self.dims[0] - 1),
+            at(hi[1], 1).min(self.dims[1] - 1),
+            at(hi[2], 2).min(self.dims[2] - 1),
+        ];
+        (lo, hi)
+    }
+
+    /// Lowers `best` (squared distance, triangle) to the nearest triangle to `p` when one is
+    /// nearer than `best` already is. Returns false, changing nothing, when the grid cannot tell
+    /// (no grid, or a bound too wide for few cells): the caller then searches otherwise.
+    pub fn improve(&self, p: Vec3, corners: &[[Vec3; 3]], best: &mut (f64, u32)) -> bool {
+        if self.start.is_empty() || !best.0.is_finite() {
+            return false;
+        }
+        // A little wider than the bound, so rounding in `p ± d` never drops a nearer triangle.
+        let d = best.0.sqrt() * (1.0 + 1e-9) + 1e-9 / self.inv_cell;
+        let range = self.cells(
+            [p[0] - d, p[1] - d, p[2] - d],
+            [p[0] + d, p[1] + d, p[2] + d],
+        );
+        if cell_count(&range) > MAX_QUERY_CELLS {
+            return false;
+        }
+        let buckets = self.start.len() - 1;
+        let exact = |t: u32, best: &mut (f64, u32)| {
+            if let Some(c) = corners.get(t as usize) {
+                let d2 = point_triangle_distance_squared(p, c[0], c[1], c[2]);
+                if d2 < best.0 {
+                    *best = (d2, t);
+                }
+            }
+        };
+        for &t in &self.oversized {
+            if t != best.1 {
+                exact(t, best);
+            }
+        }
+        for_each_cell(&range, |cell| {
+            let b = bucket(cell, buckets);
+            let (Some(&s), Some(&e)) = (self.start.get(b), self.start.get(b + 1)) else {
+                return;
+            };
+            for entry in self.entries.get(s as usize..e as usize).unwrap_or(&[]) {
+                if entry.triangle != best.1 && entry.distance_squared(p) < best.0 {
+                    exact(entry.triangle, best);
+                }
+            }
+        });
+        true
+    }
+}
+
+/// The bounding box of a triangle's corners.
+fn corner_box(c: &[Vec3; 3]) -> [Vec3; 2] {
+    let (mut lo, mut hi) = (c[0], c[0]);
+    for p in &c[1..] {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    [lo, hi]
+}
+
+/// Cells in a range (0 when it is empty along an axis).
+fn cell_count((lo, hi): &CellRange) -> usize {
+    (0..3)
+        .map(|a| (hi[a] - lo[a] + 1).max(0) as usize)
+        .product()
+}
+
+fn for_each_cell((lo, hi): &CellRange, mut f: impl FnMut([i64; 3])) {
+    for i in lo[0]..=hi[0] {
+        for j in lo[1]..=hi[1] {
+            for k in lo[2]..=hi[2] {
+                f([i, j, k]);
+            }
+        }
+    }
+}
+
+/// The bucket of a cell: the classic spatial-hash primes, in a power-of-two table.
+fn bucket(c: [i64; 3], buckets: usize) -> usize {
+    let h = (c[0] as u64).wrapping_mul(73_856_093)
+        ^ (c[1] as u64).wrapping_mul(19_349_663)
+        ^ (c[2] as u64).wrapping_mul(83_492_791);
+    (h as usize) & (buckets - 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_xoshiro::rand_core::{RngCore, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    fn uniform(rng: &mut Xoshiro256PlusPlus) -> f64 {
+        (rng.next_u32() >> 8) as f64 / (1u32 << 24) as f64
+    }
+
+    /// Small triangles scattered in the unit cube, plus one spanning it (kept aside).
+    fn soup(rng: &mut Xoshiro256PlusPlus) -> Vec<[Vec3; 3]> {
+        let mut corners: Vec<[Vec3; 3]> = (0..400)
+            .map(|_| {
+                let o = [uniform(rng), uniform(rng), uniform(rng)];
+                let mut c = [o; 3];
+                for p in &mut c[1..] {
+                    for x in p.iter_mut() {
+                        *x += 0.1 * uniform(rng) - 0.05;
+                    }
+                }
+                c
+            })
+            .collect();
+        corners.push([[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 1.0]]);
+        corners
+    }
+
+    #[test]
+    fn a_settled_query_is_the_linear_scan() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+        let corners = soup(&mut rng);
+        let mut grid = TriangleGrid::default();
+        grid.rebuild(&corners);
+        assert_eq!(grid.oversized.len(), 1, "the spanning triangle is kept aside");
+        let distance = |t: usize, p: Vec3| {
+            let c = corners[t];
+            point_triangle_distance_squared(p, c[0], c[1], c[2])
+        };
+        let mut settled = 0;
+        for k in 0..3000 {
+            let hint = k % corners.len();
+            // Half the queries lie near their hint, as the measures' do; half anywhere.
+            let p = if k % 2 == 0 {
+                corners[hint][0].map(|x| x + 0.01 * uniform(&mut rng))
+            } else {
+                [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)]
+            };
+            let want = (0..corners.len())
+                .map(|t| distance(t, p))
+                .fold(f64::INFINITY, f64::min);
+            let mut best = (distance(hint, p), hint as u32);
+            if grid.improve(p, &corners, &mut best) {
+                settled += 1;
+                assert_eq!(best.0, want, "query {k}");
+                assert_eq!(distance(best.1 as usize, p), want);
+            } else {
+                assert_eq!(best, (distance(hint, p), hint as u32), "unchanged when unsure");
+            }
+        }
+        // Far hints span too many cells and are left to the tree; near ones are settled.
+        assert!(settled > 1000, "{settled}");
+    }
+
+    #[test]
+    fn widened_boxes_hold_the_exact_ones() {
+        for x in [0.1f64, -0.1, 1e-40, -1e-40, 0.0, 3.0, 1e300, -1e300, 16777217.0] {
+            let e = Entry::new(&[[x; 3], [x; 3]], 0);
+            assert!(f64::from(e.lo[0]) <= x && f64::from(e.hi[0]) >= x, "{x}");
+            assert!(e.hi[0] <= step(step(e.lo[0], 1), 1), "{x}: within two steps");
+        }
+        assert_eq!(step(1.0, 1), 1.0 + f32::EPSILON);
+        assert_eq!(step(-1.0, -1), -1.0 - f32::EPSILON);
+        assert_eq!(step(f32::MAX, 1), f32::INFINITY);
+        assert!(step(0.0, -1) < 0.0 && step(-0.0, 1) > 0.0);
+    }
+
+    #[test]
+    fn no_grid_or_no_bound_settles_nothing() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(4);
+        let corners = soup(&mut rng);
+        let mut best = (0.5, 0);
+        assert!(!TriangleGrid::default().improve([0.5; 3], &corners, &mut best));
+        let mut grid = TriangleGrid::default();
+        grid.rebuild(&corners);
+        let mut unbounded = (f64::INFINITY, 0);
+        assert!(!grid.improve([0.5; 3], &corners, &mut unbounded));
+        // Non-finite corners switch the grid off rather than filling it with junk.
+        grid.rebuild(&[[[f64::NAN; 3]; 3]]);
+        assert!(!grid.improve([0.5; 3], &corners, &mut best));
+    }
+}

@@ -1,0 +1,244 @@
+//! k-means on the rows of a matrix: k-means++ seeding, then Lloyd rounds with the m_k-means
+//! update — the algorithm of `linfa-clustering` 0.8 (which the project used before), reproduced to
+//! the bit, so that the partition, and with it every stream, stays what it was.
+//!
+//! Written here rather than called from `linfa-clustering` because linfa measures every
+//! point–centroid distance with an element loop: on the motion descriptors (768 dimensions) that
+//! was half of a default encode's time. Here a round's nearest centroids come from one matrix
+//! product (‖x‖² − 2 x·c + ‖c‖², ndarray's `dot`), and only the centroids that product cannot tell
+//! apart from the nearest are measured exactly, in linfa's order of summation: the same labels at a
+//! fraction of the cost (docs/design.md, "Speed of the automatic choice").
+
+use ndarray::{Array1, Array2, ArrayView1, Axis};
+use rand::distributions::{Distribution, WeightedIndex};
+use rand::Rng;
+use rayon::prelude::*;
+
+/// The `k` centroids of the rows of `x` (1 ≤ k ≤ rows): k-means++ seeding from `rng`, then
+/// Lloyd rounds until the centroids (as one vector) move less than `tolerance`, or `max_rounds`.
+/// Each update averages a centroid's rows together with the old centroid (m_k-means), so that an
+/// emptied centroid stays where it was.
+pub(crate) fn kmeans(
+    x: &Array2<f32>,
+    k: usize,
+    rng: &mut impl Rng,
+    max_rounds: u64,
+    tolerance: f32,
+) -> Array2<f32> {
+    let rows = Centred::new(x);
+    let mut centroids = seed(x, k, rng);
+    for _ in 0..max_rounds.max(1) {
+        let labels = rows.nearest(&centroids);
+        let moved = means(x, &labels, &centroids);
+        let shift = exact_sq_distance(
+            centroids.as_slice().unwrap_or(&[]),
+            moved.as_slice().unwrap_or(&[]),
+        );
+        centroids = moved;
+        // linfa's L2 distance: the f32 sum of squares, its root taken in f64.
+        if (f64::from(shift).sqrt() as f32) < tolerance {
+            break;
+        }
+    }
+    centroids
+}
+
+/// Each row's nearest centroid (ties: the lowest index), measured as [`exact_sq_distance`] does.
+pub(crate) fn nearest(x: &Array2<f32>, centroids: &Array2<f32>) -> Vec<usize> {
+    Centred::new(x).nearest(centroids)
+}
+
+/// The squared distance of two equally long vectors, summed in f32 from the first element on:
+/// the value linfa's (ndarray-stats') `sq_l2_dist` gives, on which its choices depend.
+fn exact_sq_distance(a: &[f32], b: &[f32]) -> f32 {
+    let mut sum = 0f32;
+    for (&p, &q) in a.iter().zip(b) {
+        let d = p - q;
+        sum += d * d;
+    }
+    sum
+}
+
+fn row_norms(x: &Array2<f32>) -> Array1<f32> {
+    x.map_axis(Axis(1), |r| r.dot(&r))
+}
+
+fn row_slice<'a>(row: &'a ArrayView1<'_, f32>) -> std::borrow::Cow<'a, [f32]> {
+    match row.as_slice() {
+        Some(s) => std::borrow::Cow::Borrowed(s),
+        None => std::borrow::Cow::Owned(row.to_vec()),
+    }
+}
+
+/// k-means++: the first centroid a row drawn uniformly (as a weighted draw over weights one), each
+/// next one a row drawn with probability proportional to its squared distance to the nearest
+/// centroid so far (the first row if every distance is zero).
+fn seed(x: &Array2<f32>, k: usize, rng: &mut impl Rng) -> Array2<f32> {
+    let rows = x.nrows();
+    let mut centroids = Array2::zeros((k, x.ncols()));
+    let first = WeightedIndex::new(std::iter::repeat_n(1f32, rows)).map_or(0, |w| w.sample(rng));
+    centroids.row_mut(0).assign(&x.row(first));
+    let mut nearest_d2 = vec![f32::INFINITY; rows];
+    for j in 1..k {
+        let newest = centroids.row(j - 1).to_vec();
+        nearest_d2.par_iter_mut().enumerate().for_each(|(i, d)| {
+            *d = d.min(exact_sq_distance(&row_slice(&x.row(i)), &newest));
+        });
+        let pick = WeightedIndex::new(nearest_d2.iter()).map_or(0, |w| w.sample(rng));
+        centroids.row_mut(j).assign(&x.row(pick));
+    }
+    centroids
+}
+
+/// Rows ready for the matrix product: moved so that their mean is the origin (distances do not
+/// change, and the product's rounding, relative to the norms, shrinks to the spread of the rows),
+/// with their squared norms.
+struct Centred<'a> {
+    x: &'a Array2<f32>,
+    mean: Array1<f32>,
+    centred: Array2<f32>,
+    norms: Array1<f32>,
+}
+
+impl<'a> Centred<'a> {
+    fn new(x: &'a Array2<f32>) -> Self {
+        let mean = x.mean_axis(Axis(0)).unwrap_or_else(|| Array1::zeros(x.ncols()));
+        let centred = x - &mean;
+        let norms = row_norms(&centred);
+        Self {
+            x,
+            mean,
+            centred,
+            norms,
+        }
+    }
+
+    /// The nearest centroid of each row. The product's distances carry rounding of the order of
+    /// dim·ε(‖x‖² + ‖c‖²); every centroid within a wide margin of that around the product's nearest
+    /// is measured exactly, and the first of the exact minima wins, as in linfa.
+    fn nearest(&self, centroids: &Array2<f32>) -> Vec<usize> {
+        let moved = centroids - &self.mean;
+        let cross = self.centred.dot(&moved.t());
+        let centroid_norms = row_norms(&moved);
+        let largest_norm = centroid_norms.iter().copied().fold(0.0, f32::max);
+        let centroid_rows: Vec<Vec<f32>> =
+            centroids.rows().into_iter().map(|r| r.to_vec()).collect();
+        let dim = self.x.ncols().max(1) as f32;
+        (0..self.x.nrows())
+            .into_par_iter()
+            .map(|i| {
+                let n = self.norms[i];
+                let approx: Vec<f32> = cross
+                    .row(i)
+                    .iter()
+                    .zip(&centroid_norms)
+                    .map(|(&xc, &cc)| n - 2.0 * xc + cc)
+                    .collect();
+                let lowest = approx.iter().copied().fold(f32::INFINITY, f32::min);
+                let margin = 64.0 * dim * f32::EPSILON * (n + largest_norm);
+                let row = self.x.row(i);
+                let row = row_slice(&row);
+                let mut best = (0, f32::INFINITY);
+                for (j, &a) in approx.iter().enumerate() {
+                    // NaN (a non-finite descriptor) is measured too, as linfa would.
+                    if a.partial_cmp(&(lowest + margin)) != Some(std::cmp::Ordering::Greater) {
+                        let d = exact_sq_distance(&row, centroid_rows[j].as_slice());
+                        if d < best.1 {
+                            best = (j, d);
+                        }
+                    }
+                }
+                best.0
+            })
+            .collect()
+    }
+}
+
+/// m_k-means update: each centroid becomes the mean of its rows and its old self, the rows summed
+/// in f32 in row order and the sum divided by the count, as linfa does.
+fn means(x: &Array2<f32>, labels: &[usize], centroids: &Array2<f32>) -> Array2<f32> {
+    let mut sums = Array2::<f32>::zeros(centroids.raw_dim());
+    let mut counts = vec![1usize; centroids.nrows()];
+    for (row, &l) in x.rows().into_iter().zip(labels) {
+        let mut sum = sums.row_mut(l);
+        sum += &row;
+        counts[l] += 1;
+    }
+    sums += centroids;
+    for (mut sum, &count) in sums.rows_mut().into_iter().zip(&counts) {
+        sum /= count as f32;
+    }
+    sums
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_xoshiro::rand_core::SeedableRng;
+    use rand_xoshiro::Xoshiro256Plus;
+
+    /// Three well-separated blobs in 5 dimensions.
+    fn blobs() -> (Array2<f32>, Vec<usize>) {
+        let mut rng = Xoshiro256Plus::seed_from_u64(7);
+        let centres = [[0.0f32; 5], [10.0; 5], [-10.0, 10.0, -10.0, 10.0, 0.0]];
+        let mut rows = Vec::new();
+        let mut truth = Vec::new();
+        for i in 0..300 {
+            let c = i % 3;
+            truth.push(c);
+            for &m in &centres[c] {
+                rows.push(m + rng.gen_range(-0.5f32..0.5));
+            }
+        }
+        (Array2::from_shape_vec((300, 5), rows).unwrap(), truth)
+    }
+
+    #[test]
+    fn separated_blobs_are_found_and_the_result_repeats() {
+        let (x, truth) = blobs();
+        let run = || {
+            let mut rng = Xoshiro256Plus::seed_from_u64(0);
+            kmeans(&x, 3, &mut rng, 20, 1e-6)
+        };
+        let centroids = run();
+        assert_eq!(centroids, run());
+        let labels = nearest(&x, &centroids);
+        // Every blob in one cluster, every cluster one blob.
+        for c in 0..3 {
+            let of_blob: Vec<usize> = (0..300).filter(|&i| truth[i] == c).map(|i| labels[i]).collect();
+            assert!(of_blob.iter().all(|&l| l == of_blob[0]), "blob {c}");
+        }
+        let mut seen: Vec<usize> = (0..3).map(|c| labels[c]).collect();
+        seen.sort_unstable();
+        assert_eq!(seen, vec![0, 1, 2]);
+    }
+
+    #[test]
+    fn nearest_agrees_with_exact_distances_on_near_ties() {
+        // Rows almost equidistant from two far-off centroids: the product's rounding is larger than
+        // the gap, the exact measure decides.
+        let centroids = Array2::from_shape_vec((2, 3), vec![1e4, 0.0, 0.0, -1e4, 0.0, 0.0]).unwrap();
+        let rows: Vec<f32> = (0..40).flat_map(|i| [(i as f32 - 20.0) * 1e-3, 5.0, 5.0]).collect();
+        let x = Array2::from_shape_vec((40, 3), rows).unwrap();
+        let labels = nearest(&x, &centroids);
+        for (i, &l) in labels.iter().enumerate() {
+            let row = x.row(i).to_vec();
+            let d: Vec<f32> = centroids
+                .rows()
+                .into_iter()
+                .map(|c| exact_sq_distance(&row, c.as_slice().unwrap()))
+                .collect();
+            let want = if d[1] < d[0] { 1 } else { 0 };
+            assert_eq!(l, want, "row {i}: {d:?}");
+        }
+    }
+
+    #[test]
+    fn identical_rows_and_more_clusters_than_distinct_points() {
+        let x = Array2::from_elem((10, 4), 1.5f32);
+        let mut rng = Xoshiro256Plus::seed_from_u64(3);
+        let centroids = kmeans(&x, 4, &mut rng, 10, 0.0);
+        assert!(centroids.iter().all(|&v| v == 1.5));
+        assert!(nearest(&x, &centroids).iter().all(|&l| l < 4));
+    }
+}

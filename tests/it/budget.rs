@@ -1,0 +1,245 @@
+//! Budgets (issue 36): `encode_to_budget` lands within the tolerance under a size or an error
+//! bound, never over it, and says the quality found and the encodes made; quality is monotone
+//! in error for every codec, which the search relies on.
+//!
+//! pdance's figures (the issue's) need the shared media and take minutes on two cores: they are
+//! `#[ignore]`d and run by `make test-budgets`.
+
+use crate::common::{decode_all, read_media};
+use mcgv_video::codec::Codec;
+use mcgv_video::encoder::{encode_to_budget, Budget, Budgeted, EncodeOptions, Segmentation};
+use mcgv_video::mesh::{read_animation, AnimatedMesh, ReadOptions};
+use mcgv_video::metrics::vertex_errors;
+use mcgv_video::motion::PredictorKind;
+use std::path::PathBuf;
+
+/// The vertex RMSE of a stream over the first frame's diagonal, measured apart from the search.
+fn vertex_rmse(mesh: &AnimatedMesh, found: &Budgeted) -> f64 {
+    let decoded = decode_all(found.encoded.to_bytes()).expect("decodes");
+    vertex_errors(mesh, &decoded).expect("same sizes").rmse / mesh.bbox_diagonal()
+}
+
+/// Asserts that `found` is within `budget` and `tolerance` under it, by the stream itself.
+fn assert_within(mesh: &AnimatedMesh, found: &Budgeted, budget: Budget, tolerance: f64) {
+    let search = &found.search;
+    let (measure, limit) = match budget {
+        Budget::Bytes(bytes) => (found.encoded.to_bytes().len() as f64, bytes as f64),
+        Budget::VertexRmse(e) => (vertex_rmse(mesh, found), e),
+        other => panic!("not checked here: {other:?}"),
+    };
+    assert!(
+        measure <= limit && measure >= limit * (1.0 - tolerance),
+        "{budget:?}: {measure} not within {tolerance} under {limit}: {search:?}"
+    );
+    assert!(search.within_tolerance, "{search:?}");
+    assert!(
+        (search.achieved - measure).abs() <= 1e-9 * limit,
+        "{search:?}"
+    );
+    assert_eq!(search.encodes, search.trials.len());
+    let kept = search.trials.iter().find(|t| t.quality == search.quality);
+    assert_eq!(kept.map(|t| t.bytes), Some(found.encoded.report.bytes));
+    // The header records the quality found, rounded.
+    let header = found.encoded.report.header.quality;
+    assert_eq!(f64::from(header), search.quality.round(), "{search:?}");
+}
+
+/// A codec's options with one motion model (what the search keeps after its first encode), so
+/// that the picture codecs' tests code no candidates.
+fn fixed(codec: Codec) -> EncodeOptions {
+    EncodeOptions {
+        codec: codec.into(),
+        predictor: PredictorKind::Affine.into(),
+        segmentation: Segmentation::KMeans.into(),
+        ..EncodeOptions::default()
+    }
+}
+
+#[test]
+fn tdct_lands_under_a_size_and_an_error_in_three_encodes() {
+    let mesh = read_media("CesiumMan.glb");
+    // The defaults: the automatic choice on the first encode, kept by the others.
+    let opts = EncodeOptions::default();
+    for budget in [Budget::Bytes(30_000), Budget::VertexRmse(2e-4)] {
+        let found = encode_to_budget(&mesh, &opts, budget).expect("a stream within the budget");
+        assert_within(&mesh, &found, budget, budget.tolerance());
+        assert!(found.search.encodes <= 3, "{:?}", found.search);
+        assert_ne!(found.search.quality, 50.0);
+    }
+}
+
+#[test]
+fn av1_lands_under_a_size_and_an_error() {
+    if !Codec::Av1.available() {
+        return;
+    }
+    let mesh = cesium_man_at(12.0);
+    for budget in [Budget::Bytes(40_000), Budget::VertexRmse(2.5e-4)] {
+        let found = encode_to_budget(&mesh, &fixed(Codec::Av1), budget).expect("within budget");
+        assert_within(&mesh, &found, budget, budget.tolerance());
+        assert!(
+            found.search.encodes <= mcgv_video::encoder::MAX_BUDGET_ENCODES,
+            "{:?}",
+            found.search
+        );
+    }
+}
+
+#[test]
+fn a_largest_error_budget_lands_though_that_error_jumps_between_qualities() {
+    // On RiggedFigure the largest vertex error is 8.97e-4 at quality 50 and 7.51e-4 at 44.99: the
+    // search brackets by neighbouring steps, not by the measure, and still lands.
+    let mesh = read_media("RiggedFigure.glb");
+    let budget = Budget::MaxVertexError(1e-3);
+    let found = encode_to_budget(&mesh, &EncodeOptions::default(), budget).expect("within");
+    let decoded = decode_all(found.encoded.to_bytes()).expect("decodes");
+    let largest = mesh
+        .frames()
+        .iter()
+        .zip(decoded.frames())
+        .flat_map(|(a, b)| a.iter().zip(b))
+        .map(|(p, q)| (0..3).map(|i| f64::from(p[i] - q[i]).powi(2)).sum::<f64>())
+        .fold(0.0f64, f64::max)
+        .sqrt()
+        / mesh.bbox_diagonal();
+    let search = &found.search;
+    assert!((0.97e-3..=1e-3).contains(&largest), "{largest}: {search:?}");
+    assert!(search.within_tolerance, "{search:?}");
+    assert!((search.achieved - largest).abs() < 1e-12, "{search:?}");
+}
+
+#[test]
+fn an_unreachable_budget_is_an_error_naming_its_option() {
+    let mesh = read_media("RiggedSimple.glb");
+    let err = encode_to_budget(&mesh, &EncodeOptions::default(), Budget::Bytes(10))
+        .err()
+        .expect("10 bytes hold no stream");
+    assert!(err.to_string().contains("target_size"), "{err}");
+    let opts = EncodeOptions {
+        step: Some(1e-3),
+        ..EncodeOptions::default()
+    };
+    let err = encode_to_budget(&mesh, &opts, Budget::VertexRmse(1e-3)).err();
+    assert!(err.is_some_and(|e| e.to_string().contains("step")));
+    let err = encode_to_budget(&mesh, &EncodeOptions::default(), Budget::Bpvf(-1.0)).err();
+    assert!(err.is_some_and(|e| e.to_string().contains("target_bpvf")));
+}
+
+#[test]
+fn a_fine_quality_codes_between_its_integers() {
+    let mesh = read_media("RiggedSimple.glb");
+    let diagonal = mesh.bbox_diagonal();
+    for codec in Codec::ALL.into_iter().filter(|c| c.available()) {
+        let at = |quality: u8, fine_quality: Option<f64>| {
+            let opts = EncodeOptions {
+                quality,
+                fine_quality,
+                ..fixed(codec)
+            };
+            opts.plan(diagonal).expect("a plan")
+        };
+        let (lower, between, upper) = (at(60, None), at(61, Some(60.5)), at(61, None));
+        assert!(
+            lower.step > between.step && between.step > upper.step,
+            "{codec:?}: {lower:?} {between:?} {upper:?}"
+        );
+        assert_eq!(between.quality, 61);
+        // A fine quality at an integer is that integer.
+        assert_eq!(at(60, Some(60.0)), lower);
+    }
+    let opts = EncodeOptions {
+        fine_quality: Some(60.5),
+        ..fixed(Codec::Tdct)
+    };
+    let encoded = mcgv_video::encode(&mesh, &opts).expect("encodes");
+    assert_eq!(encoded.report.header.quality, 61);
+}
+
+/// CesiumMan at `fps` frames a second (12: 24 frames), to keep the sweeps short.
+fn cesium_man_at(fps: f64) -> AnimatedMesh {
+    let read = ReadOptions {
+        fps: Some(fps),
+        ..ReadOptions::default()
+    };
+    let path = crate::common::media_path("CesiumMan.glb");
+    read_animation(&path, &read).expect("reads")
+}
+
+/// Vertex RMSE over the diagonal of `codec` with one motion model at each of `qualities`.
+fn errors_over_qualities(mesh: &AnimatedMesh, codec: Codec, qualities: &[u8]) -> Vec<f64> {
+    qualities
+        .iter()
+        .map(|&quality| {
+            let opts = EncodeOptions {
+                quality,
+                ..fixed(codec)
+            };
+            let bytes = mcgv_video::encode(mesh, &opts).expect("encodes").to_bytes();
+            let decoded = decode_all(bytes).expect("decodes");
+            vertex_errors(mesh, &decoded).expect("same sizes").rmse / mesh.bbox_diagonal()
+        })
+        .collect()
+}
+
+/// What a search needs of every codec's law: with the motion model fixed (as the search keeps
+/// it), a higher quality gives no larger error, beyond 1 % — the noise where the 8-bit range, not
+/// the quality, sets MPEG-4's step (qualities 90–100 within 0.1–0.3 % on CesiumMan, pcow and the
+/// horses). The qualities straddle the laws' seams: anchors at 75 and 90, the 12-bit samples of
+/// HEVC and AV1 from 90, the quantisers' floors.
+#[test]
+fn a_higher_quality_never_gives_a_larger_error_for_any_codec() {
+    let mesh = cesium_man_at(6.0);
+    let qualities = [10u8, 50, 75, 89, 90, 97, 100];
+    for codec in Codec::ALL.into_iter().filter(|c| c.available()) {
+        let errors = errors_over_qualities(&mesh, codec, &qualities);
+        for (i, pair) in errors.windows(2).enumerate() {
+            assert!(
+                pair[1] <= pair[0] * 1.01,
+                "{codec:?}: quality {} gives {:.4e}, quality {} {:.4e}: {errors:?}",
+                qualities[i + 1],
+                pair[1],
+                qualities[i],
+                pair[0]
+            );
+        }
+        eprintln!("{codec:?} {errors:?}");
+    }
+}
+
+/// pdance unpacked from the shared media (`MCGV_PDANCE`, else `bench-out/media/pdance`, where
+/// `make test-budgets` and `make bench` unpack it from `${MCGV_SHARED_MEDIA:-../shared/media}`).
+fn pdance() -> Option<AnimatedMesh> {
+    let folder = std::env::var_os("MCGV_PDANCE")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| crate::common::repo_root().join("bench-out/media/pdance"));
+    read_animation(&folder.display().to_string(), &ReadOptions::default()).ok()
+}
+
+/// The issue's figures on pdance: `--target-size 100000` lands in 98 000–100 000 bytes and
+/// `--target-error 2e-4` in a vertex RMSE of 1.94e-4–2e-4, for tdct and AV1.
+#[test]
+#[ignore = "pdance, minutes on two cores: make test-budgets"]
+fn pdance_lands_under_100_kb_and_under_2e_4() {
+    let Some(mesh) = pdance() else {
+        eprintln!("no pdance unpacked (make test-budgets unpacks the shared media's): skipped");
+        return;
+    };
+    for codec in [Codec::Tdct, Codec::Av1]
+        .into_iter()
+        .filter(|c| c.available())
+    {
+        let opts = EncodeOptions {
+            codec: codec.into(),
+            ..EncodeOptions::default()
+        };
+        for budget in [Budget::Bytes(100_000), Budget::VertexRmse(2e-4)] {
+            let found = encode_to_budget(&mesh, &opts, budget).expect("within budget");
+            let search = &found.search;
+            eprintln!(
+                "pdance {codec:?} {budget:?}: quality {} in {} encodes, {} bytes, {:?}",
+                search.quality, search.encodes, found.encoded.report.bytes, search.achieved
+            );
+            assert_within(&mesh, &found, budget, budget.tolerance());
+        }
+    }
+}
