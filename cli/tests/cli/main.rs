@@ -7,6 +7,7 @@ mod common;
 mod auto;
 mod codec;
 mod convert;
+mod determinism;
 mod eval;
 mod frictions;
 mod gltf;

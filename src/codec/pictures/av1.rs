@@ -303,4 +303,9 @@ mod ffmpeg_tests {
     fn bad_settings_are_errors() {
         deep::testing::bad_settings_are_errors(Libaom, 32);
     }
+
+    #[test]
+    fn the_same_pictures_give_the_same_bytes_every_run() {
+        deep::testing::same_bytes_every_run(&Libaom, 24, 50, 3);
+    }
 }

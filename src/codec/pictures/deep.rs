@@ -351,7 +351,9 @@ mod coder {
     }
 
     /// Copies columns `x0..x0 + width` of the plane into FFmpeg plane `index` of `picture`, as 16-bit
-    /// little-endian samples, row by row (FFmpeg pads rows to its own stride, in bytes).
+    /// little-endian samples, row by row (FFmpeg pads rows to its own stride, in bytes). The rest
+    /// of FFmpeg's buffer, which it leaves as the allocator gave it, is zeroed first: no byte an
+    /// encoder may read can differ from one run to the next.
     fn fill_samples(
         picture: &mut frame::Video,
         index: usize,
@@ -361,6 +363,7 @@ mod coder {
     ) -> Result<()> {
         let stride = picture.stride(index);
         let buffer = picture.data_mut(index);
+        buffer.fill(0);
         for (y, row) in plane.data.chunks_exact(plane.width as usize).enumerate() {
             let src = &row[x0..x0 + width];
             let start = y * stride;
