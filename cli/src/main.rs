@@ -7,6 +7,8 @@ mod args;
 mod commands;
 mod progress;
 mod render;
+mod staging;
+mod target;
 
 use args::{Cli, Command};
 use clap::{CommandFactory, Parser};

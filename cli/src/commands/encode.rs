@@ -3,7 +3,7 @@
 use crate::args::{BitDepth, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::progress;
 use mcgv_video::codec::{Codec, CodecConfig, PictureOptions};
-use mcgv_video::encoder::{self, EncodeOptions, Segmentation};
+use mcgv_video::encoder::{self, EncodeOptions, Encoded, Segmentation};
 use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
 use mcgv_video::mesh::input_files;
 use mcgv_video::mesh::ReadOptions;
@@ -198,9 +198,11 @@ fn check_not_input(input: &str, opts: &ReadOptions, output: &Path) -> Result<()>
     Ok(())
 }
 
-/// Runs `encode`: one stream, or with `--clip all` one stream per glTF clip.
+/// Runs `encode`: one stream, or with `--clip all` one stream per glTF clip. Every output is
+/// checked before any work, and with several clips every stream is coded before any is written.
 pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
     let opts = options(args, threads)?;
+    opts.validate()?;
     let read_options: ReadOptions = (&args.input_args).into();
     let to_stdout = args.output.as_os_str() == "-";
     if to_stdout && args.json {
@@ -210,7 +212,9 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
         ));
     }
     if read_options.clip.as_deref() != Some("all") {
-        return encode_one(args, &opts, &read_options, &args.output, quiet);
+        check_output(args, &read_options, &args.output)?;
+        let encoded = encode_one(args, &opts, &read_options, quiet)?;
+        return write_and_report(args, encoded, &args.output, quiet);
     }
     let clips = mcgv_video::mesh::clips(&args.input, read_options.fps)?;
     if clips.is_empty() || to_stdout {
@@ -219,6 +223,7 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
             "all: needs a glTF input with animations and a file -o (one stream per clip)",
         ));
     }
+    let mut jobs = Vec::with_capacity(clips.len());
     for clip in &clips {
         let name = if clip.name.is_empty() {
             clip.index.to_string()
@@ -230,9 +235,27 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
             clip: Some(clip.index.to_string()),
             ..read_options.clone()
         };
-        encode_one(args, &opts, &read, &output, quiet)?;
+        check_output(args, &read, &output)?;
+        jobs.push((read, output));
+    }
+    let mut encoded = Vec::with_capacity(jobs.len());
+    for (read, output) in jobs {
+        encoded.push((encode_one(args, &opts, &read, quiet)?, output));
+    }
+    for (encoded, output) in encoded {
+        write_and_report(args, encoded, &output, quiet)?;
     }
     Ok(())
+}
+
+/// Checks `output` before any work: not an input file, not a file that exists unless `--force`,
+/// in a folder that takes files (stdout needs no check).
+fn check_output(args: &EncodeArgs, read: &ReadOptions, output: &Path) -> Result<()> {
+    if output.as_os_str() == "-" {
+        return Ok(());
+    }
+    check_not_input(&args.input, read, output)?;
+    crate::staging::check_file(output, args.force)
 }
 
 /// `fox.mcgv` for clip `Walk` → `fox-Walk.mcgv` (characters a file name cannot hold become `_`).
@@ -254,18 +277,13 @@ fn clip_output(output: &Path, clip: &str) -> PathBuf {
     output.with_file_name(format!("{stem}-{clean}.{extension}"))
 }
 
-/// Encodes one animation to `output` (a file, or stdout for `-`) and reports it.
+/// Encodes one animation, timed.
 fn encode_one(
     args: &EncodeArgs,
     opts: &EncodeOptions,
     read_options: &ReadOptions,
-    output: &Path,
     quiet: bool,
-) -> Result<()> {
-    let to_stdout = output.as_os_str() == "-";
-    if !to_stdout {
-        check_not_input(&args.input, read_options, output)?;
-    }
+) -> Result<(Encoded, Instant)> {
     let start = Instant::now();
     let spin = progress::spinner("reading", quiet);
     let source = super::open_source(&args.input, read_options, quiet);
@@ -274,10 +292,21 @@ fn encode_one(
     let pb = progress::bar(source.frame_count() as u64, "encode", quiet);
     let encoded = encoder::encode_source(&mut source, opts, &progress::Reporter(&pb))?;
     pb.finish_and_clear();
+    Ok((encoded, start))
+}
+
+/// Writes a stream to `output` (a file, or stdout for `-`) and reports it.
+fn write_and_report(
+    args: &EncodeArgs,
+    (encoded, start): (Encoded, Instant),
+    output: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let to_stdout = output.as_os_str() == "-";
     if to_stdout {
         write_stdout_bytes(&encoded.to_bytes())?;
     } else {
-        crate::output::create_parent(output)?;
+        crate::staging::create_parent(output)?;
         encoded.container.write_atomic(output)?;
     }
     let seconds = start.elapsed().as_secs_f64();

@@ -210,7 +210,7 @@ fn decoded_gltf_plays_at_the_source_frame_rate() {
     let fps_of = |extra: &[&str]| {
         let out = dir.path().join("out.glb");
         let o = out.to_str().unwrap();
-        let mut args = vec!["decode", s, "-o", o, "--quiet"];
+        let mut args = vec!["decode", s, "-o", o, "--quiet", "--force"];
         args.extend_from_slice(extra);
         ok(&run(&args));
         let info = crate::common::json(&run(&["info", o, "--json"]));

@@ -14,6 +14,7 @@ mod gltf;
 mod info;
 mod limits;
 mod outputs;
+mod safety;
 mod segmentation;
 mod segments;
 mod skinning;
