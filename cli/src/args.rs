@@ -7,7 +7,10 @@ use std::path::PathBuf;
 
 /// mcgv-video: compress animated triangle meshes into one `.mcgv` file (Multi-Chart Geometry Video).
 #[derive(Debug, Parser)]
+// No `help` subcommand (every command takes --help): each subcommand has a man page, and a
+// `help` page would only repeat this one.
 #[command(name = "mcgv-video", version, about, long_about = None, after_help = MAIN_EXAMPLES)]
+#[command(disable_help_subcommand = true)]
 pub struct Cli {
     /// The command to run.
     #[command(subcommand)]
@@ -74,11 +77,32 @@ pub enum Command {
         /// The shell.
         shell: clap_complete::Shell,
     },
-    /// Print the man page (roff) to stdout.
+    /// Print a man page (roff) to stdout: the command's, or a subcommand's (mcgv-video-encode(1)).
     #[command(after_help = "Examples:
   mcgv-video man > /usr/local/share/man/man1/mcgv-video.1
-  mcgv-video man | man -l -")]
-    Man,
+  mcgv-video man encode > /usr/local/share/man/man1/mcgv-video-encode.1
+  mcgv-video man decode | man -l -")]
+    Man {
+        /// The subcommand whose page to print (default: the command's own page).
+        #[arg(value_parser = subcommand_names())]
+        command: Option<String>,
+    },
+}
+
+/// The subcommands, each with a man page of its own (`mcgv-video-encode(1)` …).
+pub const SUBCOMMANDS: [&str; 8] = [
+    "encode",
+    "decode",
+    "inspect",
+    "eval",
+    "info",
+    "convert",
+    "completions",
+    "man",
+];
+
+fn subcommand_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(SUBCOMMANDS)
 }
 
 /// How to read an animation: options that apply to every input form.
@@ -467,7 +491,17 @@ impl From<&InputArgs> for mcgv_video::ReadOptions {
 
 #[cfg(test)]
 mod tests {
-    use super::{Frames, PADDING_METHODS};
+    use super::{Cli, Frames, PADDING_METHODS, SUBCOMMANDS};
+
+    #[test]
+    fn every_subcommand_has_a_man_page() {
+        use clap::CommandFactory;
+        let names: Vec<String> = Cli::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect();
+        assert_eq!(names, SUBCOMMANDS);
+    }
 
     #[test]
     fn one_frame_syntax_for_every_command() {

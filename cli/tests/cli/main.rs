@@ -17,4 +17,5 @@ mod outputs;
 mod safety;
 mod segmentation;
 mod segments;
+mod shell;
 mod skinning;
