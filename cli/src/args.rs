@@ -162,15 +162,16 @@ pub struct EncodeArgs {
     /// --quality sets.
     #[arg(long)]
     pub step: Option<f64>,
-    /// Number of motion clusters K for k-means (default 20; with --segmentation auto, for its
-    /// k-means candidate; tdct's auto also tries 1.5 K and 2 K).
+    /// Number of motion clusters K: alone, k-means with exactly K; with --segmentation auto,
+    /// K of its k-means candidate (tdct's auto also tries 1.5 K and 2 K) [default: 20].
     #[arg(long)]
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or
     /// auto: both are tried at the quality's step and the smaller stream is kept (picture codecs:
-    /// the fewer bits at equal error; see --json).
-    #[arg(long, value_enum, default_value_t = SegmentationChoice::Auto)]
-    pub segmentation: SegmentationChoice,
+    /// the fewer bits at equal error; see --json) [default: auto; kmeans when --clusters is
+    /// given without --e0: a user who names K expects K].
+    #[arg(long, value_enum)]
+    pub segmentation: Option<SegmentationChoice>,
     /// Decimation's error threshold E0: RMS affine-fit error per vertex and frame, as a fraction of
     /// the bounding-box diagonal (default 0.003, the paper's; decimation and auto).
     #[arg(long)]

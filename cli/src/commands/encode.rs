@@ -16,7 +16,14 @@ use std::time::Instant;
 /// Parses the encode arguments into encoder options, rejecting nonsense with a clear message.
 pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions> {
     let e0 = args.e0.unwrap_or(mcgv_video::encoder::DEFAULT_E0);
-    let segmentation = match args.segmentation {
+    // Only what the user left unsaid is chosen automatically: `--clusters K` alone is k-means
+    // with K, not a candidate the automatic choice may drop for decimation's own K (both
+    // --clusters and --e0 name both candidates: auto).
+    let choice = args.segmentation.unwrap_or(match (args.clusters, args.e0) {
+        (Some(_), None) => SegmentationChoice::Kmeans,
+        _ => SegmentationChoice::Auto,
+    });
+    let segmentation = match choice {
         SegmentationChoice::Kmeans => {
             if args.e0.is_some() {
                 return Err(Error::option(
