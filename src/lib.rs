@@ -70,6 +70,7 @@ macro_rules! internal {
 }
 
 pub mod codec;
+mod codec_log;
 mod decoder;
 pub mod encoder;
 mod error;
@@ -88,6 +89,7 @@ internal! {
 }
 
 pub use codec::{Codec, CodecConfig, Description};
+pub use codec_log::{set_codec_log, CodecLogSink};
 pub use decoder::{DecodeOptions, Decoder};
 pub use encoder::{
     encode, encode_source, encode_with_progress, EncodeOptions, EncodeReport, Encoded,

@@ -18,6 +18,10 @@ pub struct Cli {
     /// No progress bars or chatter; errors still go to stderr.
     #[arg(long, short, global = true)]
     pub quiet: bool,
+    /// Also show the codec libraries' warnings and errors (FFmpeg's), which are dropped
+    /// otherwise: the error the tool reports already says what failed.
+    #[arg(long, short, global = true)]
+    pub verbose: bool,
     /// Threads for the work done in parallel (groups of pictures, frames measured by eval)
     /// [default: one per core]; `encode` also codes N temporal segments at once (memory: N
     /// segments' working data; default one).

@@ -38,6 +38,12 @@ fn run() -> i32 {
             return 1;
         }
     }
+    if cli.verbose {
+        mcgv_video::set_codec_log(Some(|source, message| match source {
+            "" => eprintln!("mcgv-video: codec: {message}"),
+            _ => eprintln!("mcgv-video: codec: {source}: {message}"),
+        }));
+    }
     let result = match &cli.command {
         Command::Encode(a) => commands::encode::run(a, cli.quiet, cli.threads),
         Command::Decode(a) => commands::decode::run(a, cli.quiet),
