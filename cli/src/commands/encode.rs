@@ -221,7 +221,7 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
     if read_options.clip.as_deref() != Some("all") {
         check_output(args, &read_options, &args.output)?;
         let encoded = encode_one(args, &opts, &read_options, quiet)?;
-        return write_and_report(args, encoded, &args.output, quiet);
+        return write_and_report(args, &read_options, encoded, &args.output, quiet);
     }
     let clips = mcgv_video::mesh::clips(&args.input, read_options.fps)?;
     if clips.is_empty() || to_stdout {
@@ -247,10 +247,10 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
     }
     let mut encoded = Vec::with_capacity(jobs.len());
     for (read, output) in jobs {
-        encoded.push((encode_one(args, &opts, &read, quiet)?, output));
+        encoded.push((encode_one(args, &opts, &read, quiet)?, read, output));
     }
-    for (encoded, output) in encoded {
-        write_and_report(args, encoded, &output, quiet)?;
+    for (encoded, read, output) in encoded {
+        write_and_report(args, &read, encoded, &output, quiet)?;
     }
     Ok(())
 }
@@ -302,9 +302,11 @@ fn encode_one(
     Ok((encoded, start))
 }
 
-/// Writes a stream to `output` (a file, or stdout for `-`) and reports it.
+/// Writes a stream to `output` (a file, or stdout for `-`) and reports it, with the error of
+/// the file written (read from `input` with `read`) unless the stream went to stdout.
 fn write_and_report(
     args: &EncodeArgs,
+    read: &ReadOptions,
     (encoded, start): (Encoded, Instant),
     output: &Path,
     quiet: bool,
@@ -317,12 +319,23 @@ fn write_and_report(
         encoded.container.write_atomic(output)?;
     }
     let seconds = start.elapsed().as_secs_f64();
+    let achieved = match (to_stdout, quiet && !args.json) {
+        (false, false) => {
+            let spin = progress::spinner("measuring the error of the file written", quiet);
+            let achieved =
+                super::achieved::measure(&args.input, read, output, args.input_args.max_positions);
+            spin.finish_and_clear();
+            Some(achieved.map_err(|e| super::in_file(output, e))?)
+        }
+        _ => None,
+    };
     let r = &encoded.report;
     if args.json {
         let mut value = serde_json::to_value(r).map_err(|e| Error::Usage(e.to_string()))?;
         value["seconds"] = serde_json::json!(seconds);
         value["vertices"] = serde_json::json!(r.header.vertices);
         value["frames"] = serde_json::json!(r.header.frames);
+        value["achieved"] = serde_json::json!(achieved);
         return outln!("{value}");
     }
     if quiet {
@@ -345,11 +358,16 @@ fn write_and_report(
     );
     let line = match &r.choice {
         Some(choice) => format!(
-            "{line}\nauto: kept {} of {} candidates: {}",
+            "{line}\nauto: kept {} of {} candidates: {}{}",
             choice.chosen,
             choice.candidates.len(),
-            choice.reason
+            choice.reason,
+            trial_size_note(choice, r)
         ),
+        None => line,
+    };
+    let line = match achieved {
+        Some(a) => format!("{line}\n{}", a.line()),
         None => line,
     };
     let line = match r.segments {
@@ -377,6 +395,28 @@ first frame: kept {} bits of {}",
         Ok(())
     } else {
         outln!("{line}")
+    }
+}
+
+/// The candidates' sizes are their trials' (estimated from a sample of frames, or before the
+/// first frame's precision was chosen): when the kept one's is not the file's, says so, so that
+/// the report never leaves a size that is not the file's unexplained.
+fn trial_size_note(choice: &encoder::ChoiceReport, r: &encoder::EncodeReport) -> String {
+    let kept = choice.candidates.iter().find(|c| {
+        format!("{}+{}", c.predictor.name(), c.segmentation) == choice.chosen
+            && c.clusters == r.header.clusters as usize
+    });
+    match kept {
+        Some(c) if c.bytes != r.bytes => format!(
+            " (trial sizes; the file written is {} bytes{})",
+            r.bytes,
+            if r.first_frame_trials.is_empty() {
+                ""
+            } else {
+                ", its first frame's precision chosen after"
+            }
+        ),
+        _ => String::new(),
     }
 }
 

@@ -1,5 +1,6 @@
 //! One module per subcommand: each turns parsed arguments into work and prints the result.
 
+pub mod achieved;
 pub mod convert;
 pub mod decode;
 pub mod encode;

@@ -14,6 +14,7 @@ mod gltf;
 mod info;
 mod limits;
 mod outputs;
+mod report;
 mod safety;
 mod segmentation;
 mod segments;
