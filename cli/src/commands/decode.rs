@@ -23,8 +23,8 @@ pub fn decode_options(bands: Option<u64>, max_positions: Option<u64>) -> DecodeO
 }
 
 /// Tells on stderr when a temporal-DCT stream was cut short or has a damaged band: it decodes,
-/// but coarser.
-pub fn warn_if_truncated<R>(decoder: &Decoder<R>)
+/// but coarser. `bands` is `--bands`: fewer bands asked for is no damage.
+pub fn warn_if_truncated<R>(decoder: &Decoder<R>, bands: Option<u64>)
 where
     R: std::io::Read + std::io::Seek,
 {
@@ -33,12 +33,18 @@ where
             "mcgv-video: warning: stream truncated inside its last segment's temporal-DCT bands: \
              that segment decodes coarser"
         );
-    } else if let Some(bands) = decoder.describe().and_then(|d| d.bands) {
+    } else if let Some(described) = decoder.describe().and_then(|d| d.bands) {
+        let (bands, asked) = (described, bands);
+        let total = bands.lengths.len();
         if decoder.truncated() {
             eprintln!(
-                "mcgv-video: warning: stream truncated: decoded {} of {} temporal-DCT bands, a coarser animation",
+                "mcgv-video: warning: stream truncated: decoded {} of {total} temporal-DCT bands, a coarser animation",
                 bands.decoded,
-                bands.lengths.len()
+            );
+        } else if bands.decoded < total && asked.is_none_or(|n| n > bands.decoded as u64) {
+            eprintln!(
+                "mcgv-video: warning: temporal-DCT band {} of {total} is damaged: decoded the bands before it, a coarser animation",
+                bands.decoded,
             );
         }
     }
@@ -68,7 +74,7 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
     let mut decoder =
         Decoder::open_with(&args.input, &decode_options(args.bands, args.max_positions))
             .map_err(|e| super::in_file(&args.input, e))?;
-    warn_if_truncated(&decoder);
+    warn_if_truncated(&decoder, args.bands);
     if decoder.header().reorder && !quiet {
         eprintln!(
             "mcgv-video: note: {} was encoded with --reorder: the vertices are written in the \

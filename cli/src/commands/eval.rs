@@ -19,8 +19,8 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
         let path = Path::new(&args.decoded);
         let mut decoder =
             Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;
-        super::decode::warn_if_truncated(&decoder);
-        let bits = decoder.file_len() * 8;
+        super::decode::warn_if_truncated(&decoder, args.bands);
+        let bits = bits_read(&decoder, args.bands.is_some());
         compare_stream(&mut original, &mut decoder, quiet)
             .map_err(|e| super::in_file(path, e))?
             .with_bits(bits)
@@ -96,6 +96,20 @@ fn compare_sources(original: &mut FrameSource, decoded: &mut FrameSource) -> Res
         comparison.add(&original.read(range.clone())?, &decoded.read(range)?)?;
     }
     Ok(comparison.finish())
+}
+
+/// The bits the comparison stands on: the file's, less with `--bands` (`preview`) the bands it
+/// left unread, so that a preview's bpvf is the preview's (of a one-segment stream; a segmented
+/// one is charged whole, its other segments' bands being unknown until opened).
+fn bits_read(decoder: &Decoder<BufReader<File>>, preview: bool) -> u64 {
+    let unread = match decoder.describe().and_then(|d| d.bands) {
+        Some(b) if preview && !decoder.truncated() && decoder.segments().len() == 1 => b.lengths
+            [b.decoded.min(b.lengths.len())..]
+            .iter()
+            .sum::<u64>(),
+        _ => 0,
+    };
+    decoder.file_len().saturating_sub(unread) * 8
 }
 
 /// The first frame of an animation as a surface.
