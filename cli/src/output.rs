@@ -100,9 +100,24 @@ fn gltf_output(_path: &Path) -> Result<OutputKind> {
     Ok(OutputKind::Gltf)
 }
 
+/// `1 frame`, `2 frames`: a count with its noun in the right number (`word` is the singular).
+pub fn count(n: impl Into<u64>, word: &str) -> String {
+    match n.into() {
+        1 => format!("1 {word}"),
+        n => format!("{n} {word}s"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn counts_name_one_thing_in_the_singular() {
+        assert_eq!(count(1u32, "frame"), "1 frame");
+        assert_eq!(count(0u32, "cluster"), "0 clusters");
+        assert_eq!(count(49u32, "frame"), "49 frames");
+    }
 
     #[test]
     fn output_kind_comes_from_the_name() {

@@ -1,6 +1,7 @@
 //! `mcgv-video encode`.
 
 use crate::args::{BitDepth, EncodeArgs, PredictorChoice, SegmentationChoice};
+use crate::output::count;
 use crate::progress;
 use mcgv_video::codec::{Codec, CodecConfig, PictureOptions};
 use mcgv_video::encoder::{self, EncodeOptions, Encoded, Segmentation};
@@ -342,17 +343,17 @@ fn write_and_report(
         return Ok(());
     }
     let line = format!(
-        "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters by {} in {:.2} s, {} predictor, {} charts), {:.1} s ({:.1} frames/s)",
+        "{}: {} bytes, {:.3} bpvf ({} vertices x {}, {} by {} in {:.2} s, {} predictor, {}), {:.1} s ({:.1} frames/s)",
         if to_stdout { "stdout".into() } else { output.display().to_string() },
         r.bytes,
         r.bpvf,
         r.header.vertices,
-        r.header.frames,
-        r.header.clusters,
+        count(r.header.frames, "frame"),
+        count(r.header.clusters, "cluster"),
         r.segmentation.method,
         r.segmentation.seconds,
         r.header.predictor.name(),
-        r.charts,
+        count(r.charts as u64, "chart"),
         seconds,
         r.header.frames as f64 / seconds.max(1e-9)
     );

@@ -188,14 +188,14 @@ fn summary(h: &Header, stored: &Description, path: &Path) -> String {
         (None, None) => "no atlas".into(),
     };
     format!(
-        "{}: {} vertices x {} frames, {} faces; {} quality {}{settings}; {} clusters, {} predictor; {residuals}",
+        "{}: {} vertices x {}, {}; {} quality {}{settings}; {}, {} predictor; {residuals}",
         path.display(),
         h.vertices,
-        h.frames,
-        h.triangles,
+        crate::output::count(h.frames, "frame"),
+        crate::output::count(h.triangles, "face"),
         stored.codec.name(),
         h.quality,
-        h.clusters,
+        crate::output::count(h.clusters, "cluster"),
         h.predictor.name(),
     )
 }
