@@ -196,8 +196,9 @@ impl StagedFolder {
         let others = self.commit()?;
         if others > 0 && !quiet {
             eprintln!(
-                "mcgv-video: {}: left {others} other file(s) there as they were",
-                target.display()
+                "mcgv-video: {}: left {} there as they were",
+                target.display(),
+                crate::output::count(others as u64, "other file")
             );
         }
         Ok(())

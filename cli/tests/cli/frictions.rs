@@ -107,7 +107,7 @@ fn f3_decoding_into_a_folder_of_old_frames_is_refused_or_leaves_them() {
     // --force replaces only what the run writes: the stale frame stays, and the run says so.
     assert!(stale.exists(), "the stale frame was deleted");
     assert!(
-        stderr(&out).contains("left 1 other file(s)"),
+        stderr(&out).contains("left 1 other file there"),
         "{}",
         stderr(&out)
     );

@@ -78,7 +78,7 @@ fn a_folder_of_foreign_files_is_refused_and_with_force_keeps_what_the_run_does_n
     let err = succeeds(&run(&[
         "decode", &s, "--frames", "0..1", "-o", o, "--force",
     ]));
-    assert!(err.contains("left 10 other file(s)"), "{err}");
+    assert!(err.contains("left 10 other files"), "{err}");
     let after = snapshot(&dir);
     assert_eq!(after.len(), 11, "{:?}", after.keys());
     assert_ne!(after["frame_0000.obj"], before["frame_0000.obj"]);
