@@ -32,7 +32,13 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
             ));
         }
         let mut original = super::open_source(&args.original, &opts, quiet)?;
-        let mut decoded = super::open_source(&args.decoded, &opts, quiet)?;
+        // --clip names the original's clip: a decoded glTF holds one clip (`frames`), whatever
+        // the original's was called.
+        let decoded_opts = ReadOptions {
+            clip: None,
+            ..opts.clone()
+        };
+        let mut decoded = super::open_source(&args.decoded, &decoded_opts, true)?;
         compare_sources(&mut original, &mut decoded)?
     };
     if args.json {
