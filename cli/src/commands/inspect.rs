@@ -34,8 +34,8 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             return Err(Error::option(
                 "png",
                 format!(
-                    "a {} stream has no geometry images to write (its figures are in the plain \
-                     and --json output)",
+                    "applies to streams of geometry images: a {} stream has none (its figures \
+                     are in the plain and --json output)",
                     stored.codec.name()
                 ),
             ));

@@ -265,7 +265,8 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
         dir.path().join("png").to_str().unwrap(),
     ]);
     assert!(!png.status.success());
-    assert!(String::from_utf8_lossy(&png.stderr).contains("no geometry images"));
+    assert!(String::from_utf8_lossy(&png.stderr)
+        .contains("applies to streams of geometry images: a tdct stream has none"));
 
     let frames = dir.path().join("frames");
     ok(&run(&[
