@@ -150,8 +150,8 @@ mod coder {
         fn max_qp(&self) -> u8;
         /// The encoder's private options (FFmpeg's dictionary) for a fixed quantiser, deterministic
         /// output and a key frame every `gop` frames (size, format, GOP, no B-frames and one thread
-        /// are set on the context already).
-        fn settings(&self, options: &Options, gop: u32) -> Dictionary<'static>;
+        /// are set on the context already); `size` is the picture's width and height.
+        fn settings(&self, options: &Options, gop: u32, size: (u32, u32)) -> Dictionary<'static>;
     }
 
     /// How the x | y | z residual images of a frame go into a picture.
@@ -282,7 +282,10 @@ mod coder {
             video.set_max_b_frames(0);
             video.set_threading(libav::one_thread());
             let inner = video
-                .open_as_with(codec, flavour.settings(options, gop))
+                .open_as_with(
+                    codec,
+                    flavour.settings(options, gop, (picture_width, picture_height)),
+                )
                 .map_err(|e| {
                     let context = format!("open {} {width}×{height}", flavour.encoder_name());
                     libav::error(name, &context, e)

@@ -111,15 +111,23 @@ mod coder {
         /// analysis, lookahead slices or threads, each also turned off by name), one frame thread,
         /// and coding tree units of 32 pixels: with x265 3.5's 64, its reference limits and its
         /// motion compensation read memory it never wrote, so the same pictures came out as
-        /// different bytes from one encoder to the next (docs/design.md, "HEVC settings").
-        fn settings(&self, options: &deep::Options, gop: u32) -> Dictionary<'static> {
+        /// different bytes from one encoder to the next (docs/design.md, "HEVC settings"). A
+        /// picture narrower or lower than 32 takes 16-pixel units: x265 refuses a picture smaller
+        /// than one unit ("Picture size must be at least one CTU").
+        fn settings(
+            &self,
+            options: &deep::Options,
+            gop: u32,
+            (width, height): (u32, u32),
+        ) -> Dictionary<'static> {
             let mut dict = Dictionary::new();
             dict.set("preset", "medium");
             dict.set("tune", "psnr");
+            let ctu = if width.min(height) >= 32 { 32 } else { 16 };
             let params = format!(
                 "qp={qp}:keyint={gop}:min-keyint={gop}:scenecut=0:open-gop=0:bframes=0:\
                  repeat-headers=1:info=0:pools=none:frame-threads=1:wpp=0:pmode=0:pme=0:\
-                 lookahead-slices=0:lookahead-threads=0:ctu=32:log-level=error",
+                 lookahead-slices=0:lookahead-threads=0:ctu={ctu}:log-level=error",
                 qp = options.qp
             );
             dict.set("x265-params", &params);
