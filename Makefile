@@ -33,7 +33,7 @@ help:
 	@echo "make bench-speed  each codec's default encode against its choices fixed: CPU, wall, stages (bench-out/speed.md)"
 	@echo "make test-budgets  the budget searches on pdance (from the shared media), tdct and AV1"
 	@echo "make fuzz   fuzz the stream decoder and the mesh readers, FUZZ_SECONDS (default 300) each"
-	@echo "make install  the binary, shell completions and man page under PREFIX (default /usr/local)"
+	@echo "make install  the binary, shell completions and man pages under PREFIX (default /usr/local); needs only cargo"
 	@echo "make web   build the WebAssembly decoder and serve the player (web/example/) on localhost:WEB_PORT (8080)"
 	@echo "make python  build the Python package (release wheel) and install it into .venv"
 	@echo "make cluster-demo  a long clip's segments and a batch of files on a local Dask cluster"
@@ -191,19 +191,34 @@ fuzz: apt-deps
 	done; \
 	exit $$status
 
-# The completions and the man page come from the binary itself (clap_complete, clap_mangen), so they
-# always match its flags. DESTDIR for staged installs (packaging).
-install: apt-deps
-	$(CARGO) build --release --quiet -p mcgv-video-cli
-	install -Dm755 target/release/mcgv-video $(DESTDIR)$(PREFIX)/bin/mcgv-video
-	@bin=target/release/mcgv-video; dest=$(DESTDIR)$(PREFIX)/share; \
-	mkdir -p $$dest/bash-completion/completions $$dest/zsh/site-functions \
-		$$dest/fish/vendor_completions.d $$dest/man/man1 && \
-	$$bin completions bash >$$dest/bash-completion/completions/mcgv-video && \
-	$$bin completions zsh >$$dest/zsh/site-functions/_mcgv-video && \
-	$$bin completions fish >$$dest/fish/vendor_completions.d/mcgv-video.fish && \
-	$$bin man >$$dest/man/man1/mcgv-video.1 && \
-	echo "installed $(DESTDIR)$(PREFIX)/bin/mcgv-video, its completions and man page"
+# The binary (the `dist` profile: release, stripped, no debug information), its completions and
+# a man page per command, under PREFIX. Needs cargo and nothing else: no test dependency is
+# installed. The completions and man pages come from the binary itself (clap_complete,
+# clap_mangen), so they always match its flags. DESTDIR for staged installs (packaging);
+# CARGO_FLAGS=--no-default-features builds without FFmpeg (JPEG and tdct only, no shared
+# libraries needed at run time).
+MAN_PAGES := encode decode inspect eval info convert completions man
+CARGO_FLAGS ?=
+
+install:
+	@$(CARGO) build --profile dist --quiet -p mcgv-video-cli $(CARGO_FLAGS) || { \
+		echo "the default build links FFmpeg: install its development packages and clang"; \
+		echo "(make apt-deps), or build without it: make install CARGO_FLAGS=--no-default-features"; \
+		exit 1; }
+	@bin=target/dist/mcgv-video; dest=$(DESTDIR)$(PREFIX); share=$$dest/share; \
+	install -Dm755 $$bin $$dest/bin/mcgv-video && \
+	mkdir -p $$share/bash-completion/completions $$share/zsh/site-functions \
+		$$share/fish/vendor_completions.d $$share/man/man1 && \
+	$$bin completions bash >$$share/bash-completion/completions/mcgv-video && \
+	$$bin completions zsh >$$share/zsh/site-functions/_mcgv-video && \
+	$$bin completions fish >$$share/fish/vendor_completions.d/mcgv-video.fish && \
+	$$bin man >$$share/man/man1/mcgv-video.1 && \
+	for page in $(MAN_PAGES); do \
+		$$bin man $$page >$$share/man/man1/mcgv-video-$$page.1 || exit 1; \
+	done && \
+	echo "installed $$dest/bin/mcgv-video ($$(du -k $$bin | cut -f1) KB), its completions and man pages" && \
+	libs=$$(ldd $$bin 2>/dev/null | grep -oE 'lib(av|sw|postproc)[a-z]*\.so[.0-9]*' | sort -u | tr '\n' ' '); \
+	echo "shared libraries it needs at run time besides the C library: $${libs:-none}"
 
 clean:
 	$(CARGO) clean

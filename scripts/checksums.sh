@@ -21,9 +21,9 @@ sums() {
     local name=$1 sample=$2
     shift 2
     local out="$work/$name.mcgv"
-    "$bin" encode "$sample" -o "$out" --quiet "$@"
+    "$bin" encode "$sample" -o "$out" --force --quiet "$@"
     rm -f "$work/$name.pc2" "$work/$name.obj"
-    "$bin" decode "$out" -o "$work/$name.pc2" --quiet
+    "$bin" decode "$out" -o "$work/$name.pc2" --force --quiet
     printf '%s  %s  %s\n' "$(sha256sum <"$out" | cut -d' ' -f1)" \
         "$(sha256sum <"$work/$name.pc2" | cut -d' ' -f1)" "$name"
 }

@@ -17,7 +17,7 @@ for run in default mpeg4 jpeg; do
     [ "$run" = default ] || codec_flag=(--codec "$run")
     stream="$out/sample-$run.mcgv"
     t0=$(date +%s.%N)
-    "$bin" encode "$sample" -o "$stream" "${codec_flag[@]}" --quiet
+    "$bin" encode "$sample" -o "$stream" "${codec_flag[@]}" --force --quiet
     t1=$(date +%s.%N)
     "$bin" decode "$stream" -o "$out/decoded-$run/" --force --quiet
     t2=$(date +%s.%N)
@@ -34,7 +34,7 @@ done
 echo "(* the default codec)"
 glb="$out/$(basename "${sample%.*}")-decoded.glb"
 like=(); case $sample in *.glb | *.gltf) like=(--like "$sample") ;; esac
-"$bin" decode "$out/sample-default.mcgv" -o "$glb" "${like[@]}" --quiet
+"$bin" decode "$out/sample-default.mcgv" -o "$glb" "${like[@]}" --force --quiet
 echo
 echo "streams and decoded OBJ frames are in $out/; look inside with: $bin inspect $out/sample-jpeg.mcgv --png $out/png"
 echo "the default stream decoded to glTF (morph targets, UVs, the source's materials): $glb; drop it on https://gltf-viewer.donmccurdy.com/"

@@ -26,12 +26,12 @@ echo "segments,segment_frames,command,seconds,peak_rss_kb,bytes"
 for n in ${SEGMENTS:-1 4 16}; do
 	length=$(((F + n - 1) / n))
 	out="$work/clip-$n.mcgv"
-	row=$(run "$n,$length,encode" "$bin" encode "$work/clip/cloth.pc2" -o "$out" --codec "$codec" \
+	row=$(run "$n,$length,encode" "$bin" encode "$work/clip/cloth.pc2" -o "$out" --force --codec "$codec" \
 		--segment-frames "$length" --quiet "${quality[@]}")
 	bytes=$(stat -c %s "$out")
 	echo "$row,$bytes"
 	rm -rf "$work/frames"
-	echo "$(run "$n,$length,decode" "$bin" decode "$out" -o "$work/frames/" --quiet),$bytes"
+	echo "$(run "$n,$length,decode" "$bin" decode "$out" -o "$work/frames/" --force --quiet),$bytes"
 	rm -rf "$work/frames"
 	echo "$(run "$n,$length,eval" "$bin" eval "$work/clip/cloth.pc2" "$out" --json),$bytes"
 done

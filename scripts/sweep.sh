@@ -120,7 +120,7 @@ for input in "$@"; do
             case $codec in hevc-intra* | av1-intra*) codec_flags+=(--gop 1) ;; esac
             case $codec in *@*) codec_flags+=(--bit-depth "${codec#*@}") ;; esac
             [ "$lattice" = auto ] || codec_flags+=(--lattice "$lattice")
-            if ! read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" "${codec_flags[@]}" "$flag" "$value" \
+            if ! read -r ew ec em < <(measure "$bin" encode "$input" -o "$stream" --force "${codec_flags[@]}" "$flag" "$value" \
                 ${extra[@]+"${extra[@]}"} --quiet) || [ -z "${em:-}" ]; then
                 # Only a fixed lattice may be too small for the charts; any other failure stops the sweep.
                 [ "$lattice" = auto ] && exit 1
@@ -132,7 +132,7 @@ for input in "$@"; do
                 used=$("$bin" inspect "$stream" --json | sed -E 's/.*"lattice":\[([0-9]+),([0-9]+)\].*/\1x\2/')
                 label="$codec@$used"
             fi
-            read -r dw dc dm < <(measure "$bin" decode "$stream" -o "$tmp/dec.pc2" --quiet)
+            read -r dw dc dm < <(measure "$bin" decode "$stream" -o "$tmp/dec.pc2" --force --quiet)
             m=$("$bin" eval "$input" "$stream" --json --quiet)
             printf '%s,%s,%s,%d,%.4f,%.6e,%.6e,%.5f,%.6e,%s,%s,%s,%s,%s,%s,%d,%d\n' \
                 "$name" "$label$suffix" "${flag#--} $value" "$(stat -c %s "$stream")" "$(field bpvf "$m")" \

@@ -80,6 +80,7 @@ macro_rules! internal {
 }
 
 pub mod codec;
+mod codec_log;
 mod decoder;
 #[cfg(feature = "encode")]
 pub mod encoder;
@@ -102,6 +103,7 @@ internal! {
 }
 
 pub use codec::{Codec, CodecConfig, Description};
+pub use codec_log::{set_codec_log, CodecLogSink};
 pub use decoder::{DecodeOptions, Decoder, FirstFrame};
 #[cfg(feature = "encode")]
 pub use encoder::{

@@ -7,7 +7,10 @@ use std::path::PathBuf;
 
 /// mcgv-video: compress animated triangle meshes into one `.mcgv` file (Multi-Chart Geometry Video).
 #[derive(Debug, Parser)]
+// No `help` subcommand (every command takes --help): each subcommand has a man page, and a
+// `help` page would only repeat this one.
 #[command(name = "mcgv-video", version, about, long_about = None, after_help = MAIN_EXAMPLES)]
+#[command(disable_help_subcommand = true)]
 pub struct Cli {
     /// The command to run.
     #[command(subcommand)]
@@ -15,6 +18,10 @@ pub struct Cli {
     /// No progress bars or chatter; errors still go to stderr.
     #[arg(long, short, global = true)]
     pub quiet: bool,
+    /// Also show the codec libraries' warnings and errors (FFmpeg's), which are dropped
+    /// otherwise: the error the tool reports already says what failed.
+    #[arg(long, short, global = true)]
+    pub verbose: bool,
     /// Threads for the work done in parallel (groups of pictures, frames measured by eval)
     /// [default: one per core]; `encode` also codes N temporal segments at once (memory: N
     /// segments' working data; default one).
@@ -76,11 +83,32 @@ pub enum Command {
         /// The shell.
         shell: clap_complete::Shell,
     },
-    /// Print the man page (roff) to stdout.
+    /// Print a man page (roff) to stdout: the command's, or a subcommand's (mcgv-video-encode(1)).
     #[command(after_help = "Examples:
   mcgv-video man > /usr/local/share/man/man1/mcgv-video.1
-  mcgv-video man | man -l -")]
-    Man,
+  mcgv-video man encode > /usr/local/share/man/man1/mcgv-video-encode.1
+  mcgv-video man decode | man -l -")]
+    Man {
+        /// The subcommand whose page to print (default: the command's own page).
+        #[arg(value_parser = subcommand_names())]
+        command: Option<String>,
+    },
+}
+
+/// The subcommands, each with a man page of its own (`mcgv-video-encode(1)` …).
+pub const SUBCOMMANDS: [&str; 8] = [
+    "encode",
+    "decode",
+    "inspect",
+    "eval",
+    "info",
+    "convert",
+    "completions",
+    "man",
+];
+
+fn subcommand_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(SUBCOMMANDS)
 }
 
 /// How to read an animation: options that apply to every input form.
@@ -110,6 +138,9 @@ pub struct EncodeArgs {
     /// Output .mcgv file, or `-` for stdout. Missing parent folders are created.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Replace the output file if it exists.
+    #[arg(long, short = 'y')]
+    pub force: bool,
     /// Residual coder: tdct is the smallest at equal error; jpeg decodes any frame on its own;
     /// mpeg4, hevc and av1 (10/12-bit pictures) suit hardware video decoders.
     #[arg(long, default_value_t = Codec::default(), value_parser = codec_names())]
@@ -155,15 +186,16 @@ pub struct EncodeArgs {
     /// --quality sets.
     #[arg(long)]
     pub step: Option<f64>,
-    /// Number of motion clusters K for k-means (default 20; with --segmentation auto, for its
-    /// k-means candidate; tdct's auto also tries 1.5 K and 2 K).
+    /// Number of motion clusters K: alone, k-means with exactly K; with --segmentation auto,
+    /// K of its k-means candidate (tdct's auto also tries 1.5 K and 2 K) [default: 20].
     #[arg(long)]
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or
     /// auto: both are tried at the quality's step and the smaller stream is kept (picture codecs:
-    /// the fewer bits at equal error; see --json).
-    #[arg(long, value_enum, default_value_t = SegmentationChoice::Auto)]
-    pub segmentation: SegmentationChoice,
+    /// the fewer bits at equal error; see --json) [default: auto; kmeans when --clusters is
+    /// given without --e0: a user who names K expects K].
+    #[arg(long, value_enum)]
+    pub segmentation: Option<SegmentationChoice>,
     /// Decimation's error threshold E0: RMS affine-fit error per vertex and frame, as a fraction of
     /// the bounding-box diagonal (default 0.003, the paper's; decimation and auto).
     #[arg(long)]
@@ -314,14 +346,17 @@ pub struct DecodeArgs {
     /// source), so the decoded asset renders as the source did.
     #[arg(long, value_name = "SOURCE.glb")]
     pub like: Option<PathBuf>,
-    /// Decode only this frame (numbered from 0).
+    /// Decode only this frame (numbered from 0), e.g. into one X.obj.
     #[arg(long)]
     pub frame: Option<usize>,
-    /// Decode only frames A to B - 1 (numbered from 0; `10..20` is ten frames): a part of a long
-    /// clip, e.g. as glTF with fewer morph targets. OBJ frames keep their numbers.
-    #[arg(long, value_name = "A..B", conflicts_with = "frame", value_parser = parse_frame_range)]
-    pub frames: Option<std::ops::Range<usize>>,
-    /// Decode into a folder that already holds files, removing the frame_*.obj of an earlier decode.
+    /// Decode only these frames (numbered from 0): `A..B` is A to B - 1 (`10..20` is ten
+    /// frames), `A..` from A on, `..B` up to B - 1, `N` one frame, and `a,b,c` a list of any of
+    /// these; e.g. a part of a long clip as glTF with fewer morph targets. OBJ frames keep their
+    /// numbers.
+    #[arg(long, value_name = "A..B|N|a,b,c", conflicts_with = "frame")]
+    pub frames: Option<Frames>,
+    /// Replace output files that exist; in a folder that holds files, write the frames among them
+    /// (only files of the names this run writes are replaced; the others are left and counted).
     #[arg(long, short = 'y')]
     pub force: bool,
     /// tdct streams: decode only the first N temporal-DCT bands (a coarser, progressive preview).
@@ -333,21 +368,67 @@ pub struct DecodeArgs {
     pub max_positions: Option<u64>,
 }
 
-/// `A..B` with A < B, for `decode --frames`.
-fn parse_frame_range(text: &str) -> std::result::Result<std::ops::Range<usize>, String> {
-    let (a, b) = text
-        .split_once("..")
-        .ok_or_else(|| format!("{text}: expected A..B, e.g. 0..24"))?;
-    let number = |t: &str| {
-        t.trim()
-            .parse::<usize>()
-            .map_err(|_| format!("{text}: `{t}` is not a frame number"))
-    };
-    let (a, b) = (number(a)?, number(b)?);
-    if a >= b {
-        return Err(format!("{text}: the range is empty (A must be below B)"));
+/// A selection of frames, as `--frames` takes it: spans separated by commas, each `A..B` (A to
+/// B - 1), `A..` (A to the last), `..B` (the first to B - 1) or `N` (frame N).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Frames(Vec<(Option<usize>, Option<usize>)>);
+
+impl std::str::FromStr for Frames {
+    type Err = String;
+
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        let number = |t: &str| {
+            t.trim().parse::<usize>().map_err(|_| {
+                format!("{text}: `{t}` is not a frame number (A..B, A.., ..B, N or a,b,c)")
+            })
+        };
+        let mut spans = Vec::new();
+        for span in text.split(',') {
+            let span = span.trim();
+            let (from, to) = match span.split_once("..") {
+                None => {
+                    let n = number(span)?;
+                    (Some(n), Some(n + 1))
+                }
+                Some((a, b)) => {
+                    let end = |t: &str| (!t.trim().is_empty()).then(|| number(t)).transpose();
+                    (end(a)?, end(b)?)
+                }
+            };
+            if let (Some(a), Some(b)) = (from, to) {
+                if a >= b {
+                    return Err(format!("{text}: {span} is empty (A must be below B)"));
+                }
+            }
+            spans.push((from, to));
+        }
+        Ok(Frames(spans))
     }
-    Ok(a..b)
+}
+
+impl Frames {
+    /// The frames selected of a clip of `count` frames, in order, each once; a frame past the
+    /// end is a usage error of `option` (the flag's field name).
+    pub fn resolve(&self, count: usize, option: &'static str) -> mcgv_video::Result<Vec<usize>> {
+        let mut frames = Vec::new();
+        for &(from, to) in &self.0 {
+            let (a, b) = (from.unwrap_or(0), to.unwrap_or(count));
+            if b > count || a >= count {
+                return Err(mcgv_video::Error::option(
+                    option,
+                    format!(
+                        "{}..{b}: the stream has frames 0 to {}",
+                        a,
+                        count.saturating_sub(1)
+                    ),
+                ));
+            }
+            frames.extend(a..b);
+        }
+        frames.sort_unstable();
+        frames.dedup();
+        Ok(frames)
+    }
 }
 
 /// `inspect` arguments.
@@ -358,13 +439,18 @@ pub struct InspectArgs {
     /// Write residual images (raw, padded, decoded), the atlas and the segmentation as PNG here.
     #[arg(long)]
     pub png: Option<PathBuf>,
-    /// Frames whose images to write with --png (default: 0).
-    #[arg(long, value_delimiter = ',')]
-    pub frames: Vec<usize>,
+    /// Frames whose images --png writes (default: 0), as `decode --frames` takes them: `A..B`,
+    /// `A..`, `..B`, `N` or a list `a,b,c`.
+    #[arg(long, value_name = "A..B|N|a,b,c", requires = "png")]
+    pub frames: Option<Frames>,
     /// The original animation: with --png, also write the raw and padded residual images the encoder
     /// made (the encoder's analysis is re-run; it is deterministic).
-    #[arg(long)]
+    #[arg(long, requires = "png")]
     pub original: Option<String>,
+    /// With --png: replace the images of a folder that holds files (only files of the names this
+    /// run writes are replaced; the others are left and counted).
+    #[arg(long, short = 'y', requires = "png")]
+    pub force: bool,
     /// How to read the original.
     #[command(flatten)]
     pub input_args: InputArgs,
@@ -418,7 +504,8 @@ pub struct ConvertArgs {
     /// a name without extension) for OBJ frames frame_0000.obj ….
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Write into a folder that already holds files, removing the frame_*.obj of an earlier run.
+    /// Replace output files that exist; in a folder that holds files, write the frames among them
+    /// (only files of the names this run writes are replaced; the others are left and counted).
     #[arg(long, short = 'y')]
     pub force: bool,
     /// How to read the input.
@@ -441,7 +528,33 @@ impl From<&InputArgs> for mcgv_video::ReadOptions {
 
 #[cfg(test)]
 mod tests {
-    use super::PADDING_METHODS;
+    use super::{Cli, Frames, PADDING_METHODS, SUBCOMMANDS};
+
+    #[test]
+    fn every_subcommand_has_a_man_page() {
+        use clap::CommandFactory;
+        let names: Vec<String> = Cli::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect();
+        assert_eq!(names, SUBCOMMANDS);
+    }
+
+    #[test]
+    fn one_frame_syntax_for_every_command() {
+        let pick = |text: &str, count| text.parse::<Frames>().unwrap().resolve(count, "frames");
+        assert_eq!(pick("2..5", 10).unwrap(), [2, 3, 4]);
+        assert_eq!(pick("7..", 10).unwrap(), [7, 8, 9]);
+        assert_eq!(pick("..2", 10).unwrap(), [0, 1]);
+        assert_eq!(pick("3", 10).unwrap(), [3]);
+        assert_eq!(pick("0,9, 4..6,5", 10).unwrap(), [0, 4, 5, 9]);
+        assert_eq!(pick("..", 3).unwrap(), [0, 1, 2]);
+        assert!(pick("8..12", 10).is_err());
+        assert!(pick("10", 10).is_err());
+        for bad in ["5..5", "6..2", "a", "1..x", "", "1,,2", "-1"] {
+            assert!(bad.parse::<Frames>().is_err(), "{bad}");
+        }
+    }
 
     #[test]
     fn every_padding_method_is_offered_once() {

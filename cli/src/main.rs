@@ -7,6 +7,8 @@ mod args;
 mod commands;
 mod progress;
 mod render;
+mod staging;
+mod target;
 
 use args::{Cli, Command};
 use clap::{CommandFactory, Parser};
@@ -36,6 +38,12 @@ fn run() -> i32 {
             return 1;
         }
     }
+    if cli.verbose {
+        mcgv_video::set_codec_log(Some(|source, message| match source {
+            "" => eprintln!("mcgv-video: codec: {message}"),
+            _ => eprintln!("mcgv-video: codec: {source}: {message}"),
+        }));
+    }
     let result = match &cli.command {
         Command::Encode(a) => commands::encode::run(a, cli.quiet, cli.threads),
         Command::Decode(a) => commands::decode::run(a, cli.quiet),
@@ -44,7 +52,7 @@ fn run() -> i32 {
         Command::Info(a) => commands::info::run(a, cli.quiet),
         Command::Convert(a) => commands::convert::run(a, cli.quiet),
         Command::Completions { shell } => completions(*shell),
-        Command::Man => man(),
+        Command::Man { command } => man(command.as_deref()),
     };
     match result {
         Ok(()) => 0,
@@ -84,14 +92,49 @@ fn clap_error(e: &clap::Error) -> i32 {
 /// Writes the completion script of `shell` to stdout.
 fn completions(shell: clap_complete::Shell) -> mcgv_video::Result<()> {
     let mut buffer = Vec::new();
-    clap_complete::generate(shell, &mut Cli::command(), "mcgv-video", &mut buffer);
-    outln!("{}", String::from_utf8_lossy(&buffer).trim_end())
+    clap_complete::generate(shell, &mut Cli::command(), BIN, &mut buffer);
+    let script = String::from_utf8_lossy(&buffer);
+    let script = match shell {
+        clap_complete::Shell::Bash => fix_bash_labels(&script),
+        _ => script.into_owned(),
+    };
+    outln!("{}", script.trim_end())
 }
 
-/// Writes the man page (roff) to stdout.
-fn man() -> mcgv_video::Result<()> {
+/// The binary's name, as shells and man pages call it.
+const BIN: &str = "mcgv-video";
+
+/// clap_complete's bash script names a subcommand's state `mcgv__video__subcmd__encode` where it
+/// sets it but `mcgv__subcmd__video__subcmd__encode` in the case labels that read it (it splits a
+/// name holding `-` twice), so no option would ever complete: the labels are renamed to match.
+fn fix_bash_labels(script: &str) -> String {
+    let set = format!("{}__subcmd__", BIN.replace('-', "__"));
+    let read = format!("{}__subcmd__", BIN.replace('-', "__subcmd__"));
+    script.replace(&read, &set)
+}
+
+/// Writes a man page (roff) to stdout: the command's, or subcommand `command`'s, named
+/// `mcgv-video-COMMAND` as the main page's SEE ALSO lists it, with the global options.
+fn man(command: Option<&str>) -> mcgv_video::Result<()> {
+    let mut cli = Cli::command();
+    // Propagates the global options (--quiet, --threads) into every subcommand.
+    cli.build();
+    let page = match command {
+        None => cli,
+        Some(name) => {
+            let sub = cli.find_subcommand(name).ok_or_else(|| {
+                mcgv_video::Error::option("command", format!("{name}: no such subcommand"))
+            })?;
+            let full = format!("{BIN}-{name}");
+            sub.clone()
+                .name(full.clone())
+                .bin_name(format!("{BIN} {name}"))
+                .display_name(full)
+                .version(env!("CARGO_PKG_VERSION"))
+        }
+    };
     let mut buffer = Vec::new();
-    clap_mangen::Man::new(Cli::command())
+    clap_mangen::Man::new(page)
         .render(&mut buffer)
         .map_err(|e| mcgv_video::Error::io("stdout", e))?;
     out!("{}", String::from_utf8_lossy(&buffer))

@@ -248,8 +248,9 @@ impl EncodeOptions {
             .collect()
     }
 
-    /// Fails, naming the field, when an option is out of range.
-    pub fn check(&self, mesh: &AnimatedMesh) -> Result<()> {
+    /// Fails, naming the field, when an option is out of range: what [`EncodeOptions::check`]
+    /// checks without the animation, so that a caller can refuse nonsense before any work.
+    pub fn validate(&self) -> Result<()> {
         self.check_ranges()?;
         self.check_step()?;
         self.codec.check()?;
@@ -260,6 +261,12 @@ impl EncodeOptions {
                 format!("{}: this build has no such codec", codec.name()),
             ));
         }
+        Ok(())
+    }
+
+    /// Fails, naming the field, when an option is out of range or does not fit `mesh`.
+    pub fn check(&self, mesh: &AnimatedMesh) -> Result<()> {
+        self.validate()?;
         if mesh.triangles().is_empty() {
             return Err(Error::Mesh(
                 "the mesh has no triangles: nothing to parameterize".into(),

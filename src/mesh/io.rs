@@ -138,6 +138,23 @@ pub fn write_obj_sequence_from(mesh: &AnimatedMesh, dir: &Path, first: usize) ->
     Ok(())
 }
 
+/// The file names of OBJ frames `frames` in a sequence whose last frame is numbered `last`, as
+/// [`write_obj_sequence`] and [`ObjFrameWriter`] name them (`frame_0012.obj`): what a caller checks
+/// before writing them, so that no other file is touched.
+pub fn obj_frame_names(frames: impl IntoIterator<Item = usize>, last: usize) -> Vec<String> {
+    let digits = frame_digits(last);
+    frames.into_iter().map(|f| frame_name(f, digits)).collect()
+}
+
+/// Digits of frame numbers up to `last`: at least four, so that the files sort by name too.
+fn frame_digits(last: usize) -> usize {
+    last.to_string().len().max(4)
+}
+
+fn frame_name(f: usize, digits: usize) -> String {
+    format!("frame_{f:0digits$}.obj")
+}
+
 /// Writes frames of one connectivity as they come (a decoder's, one at a time), named as
 /// [`write_obj_sequence`] names them: no frame needs to wait for the others.
 pub struct ObjFrameWriter<'a> {
@@ -158,7 +175,7 @@ impl<'a> ObjFrameWriter<'a> {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         Ok(Self {
             dir,
-            digits: last.to_string().len().max(4),
+            digits: frame_digits(last),
             triangles,
             attributes,
         })
@@ -166,8 +183,7 @@ impl<'a> ObjFrameWriter<'a> {
 
     /// Writes frame number `f`.
     pub fn write(&self, f: usize, positions: &[super::Point]) -> Result<()> {
-        let digits = self.digits;
-        let path = self.dir.join(format!("frame_{f:0digits$}.obj"));
+        let path = self.dir.join(frame_name(f, self.digits));
         let text = obj::obj_text(self.triangles, positions, self.attributes);
         write_atomic(&path, text.as_bytes())
     }

@@ -38,9 +38,9 @@ pub use gltf::Clip;
 pub use gltf_write::{is_gltf_path, write_gltf, GltfOptions, MANY_MORPH_TARGETS};
 #[cfg(feature = "encode")]
 pub use io::{
-    clips, input_files, parse_gltf, parse_obj, parse_pc2, read_animation, write_obj_frame,
-    write_obj_mesh_frame, write_obj_sequence, write_obj_sequence_from, write_pc2, ObjFrameWriter,
-    Pc2Writer, ReadOptions,
+    clips, input_files, obj_frame_names, parse_gltf, parse_obj, parse_pc2, read_animation,
+    write_obj_frame, write_obj_mesh_frame, write_obj_sequence, write_obj_sequence_from, write_pc2,
+    ObjFrameWriter, Pc2Writer, ReadOptions,
 };
 #[cfg(feature = "encode")]
 pub use summary::Summary;

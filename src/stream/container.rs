@@ -458,6 +458,20 @@ impl<R: Read + Seek> ContainerReader<R> {
         crc: u32,
         what: &str,
     ) -> Result<Vec<u8>> {
+        self.chunk_if_intact(tag, offset, len, crc, what)?
+            .ok_or_else(|| Error::Stream(format!("{what} fails its checksum (damaged file)")))
+    }
+
+    /// [`Self::chunk`], but a chunk that fails its checksum is `None` rather than an error: for
+    /// chunks a decoder can do without (a temporal-DCT band and those after it).
+    pub fn chunk_if_intact(
+        &mut self,
+        tag: Tag,
+        offset: u64,
+        len: u64,
+        crc: u32,
+        what: &str,
+    ) -> Result<Option<Vec<u8>>> {
         let e = self.entry(tag)?;
         let end = offset.checked_add(len);
         if end.is_none_or(|end| end > e.len) {
@@ -470,12 +484,7 @@ impl<R: Read + Seek> ContainerReader<R> {
             return Err(Error::Stream(format!("{what} lies outside part {tag}")));
         }
         let bytes = self.read_at(e.offset + offset, len, tag)?;
-        if crc32fast::hash(&bytes) != crc {
-            return Err(Error::Stream(format!(
-                "{what} fails its checksum (damaged file)"
-            )));
-        }
-        Ok(bytes)
+        Ok((crc32fast::hash(&bytes) == crc).then_some(bytes))
     }
 
     fn read_at(&mut self, offset: u64, len: u64, tag: Tag) -> Result<Vec<u8>> {

@@ -7,24 +7,31 @@
 //! Positions are `f32` in both forms, so nothing is lost.
 
 use crate::args::ConvertArgs;
-use crate::output::{
-    animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
-};
+use crate::output::animation_output;
+use crate::target::{finish_pc2_pair, Target};
 use mcgv_video::mesh::is_gltf_path;
-use mcgv_video::mesh::{write_gltf, write_obj_sequence, GltfOptions, ReadOptions};
+use mcgv_video::mesh::{write_gltf, write_pc2, GltfOptions, ObjFrameWriter, ReadOptions};
 use mcgv_video::Result;
 
 /// Runs `convert`.
 pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
     let kind = animation_output(&args.output, false)?;
+    // The outputs are checked before the input is read (a folder's frame names once it is).
+    drop(Target::prepare(
+        &args.output,
+        kind,
+        (Vec::new(), 0),
+        args.force,
+        Some(&args.input),
+    )?);
     let mesh = super::read_input(&args.input, &ReadOptions::from(&args.input_args), quiet)?;
-    match kind {
-        OutputKind::Pc2 => {
-            write_pc2_with_base(&mesh, &args.output, Some(&args.input))?;
-        }
-        OutputKind::Gltf => {
-            create_parent(&args.output)?;
-            super::decode::warn_if_many_targets(mesh.frame_count());
+    let count = mesh.frame_count();
+    let span = ((0..count).collect(), count.saturating_sub(1));
+    match Target::prepare(&args.output, kind, span, args.force, Some(&args.input))? {
+        Target::Pc2 { cache, base } => finish_pc2_pair(&mesh, &base, || write_pc2(&mesh, &cache))?,
+        Target::Gltf(path) => {
+            crate::staging::create_parent(&path)?;
+            super::decode::warn_if_many_targets(count);
             // A glTF source lends its materials and textures to the rewritten asset.
             let source = std::path::Path::new(&args.input);
             let options = GltfOptions {
@@ -36,18 +43,29 @@ pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
                 like: (is_gltf_path(source) && source.is_file()).then(|| source.to_path_buf()),
                 ..GltfOptions::default()
             };
-            write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
+            write_gltf(&mesh, Some(mesh.attributes()), &path, &options)?;
         }
-        OutputKind::ObjFolder | OutputKind::ObjFile => {
-            prepare_frame_folder(&args.output, args.force)?;
-            write_obj_sequence(&mesh, &args.output)?;
+        Target::Folder { staged, last } => {
+            let writer =
+                ObjFrameWriter::new(staged.path(), last, mesh.triangles(), mesh.attributes())?;
+            for (f, positions) in mesh.frames().iter().enumerate() {
+                writer.write(f, positions)?;
+            }
+            staged.commit_and_tell(quiet)?;
+        }
+        Target::ObjFile(path) => {
+            return Err(mcgv_video::Error::option(
+                "output",
+                format!("{}: convert writes a whole animation", path.display()),
+            ))
         }
     }
     if !quiet {
         outln!(
-            "{}: {} frame(s) of {} vertices",
+            "{}: {} frame{} of {} vertices",
             args.output.display(),
-            mesh.frame_count(),
+            count,
+            if count == 1 { "" } else { "s" },
             mesh.vertex_count()
         )?;
     }

@@ -1,17 +1,17 @@
 //! `mcgv-video decode`.
 
 use crate::args::DecodeArgs;
-use crate::output::{
-    animation_output, create_parent, prepare_frame_folder, write_pc2_with_base, OutputKind,
-};
+use crate::output::{animation_output, OutputKind};
 use crate::progress;
+use crate::target::{finish_pc2_pair, Target};
 use mcgv_video::mesh::MANY_MORPH_TARGETS;
 use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions, DEFAULT_FPS};
-use mcgv_video::mesh::{write_obj_mesh_frame, write_obj_sequence_from, ObjFrameWriter, Pc2Writer};
+use mcgv_video::mesh::{write_obj_mesh_frame, ObjFrameWriter, Pc2Writer};
 use mcgv_video::{DecodeOptions, Decoder};
 use mcgv_video::{Error, Result};
 use std::fs::File;
 use std::io::BufReader;
+use std::path::Path;
 use std::time::Instant;
 
 /// The decoding options of `--bands` and `--max-positions`.
@@ -23,8 +23,9 @@ pub fn decode_options(bands: Option<u64>, max_positions: Option<u64>) -> DecodeO
     }
 }
 
-/// Tells on stderr when a temporal-DCT stream was cut short: it decodes, but coarser.
-pub fn warn_if_truncated<R>(decoder: &Decoder<R>)
+/// Tells on stderr when a temporal-DCT stream was cut short or has a damaged band: it decodes,
+/// but coarser. `bands` is `--bands`: fewer bands asked for is no damage.
+pub fn warn_if_truncated<R>(decoder: &Decoder<R>, bands: Option<u64>)
 where
     R: std::io::Read + std::io::Seek,
 {
@@ -33,12 +34,18 @@ where
             "mcgv-video: warning: stream truncated inside its last segment's temporal-DCT bands: \
              that segment decodes coarser"
         );
-    } else if let Some(bands) = decoder.describe().and_then(|d| d.bands) {
+    } else if let Some(described) = decoder.describe().and_then(|d| d.bands) {
+        let (bands, asked) = (described, bands);
+        let total = bands.lengths.len();
         if decoder.truncated() {
             eprintln!(
-                "mcgv-video: warning: stream truncated: decoded {} of {} temporal-DCT bands, a coarser animation",
+                "mcgv-video: warning: stream truncated: decoded {} of {total} temporal-DCT bands, a coarser animation",
                 bands.decoded,
-                bands.lengths.len()
+            );
+        } else if bands.decoded < total && asked.is_none_or(|n| n > bands.decoded as u64) {
+            eprintln!(
+                "mcgv-video: warning: temporal-DCT band {} of {total} is damaged: decoded the bands before it, a coarser animation",
+                bands.decoded,
             );
         }
     }
@@ -68,7 +75,7 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
     let mut decoder =
         Decoder::open_with(&args.input, &decode_options(args.bands, args.max_positions))
             .map_err(|e| super::in_file(&args.input, e))?;
-    warn_if_truncated(&decoder);
+    warn_if_truncated(&decoder, args.bands);
     if decoder.header().reorder && !quiet {
         eprintln!(
             "mcgv-video: note: {} was encoded with --reorder: the vertices are written in the \
@@ -77,46 +84,84 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             args.input.display()
         );
     }
-    let every_frame = args.frame.is_none() && args.frames.is_none();
-    if every_frame && matches!(kind, OutputKind::ObjFolder | OutputKind::Pc2) {
-        let frames = match kind {
-            OutputKind::Pc2 => stream_pc2(&mut decoder, &args.output, quiet),
-            _ => {
-                prepare_frame_folder(&args.output, args.force)?;
-                stream_obj_frames(&mut decoder, &args.output, quiet)
-            }
+    let count = decoder.header().frames as usize;
+    let frames = selected(args, count)?;
+    // Every file the run writes is checked before the frames are decoded.
+    let span = (frames.clone(), count - 1);
+    let target = Target::prepare(&args.output, kind, span, args.force, None)?;
+    let every_frame = frames.len() == count;
+    let in_file = |e| super::in_file(&args.input, e);
+    match target {
+        Target::Folder { staged, last } if every_frame => {
+            stream_obj_frames(&mut decoder, staged.path(), last, quiet).map_err(in_file)?;
+            staged.commit_and_tell(quiet)?;
         }
-        .map_err(|e| super::in_file(&args.input, e))?;
-        let vertices = decoder.header().vertices as usize;
-        return report(args, quiet, start, frames, vertices);
+        Target::Pc2 { cache, base } if every_frame => {
+            stream_pc2(&mut decoder, (&cache, &base), quiet).map_err(in_file)?;
+        }
+        target => {
+            let mesh = decode_mesh(&mut decoder, &frames, quiet).map_err(in_file)?;
+            write_mesh(target, &mesh, &frames, args, quiet)?;
+        }
     }
-    let mesh =
-        decode_mesh(&mut decoder, args, quiet).map_err(|e| super::in_file(&args.input, e))?;
-    match kind {
-        OutputKind::Pc2 => {
-            write_pc2_with_base(&mesh, &args.output, None)?;
+    report(
+        args,
+        quiet,
+        start,
+        frames.len(),
+        decoder.header().vertices as usize,
+    )
+}
+
+/// The frames `--frame` or `--frames` selects (all by default); one past the stream's end is a
+/// usage error.
+fn selected(args: &DecodeArgs, count: usize) -> Result<Vec<usize>> {
+    match (args.frame, &args.frames) {
+        (Some(f), _) if f >= count => Err(Error::option(
+            "frame",
+            format!("{f}: the stream has frames 0 to {}", count - 1),
+        )),
+        (Some(f), _) => Ok(vec![f]),
+        (None, Some(frames)) => frames.resolve(count, "frames"),
+        (None, None) => Ok((0..count).collect()),
+    }
+}
+
+/// Writes the decoded `mesh` (the stream's `frames`) to the checked `target`.
+fn write_mesh(
+    target: Target,
+    mesh: &AnimatedMesh,
+    frames: &[usize],
+    args: &DecodeArgs,
+    quiet: bool,
+) -> Result<()> {
+    match target {
+        Target::Pc2 { cache, base } => {
+            finish_pc2_pair(mesh, &base, || mcgv_video::mesh::write_pc2(mesh, &cache))
         }
-        OutputKind::ObjFile => {
-            create_parent(&args.output)?;
-            write_obj_mesh_frame(&mesh, 0, &args.output)?;
+        Target::ObjFile(path) => {
+            crate::staging::create_parent(&path)?;
+            write_obj_mesh_frame(mesh, 0, &path)
         }
-        OutputKind::ObjFolder => {
-            prepare_frame_folder(&args.output, args.force)?;
-            let first = args.frame.or(args.frames.as_ref().map(|r| r.start));
-            write_obj_sequence_from(&mesh, &args.output, first.unwrap_or(0))?;
+        Target::Folder { staged, last } => {
+            let writer =
+                ObjFrameWriter::new(staged.path(), last, mesh.triangles(), mesh.attributes())?;
+            for (positions, &f) in mesh.frames().iter().zip(frames) {
+                writer.write(f, positions)?;
+            }
+            staged.commit_and_tell(quiet)
         }
-        OutputKind::Gltf => {
-            create_parent(&args.output)?;
+        Target::Gltf(path) => {
+            crate::staging::create_parent(&path)?;
             warn_if_many_targets(mesh.frame_count());
             let options = GltfOptions {
                 fps: args.fps.or(mesh.frame_rate()).unwrap_or(DEFAULT_FPS),
                 like: args.like.clone(),
                 ..GltfOptions::default()
             };
-            write_gltf(&mesh, Some(mesh.attributes()), &args.output, &options)?;
+            write_gltf(mesh, Some(mesh.attributes()), &path, &options)
         }
     }
-    report(args, quiet, start, mesh.frame_count(), mesh.vertex_count())
 }
 
 /// Says what was written, unless `quiet`.
@@ -130,8 +175,9 @@ fn report(
     if !quiet {
         let seconds = start.elapsed().as_secs_f64();
         outln!(
-            "{}: {frames} frame(s) of {vertices} vertices written in {seconds:.2} s ({:.1} frames/s)",
+            "{}: {frames} frame{} of {vertices} vertices written in {seconds:.2} s ({:.1} frames/s)",
             args.output.display(),
+            if frames == 1 { "" } else { "s" },
             frames as f64 / seconds.max(1e-9)
         )?;
     }
@@ -139,99 +185,72 @@ fn report(
 }
 
 /// Decodes every frame into a PC2 cache (and its base OBJ, frame 0, beside it), each frame written
-/// as soon as its segment is decoded. Returns the frames written.
+/// as soon as its segment is decoded; both files are put in place only once every frame decoded.
 fn stream_pc2(
     decoder: &mut Decoder<BufReader<File>>,
-    path: &std::path::Path,
+    (cache, base): (&Path, &Path),
     quiet: bool,
-) -> Result<usize> {
+) -> Result<()> {
     let (frames, vertices) = (
         decoder.header().frames as usize,
         decoder.header().vertices as usize,
     );
     let (triangles, attributes) = (decoder.triangles().to_vec(), decoder.attributes().clone());
-    create_parent(path)?;
-    let base = path.with_extension("obj");
-    let mut cache = Pc2Writer::create(path, vertices, frames)?;
+    crate::staging::create_parent(cache)?;
+    let mut writer = Pc2Writer::create(cache, vertices, frames)?;
     let pb = progress::bar(frames as u64, "decode", quiet);
     let mut first = None;
     decoder.for_each_frame(&crate::progress::Reporter(&pb), |f, positions| {
-        cache.write(&positions)?;
+        writer.write(&positions)?;
         if f == 0 {
             first = Some(positions);
         }
         Ok(())
     })?;
     pb.finish_and_clear();
-    // Both files are written only once every frame decoded: a damaged stream leaves neither.
     let first = first.ok_or_else(|| Error::Stream("the stream has no frames".into()))?;
     let first = AnimatedMesh::new(triangles, vec![first])?.with_attributes(attributes)?;
-    write_obj_mesh_frame(&first, 0, &base)?;
-    cache.finish()?;
-    Ok(frames)
+    finish_pc2_pair(&first, base, || writer.finish())
 }
 
-/// Decodes every frame into an OBJ folder, each file written as soon as its segment is decoded:
-/// memory holds one segment, whatever the clip's length. Returns the frames written.
+/// Decodes every frame into the staging folder `dir` of an OBJ folder, each file written as soon
+/// as its segment is decoded: memory holds one segment, whatever the clip's length.
 fn stream_obj_frames(
     decoder: &mut Decoder<BufReader<File>>,
-    dir: &std::path::Path,
+    dir: &Path,
+    last: usize,
     quiet: bool,
-) -> Result<usize> {
+) -> Result<()> {
     let frames = decoder.header().frames as usize;
     let (triangles, attributes) = (decoder.triangles().to_vec(), decoder.attributes().clone());
-    let writer = ObjFrameWriter::new(dir, frames.saturating_sub(1), &triangles, &attributes)?;
+    let writer = ObjFrameWriter::new(dir, last, &triangles, &attributes)?;
     let pb = progress::bar(frames as u64, "decode", quiet);
     decoder.for_each_frame(&crate::progress::Reporter(&pb), |f, positions| {
         writer.write(f, &positions)
     })?;
     pb.finish_and_clear();
-    Ok(frames)
+    Ok(())
 }
 
-/// The frames `--frame` asks for (all by default), decoded.
+/// The stream's `frames`, decoded (all of them with a progress bar).
 fn decode_mesh(
     decoder: &mut Decoder<BufReader<File>>,
-    args: &DecodeArgs,
+    frames: &[usize],
     quiet: bool,
 ) -> Result<AnimatedMesh> {
-    let frames = decoder.header().frames as usize;
-    let rate = Some(f64::from(decoder.header().frame_rate));
-    match args.frame {
-        Some(f) => {
-            if f >= frames {
-                return Err(Error::option(
-                    "frame",
-                    format!("{f}: the stream has frames 0 to {}", frames - 1),
-                ));
-            }
-            let positions = decoder.decode_frame(f)?;
-            Ok(
-                AnimatedMesh::new(decoder.triangles().to_vec(), vec![positions])?
-                    .with_attributes(decoder.attributes().clone())?
-                    .with_frame_rate(rate),
-            )
-        }
-        None if args.frames.is_some() => {
-            let range = args.frames.clone().unwrap_or(0..frames);
-            if range.end > frames {
-                return Err(Error::option(
-                    "frames",
-                    format!("{range:?}: the stream has frames 0 to {}", frames - 1),
-                ));
-            }
-            let positions = range
-                .map(|f| decoder.decode_frame(f))
-                .collect::<Result<Vec<_>>>()?;
-            Ok(AnimatedMesh::new(decoder.triangles().to_vec(), positions)?
-                .with_attributes(decoder.attributes().clone())?
-                .with_frame_rate(rate))
-        }
-        None => {
-            let pb = progress::bar(frames as u64, "decode", quiet);
-            let mesh = decoder.decode_all_with_progress(&crate::progress::Reporter(&pb))?;
-            pb.finish_and_clear();
-            Ok(mesh)
-        }
+    let count = decoder.header().frames as usize;
+    if frames.len() == count {
+        let pb = progress::bar(count as u64, "decode", quiet);
+        let mesh = decoder.decode_all_with_progress(&crate::progress::Reporter(&pb))?;
+        pb.finish_and_clear();
+        return Ok(mesh);
     }
+    let rate = Some(f64::from(decoder.header().frame_rate));
+    let positions = frames
+        .iter()
+        .map(|&f| decoder.decode_frame(f))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(AnimatedMesh::new(decoder.triangles().to_vec(), positions)?
+        .with_attributes(decoder.attributes().clone())?
+        .with_frame_rate(rate))
 }

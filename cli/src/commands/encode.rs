@@ -1,6 +1,7 @@
 //! `mcgv-video encode`.
 
 use crate::args::{BitDepth, EncodeArgs, PredictorChoice, SegmentationChoice};
+use crate::output::count;
 use crate::progress;
 use mcgv_video::codec::{Codec, CodecConfig, PictureOptions};
 use mcgv_video::encoder::DEFAULT_PARALLEL_SEGMENTS;
@@ -17,7 +18,14 @@ use std::time::Instant;
 /// Parses the encode arguments into encoder options, rejecting nonsense with a clear message.
 pub fn options(args: &EncodeArgs, threads: Option<u64>) -> Result<EncodeOptions> {
     let e0 = args.e0.unwrap_or(mcgv_video::encoder::DEFAULT_E0);
-    let segmentation = match args.segmentation {
+    // Only what the user left unsaid is chosen automatically: `--clusters K` alone is k-means
+    // with K, not a candidate the automatic choice may drop for decimation's own K (both
+    // --clusters and --e0 name both candidates: auto).
+    let choice = args.segmentation.unwrap_or(match (args.clusters, args.e0) {
+        (Some(_), None) => SegmentationChoice::Kmeans,
+        _ => SegmentationChoice::Auto,
+    });
+    let segmentation = match choice {
         SegmentationChoice::Kmeans => {
             if args.e0.is_some() {
                 return Err(Error::option(
@@ -204,9 +212,11 @@ fn check_not_input(input: &str, opts: &ReadOptions, output: &Path) -> Result<()>
     Ok(())
 }
 
-/// Runs `encode`: one stream, or with `--clip all` one stream per glTF clip.
+/// Runs `encode`: one stream, or with `--clip all` one stream per glTF clip. Every output is
+/// checked before any work, and with several clips every stream is coded before any is written.
 pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
     let opts = options(args, threads)?;
+    opts.validate()?;
     let read_options: ReadOptions = (&args.input_args).into();
     let to_stdout = args.output.as_os_str() == "-";
     if to_stdout && args.json {
@@ -216,7 +226,9 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
         ));
     }
     if read_options.clip.as_deref() != Some("all") {
-        return encode_one(args, &opts, &read_options, &args.output, quiet);
+        check_output(args, &read_options, &args.output)?;
+        let encoded = encode_one(args, &opts, &read_options, quiet)?;
+        return write_and_report(args, &read_options, encoded, &args.output, quiet);
     }
     let clips = mcgv_video::mesh::clips(&args.input, read_options.fps)?;
     if clips.is_empty() || to_stdout {
@@ -225,6 +237,7 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
             "all: needs a glTF input with animations and a file -o (one stream per clip)",
         ));
     }
+    let mut jobs = Vec::with_capacity(clips.len());
     for clip in &clips {
         let name = if clip.name.is_empty() {
             clip.index.to_string()
@@ -236,9 +249,27 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
             clip: Some(clip.index.to_string()),
             ..read_options.clone()
         };
-        encode_one(args, &opts, &read, &output, quiet)?;
+        check_output(args, &read, &output)?;
+        jobs.push((read, output));
+    }
+    let mut encoded = Vec::with_capacity(jobs.len());
+    for (read, output) in jobs {
+        encoded.push((encode_one(args, &opts, &read, quiet)?, read, output));
+    }
+    for (encoded, read, output) in encoded {
+        write_and_report(args, &read, encoded, &output, quiet)?;
     }
     Ok(())
+}
+
+/// Checks `output` before any work: not an input file, not a file that exists unless `--force`,
+/// in a folder that takes files (stdout needs no check).
+fn check_output(args: &EncodeArgs, read: &ReadOptions, output: &Path) -> Result<()> {
+    if output.as_os_str() == "-" {
+        return Ok(());
+    }
+    check_not_input(&args.input, read, output)?;
+    crate::staging::check_file(output, args.force)
 }
 
 /// `fox.mcgv` for clip `Walk` → `fox-Walk.mcgv` (characters a file name cannot hold become `_`).
@@ -260,18 +291,13 @@ fn clip_output(output: &Path, clip: &str) -> PathBuf {
     output.with_file_name(format!("{stem}-{clean}.{extension}"))
 }
 
-/// Encodes one animation to `output` (a file, or stdout for `-`) and reports it.
+/// Encodes one animation, timed.
 fn encode_one(
     args: &EncodeArgs,
     opts: &EncodeOptions,
     read_options: &ReadOptions,
-    output: &Path,
     quiet: bool,
-) -> Result<()> {
-    let to_stdout = output.as_os_str() == "-";
-    if !to_stdout {
-        check_not_input(&args.input, read_options, output)?;
-    }
+) -> Result<Coded> {
     let start = Instant::now();
     let (encoded, search) = match budget(args) {
         None => (encode_streaming(args, opts, read_options, quiet)?, None),
@@ -284,19 +310,59 @@ fn encode_one(
             (found.encoded, Some(found.search))
         }
     };
+    Ok(Coded {
+        encoded,
+        start,
+        search,
+    })
+}
+
+/// One encoding, when it started, and its budget search if it had one.
+struct Coded {
+    encoded: Encoded,
+    start: Instant,
+    search: Option<BudgetReport>,
+}
+
+/// Writes a stream to `output` (a file, or stdout for `-`) and reports it, with the error of
+/// the file written (read from `input` with `read`) unless the stream went to stdout.
+fn write_and_report(
+    args: &EncodeArgs,
+    read: &ReadOptions,
+    coded: Coded,
+    output: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let Coded {
+        encoded,
+        start,
+        search,
+    } = coded;
+    let to_stdout = output.as_os_str() == "-";
     if to_stdout {
         write_stdout_bytes(&encoded.to_bytes())?;
     } else {
-        crate::output::create_parent(output)?;
+        crate::staging::create_parent(output)?;
         encoded.container.write_atomic(output)?;
     }
     let seconds = start.elapsed().as_secs_f64();
+    let achieved = match (to_stdout, quiet && !args.json) {
+        (false, false) => {
+            let spin = progress::spinner("measuring the error of the file written", quiet);
+            let achieved =
+                super::achieved::measure(&args.input, read, output, args.input_args.max_positions);
+            spin.finish_and_clear();
+            Some(achieved.map_err(|e| super::in_file(output, e))?)
+        }
+        _ => None,
+    };
     let r = &encoded.report;
     if args.json {
         let mut value = serde_json::to_value(r).map_err(|e| Error::Usage(e.to_string()))?;
         value["seconds"] = serde_json::json!(seconds);
         value["vertices"] = serde_json::json!(r.header.vertices);
         value["frames"] = serde_json::json!(r.header.frames);
+        value["achieved"] = serde_json::json!(achieved);
         if let Some(search) = &search {
             value["budget"] =
                 serde_json::to_value(search).map_err(|e| Error::Usage(e.to_string()))?;
@@ -307,17 +373,17 @@ fn encode_one(
         return Ok(());
     }
     let line = format!(
-        "{}: {} bytes, {:.3} bpvf ({} vertices x {} frames, {} clusters by {} in {:.2} s, {} predictor, {} charts), {:.1} s ({:.1} frames/s)",
+        "{}: {} bytes, {:.3} bpvf ({} vertices x {}, {} by {} in {:.2} s, {} predictor, {}), {:.1} s ({:.1} frames/s)",
         if to_stdout { "stdout".into() } else { output.display().to_string() },
         r.bytes,
         r.bpvf,
         r.header.vertices,
-        r.header.frames,
-        r.header.clusters,
+        count(r.header.frames, "frame"),
+        count(r.header.clusters, "cluster"),
         r.segmentation.method,
         r.segmentation.seconds,
         r.header.predictor.name(),
-        r.charts,
+        count(r.charts as u64, "chart"),
         seconds,
         r.header.frames as f64 / seconds.max(1e-9)
     );
@@ -327,11 +393,16 @@ fn encode_one(
     };
     let line = match &r.choice {
         Some(choice) => format!(
-            "{line}\nauto: kept {} of {} candidates: {}",
+            "{line}\nauto: kept {} of {} candidates: {}{}",
             choice.chosen,
             choice.candidates.len(),
-            choice.reason
+            choice.reason,
+            trial_size_note(choice, r)
         ),
+        None => line,
+    };
+    let line = match achieved {
+        Some(a) => format!("{line}\n{}", a.line()),
         None => line,
     };
     let line = match r.segments {
@@ -436,6 +507,28 @@ fn budget_line(search: &BudgetReport) -> String {
         },
         search.model
     )
+}
+
+/// The candidates' sizes are their trials' (estimated from a sample of frames, or before the
+/// first frame's precision was chosen): when the kept one's is not the file's, says so, so that
+/// the report never leaves a size that is not the file's unexplained.
+fn trial_size_note(choice: &encoder::ChoiceReport, r: &encoder::EncodeReport) -> String {
+    let kept = choice.candidates.iter().find(|c| {
+        format!("{}+{}", c.predictor.name(), c.segmentation) == choice.chosen
+            && c.clusters == r.header.clusters as usize
+    });
+    match kept {
+        Some(c) if c.bytes != r.bytes => format!(
+            " (trial sizes; the file written is {} bytes{})",
+            r.bytes,
+            if r.first_frame_trials.is_empty() {
+                ""
+            } else {
+                ", its first frame's precision chosen after"
+            }
+        ),
+        _ => String::new(),
+    }
 }
 
 /// The stream's bytes on stdout (a closed pipe is reported like any write to stdout).

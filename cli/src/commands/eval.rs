@@ -22,8 +22,8 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
         let path = Path::new(&args.decoded);
         let mut decoder =
             Decoder::open_with(path, &options).map_err(|e| super::in_file(path, e))?;
-        super::decode::warn_if_truncated(&decoder);
-        let bits = decoder.file_len() * 8;
+        super::decode::warn_if_truncated(&decoder, args.bands);
+        let bits = bits_read(&decoder, args.bands.is_some());
         compare_stream(&mut original, &mut decoder, tally, quiet)
             .map_err(|e| super::in_file(path, e))?
             .with_bits(bits)
@@ -35,7 +35,13 @@ pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
             ));
         }
         let mut original = super::open_source(&args.original, &opts, quiet)?;
-        let mut decoded = super::open_source(&args.decoded, &opts, quiet)?;
+        // --clip names the original's clip: a decoded glTF holds one clip (`frames`), whatever
+        // the original's was called.
+        let decoded_opts = ReadOptions {
+            clip: None,
+            ..opts.clone()
+        };
+        let mut decoded = super::open_source(&args.decoded, &decoded_opts, true)?;
         compare_sources(&mut original, &mut decoded, tally)?
     };
     if args.json {
@@ -216,6 +222,20 @@ fn compare_sources(
         tally.add(&original.read(range.clone())?, &decoded.read(range)?)?;
     }
     tally.finish()
+}
+
+/// The bits the comparison stands on: the file's, less with `--bands` (`preview`) the bands it
+/// left unread, so that a preview's bpvf is the preview's (of a one-segment stream; a segmented
+/// one is charged whole, its other segments' bands being unknown until opened).
+fn bits_read(decoder: &Decoder<BufReader<File>>, preview: bool) -> u64 {
+    let unread = match decoder.describe().and_then(|d| d.bands) {
+        Some(b) if preview && !decoder.truncated() && decoder.segments().len() == 1 => b.lengths
+            [b.decoded.min(b.lengths.len())..]
+            .iter()
+            .sum::<u64>(),
+        _ => 0,
+    };
+    decoder.file_len().saturating_sub(unread) * 8
 }
 
 /// The first frame of an animation as a surface.

@@ -2,6 +2,7 @@
 
 use crate::annotate;
 use crate::args::InspectArgs;
+use crate::staging::StagedFolder;
 use mcgv_video::codec::Description;
 use mcgv_video::codec::Plane;
 use mcgv_video::inspect::FrameRanges;
@@ -30,11 +31,14 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
     let bpvf = total as f64 * 8.0 / vf;
     if let Some(dir) = &args.png {
         let Some(pictures) = &stored.pictures else {
-            return Err(Error::Usage(format!(
-                "--png: a {} stream has no geometry images to write (its figures are in the \
-                 plain and --json output)",
-                stored.codec.name()
-            )));
+            return Err(Error::option(
+                "png",
+                format!(
+                    "applies to streams of geometry images: a {} stream has none (its figures \
+                     are in the plain and --json output)",
+                    stored.codec.name()
+                ),
+            ));
         };
         write_pngs(&mut decoder, pictures.lattice, args, dir, quiet)?;
     }
@@ -184,14 +188,14 @@ fn summary(h: &Header, stored: &Description, path: &Path) -> String {
         (None, None) => "no atlas".into(),
     };
     format!(
-        "{}: {} vertices x {} frames, {} faces; {} quality {}{settings}; {} clusters, {} predictor; {residuals}",
+        "{}: {} vertices x {}, {}; {} quality {}{settings}; {}, {} predictor; {residuals}",
         path.display(),
         h.vertices,
-        h.frames,
-        h.triangles,
+        crate::output::count(h.frames, "frame"),
+        crate::output::count(h.triangles, "face"),
         stored.codec.name(),
         h.quality,
-        h.clusters,
+        crate::output::count(h.clusters, "cluster"),
         h.predictor.name(),
     )
 }
@@ -248,6 +252,8 @@ fn write_atlas<R: std::io::Read + std::io::Seek>(
         .map_err(|e| Error::Usage(format!("{}: {e}", path.display())))
 }
 
+/// Writes the atlas, the segmentation and the chosen frames' residual images into `dir`, staged
+/// and put in place once every image is written; the folder is checked before any is made.
 fn write_pngs<R: std::io::Read + std::io::Seek>(
     decoder: &mut Decoder<R>,
     lattice: (u16, u16),
@@ -255,54 +261,60 @@ fn write_pngs<R: std::io::Read + std::io::Seek>(
     dir: &Path,
     quiet: bool,
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let header = decoder.header().clone();
     let w = usize::from(lattice.0);
-    let frames = selected_frames(args, header.frames)?;
-    write_atlas(decoder, lattice, &dir.join("atlas.png"))?;
+    let frames = match &args.frames {
+        Some(frames) => frames.resolve(header.frames as usize, "frames")?,
+        None => vec![0],
+    };
+    let staged =
+        StagedFolder::prepare(dir, png_names(&frames, args.original.is_some()), args.force)?;
+    let out = staged.path();
+    write_atlas(decoder, lattice, &out.join("atlas.png"))?;
     crate::render::render_partition_png(
         decoder.reference(),
         decoder.triangles(),
         decoder.partition().labels(),
         512,
-        &dir.join("segmentation.png"),
+        &out.join("segmentation.png"),
     )?;
-
     for &f in &frames {
         let plane = decoder.decoded_plane(f)?;
         let ranges = decoder.frame_ranges(f)?;
         save_residuals(
-            &dir.join(format!("frame_{f:04}_decoded.png")),
+            &out.join(png_name(f, "decoded")),
             plane,
             w,
             &format!("frame {f} decoded residuals"),
             ranges.as_ref(),
         )?;
     }
-
     if let Some(original) = &args.original {
-        write_encoder_pngs(decoder, lattice, args, (original, dir), &frames, quiet)?;
+        write_encoder_pngs(decoder, lattice, args, (original, out), &frames, quiet)?;
     }
+    staged.commit_and_tell(quiet)?;
     if !quiet {
         eprintln!("images written to {}", dir.display());
     }
     Ok(())
 }
 
-/// The frames `--frames` asks for (frame 0 when none), each one the stream has.
-fn selected_frames(args: &InspectArgs, stream_frames: u32) -> Result<Vec<usize>> {
-    let frames: Vec<usize> = if args.frames.is_empty() {
-        vec![0]
-    } else {
-        args.frames.clone()
+/// The file of frame `f`'s residual image of `kind` (`decoded`, `raw`, `padded`).
+fn png_name(f: usize, kind: &str) -> String {
+    format!("frame_{f:04}_{kind}.png")
+}
+
+/// Every image `--png` writes for `frames` (with the encoder's own when `original`).
+fn png_names(frames: &[usize], original: bool) -> Vec<String> {
+    let kinds: &[&str] = match original {
+        true => &["decoded", "raw", "padded"],
+        false => &["decoded"],
     };
-    if let Some(&bad) = frames.iter().find(|&&f| f >= stream_frames as usize) {
-        return Err(Error::Usage(format!(
-            "--frames {bad}: the stream has frames 0 to {}",
-            stream_frames - 1
-        )));
+    let mut names = vec!["atlas.png".to_string(), "segmentation.png".to_string()];
+    for &f in frames {
+        names.extend(kinds.iter().map(|kind| png_name(f, kind)));
     }
-    Ok(frames)
+    names
 }
 
 /// The residual images the encoder made (raw and padded) for `frames`, redone from `original`.
@@ -321,7 +333,7 @@ fn write_encoder_pngs<R: std::io::Read + std::io::Seek>(
         let f = images.frame;
         for (kind, plane) in [("raw", images.raw), ("padded", images.padded)] {
             save_residuals(
-                &dir.join(format!("frame_{f:04}_{kind}.png")),
+                &dir.join(png_name(f, kind)),
                 plane,
                 w,
                 &format!("frame {f} {kind} residuals (encoder)"),

@@ -1,5 +1,6 @@
 //! One module per subcommand: each turns parsed arguments into work and prints the result.
 
+pub mod achieved;
 pub mod convert;
 pub mod decode;
 pub mod encode;
@@ -14,6 +15,7 @@ use std::path::Path;
 /// An animation's frames as `encode` and `eval` read them: OBJ sequences and PC2 caches a run of
 /// frames at a time (a long clip is never held whole), a glTF clip baked whole by [`read_input`].
 pub fn open_source(input: &str, opts: &ReadOptions, quiet: bool) -> Result<FrameSource> {
+    not_a_stream(input)?;
     let gltf = [".gltf", ".glb"]
         .iter()
         .any(|e| input.to_ascii_lowercase().ends_with(e));
@@ -26,6 +28,7 @@ pub fn open_source(input: &str, opts: &ReadOptions, quiet: bool) -> Result<Frame
 /// Reads an animation as every command does; a glTF with several clips read without `--clip` says
 /// on stderr which clip it took and how to pick another (unless `quiet`).
 pub fn read_input(input: &str, opts: &ReadOptions, quiet: bool) -> Result<AnimatedMesh> {
+    not_a_stream(input)?;
     if opts.clip.as_deref() == Some("all") {
         return Err(Error::option(
             "clip",
@@ -46,6 +49,21 @@ pub fn read_input(input: &str, opts: &ReadOptions, quiet: bool) -> Result<Animat
         }
     }
     Ok(mesh)
+}
+
+/// Where an animation is expected, a `.mcgv` stream is a usage error that names the commands
+/// that read streams (rather than listing the mesh forms it is not).
+fn not_a_stream(input: &str) -> Result<()> {
+    if Path::new(input)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mcgv"))
+    {
+        return Err(Error::Usage(format!(
+            "{input} is a .mcgv stream, not an animation: `mcgv-video inspect {input}` describes \
+             it, `mcgv-video decode {input} -o DIR/` writes its frames"
+        )));
+    }
+    Ok(())
 }
 
 /// `0 Survey (84 frames at 24 fps), 1 Walk (…)`.

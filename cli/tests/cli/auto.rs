@@ -9,7 +9,8 @@ fn auto_reports_its_candidates_and_keeps_the_smallest() {
     let stream = dir.path().join("s.mcgv");
     let s = stream.to_str().expect("utf-8 path");
     let sample = media_path("RiggedSimple.glb");
-    let base = ["encode", sample.as_str(), "-o", s, "--quiet"];
+    // --force: every run below writes the same file.
+    let base = ["encode", sample.as_str(), "-o", s, "--force", "--quiet"];
     // The first frame at 12 bits: the size of the kept model's stream is then a candidate's.
     let auto = [
         "--predictor",
@@ -53,7 +54,7 @@ fn auto_reports_its_candidates_and_keeps_the_smallest() {
     let least = trials.iter().filter_map(|t| t["bytes"].as_u64()).min();
     assert_eq!(default["bytes"].as_u64(), least, "{default}");
     let text = ok(&run(
-        &[&base[..4], &auto[..4], &["--clusters", "5"]].concat()
+        &[&base[..5], &auto[..4], &["--clusters", "5"]].concat()
     ));
     assert!(text.contains("auto: kept"), "{text}");
     assert!(text.contains("first frame: kept"), "{text}");

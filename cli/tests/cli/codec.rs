@@ -265,7 +265,8 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
         dir.path().join("png").to_str().unwrap(),
     ]);
     assert!(!png.status.success());
-    assert!(String::from_utf8_lossy(&png.stderr).contains("no geometry images"));
+    assert!(String::from_utf8_lossy(&png.stderr)
+        .contains("applies to streams of geometry images: a tdct stream has none"));
 
     let frames = dir.path().join("frames");
     ok(&run(&[
@@ -304,6 +305,20 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("stream truncated"));
     let coarse = json(&out);
     assert!(coarse["rmse"].as_f64().unwrap() > full["rmse"].as_f64().unwrap());
+    // A damaged band where the cut was: the bands before it decode, as with the cut, with a warning.
+    let mut damaged = bytes.clone();
+    damaged[bytes.len() - coefficients / 2] ^= 0x10;
+    let bad = dir.path().join("bad.mcgv");
+    std::fs::write(&bad, &damaged).unwrap();
+    let out = run(&["eval", &sample, bad.to_str().unwrap(), "--json", "--quiet"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("is damaged: decoded the bands before it"),
+        "{stderr}"
+    );
+    assert!(json(&out)["rmse"].as_f64().unwrap() > full["rmse"].as_f64().unwrap());
+    // A preview's bpvf counts the bands it read only.
+    assert!(preview["bpvf"].as_f64().unwrap() < full["bpvf"].as_f64().unwrap());
 
     // --bands belongs to tdct; --range-floor, retired with stream version 2, is gone: a usage error.
     let jpeg = dir.path().join("fig_jpeg.mcgv");

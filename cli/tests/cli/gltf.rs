@@ -4,7 +4,7 @@
 //! The validator is npm's `gltf-validator`, installed by `make node-tools` (a step of `make test`)
 //! into `scripts/node/`. A missing validator fails the test: a check that silently skips checks nothing.
 
-use crate::common::{media_path, ok, repo_root, run};
+use crate::common::{json, media_path, ok, repo_root, run};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -210,7 +210,7 @@ fn decoded_gltf_plays_at_the_source_frame_rate() {
     let fps_of = |extra: &[&str]| {
         let out = dir.path().join("out.glb");
         let o = out.to_str().unwrap();
-        let mut args = vec!["decode", s, "-o", o, "--quiet"];
+        let mut args = vec!["decode", s, "-o", o, "--quiet", "--force"];
         args.extend_from_slice(extra);
         ok(&run(&args));
         let info = crate::common::json(&run(&["info", o, "--json"]));
@@ -221,4 +221,54 @@ fn decoded_gltf_plays_at_the_source_frame_rate() {
     assert_eq!(fps_of(&[]), 24.0);
     assert_eq!(fps_of(&["--fps", "12"]), 12.0);
     assert_eq!(fps_of(&["--frames", "0..10"]), 24.0);
+}
+
+#[test]
+fn a_clip_baked_at_5_fps_reads_back_at_5_fps() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = media_path("RiggedSimple.glb");
+    let stream = dir.path().join("s.mcgv").display().to_string();
+    let glb = dir.path().join("s.glb").display().to_string();
+    ok(&run(&["encode", &input, "--fps", "5", "-o", &stream, "-q"]));
+    ok(&run(&["decode", &stream, "-o", &glb, "-q"]));
+    // The decoded file's STEP keys are its frames: 5 per second, 2 s of clip.
+    let info = json(&run(&["info", &glb, "--json"]));
+    let clip = &info["clips"][0];
+    assert_eq!(clip["fps"], 5.0, "{info}");
+    assert_eq!(clip["frames"], 11, "{info}");
+    // Frame for frame against the source baked at that rate.
+    let eval = json(&run(&["eval", &input, &glb, "--fps", "5", "--json"]));
+    assert_eq!(eval["frames"], 11, "{eval}");
+    assert!(
+        eval["vertex_rmse"].as_f64().is_some_and(|e| e < 1e-3),
+        "{eval}"
+    );
+}
+
+#[test]
+fn eval_clip_names_the_originals_clip() {
+    let dir = tempfile::tempdir().unwrap();
+    let fox = media_path("Fox.glb");
+    let stream = dir.path().join("walk.mcgv").display().to_string();
+    let glb = dir.path().join("walk.glb").display().to_string();
+    // Fixed choices: the test is about names, not the encoder's search.
+    let base = [
+        "--codec",
+        "jpeg",
+        "--predictor",
+        "affine",
+        "--clusters",
+        "5",
+        "-q",
+    ];
+    ok(&run(&[
+        &["encode", &fox, "--clip", "Walk", "-o", &stream][..],
+        &base,
+    ]
+    .concat()));
+    ok(&run(&["decode", &stream, "-o", &glb, "-q"]));
+    // The decoded file's one clip is `frames`: --clip Walk is the original's.
+    let eval = json(&run(&["eval", &fox, &glb, "--clip", "Walk", "--json"]));
+    let info = json(&run(&["info", &fox, "--clip", "Walk", "--json"]));
+    assert_eq!(eval["frames"], info["frames"], "{eval}");
 }

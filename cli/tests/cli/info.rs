@@ -52,4 +52,10 @@ fn a_bad_input_fails_with_its_name() {
         stderr.contains("broken.obj") && stderr.contains("finite"),
         "{stderr}"
     );
+    // A stream where an animation is expected: the commands that read streams are named.
+    let stream = dir.path().join("x.mcgv");
+    std::fs::write(&stream, b"MCGV").unwrap();
+    let out = info(&[stream.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("mcgv-video inspect"), "{stderr}");
 }

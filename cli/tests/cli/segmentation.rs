@@ -1,5 +1,5 @@
 //! `encode --segmentation decimation` through the binary: the report, the stream, `inspect`, and
-//! the options that do not belong together.
+//! the options that do not belong together; `--clusters K` alone is k-means with K.
 
 use crate::common::{grey, json, media_path, ok, run};
 
@@ -95,4 +95,39 @@ fn options_of_the_other_segmentation_are_refused() {
         assert!(err.contains(needle), "{all:?}: {err}");
         assert!(!out.exists(), "{all:?} left a file");
     }
+}
+
+#[test]
+fn clusters_alone_means_k_means_with_that_k() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let out = dir.path().join("s.mcgv");
+    let o = out.to_str().expect("utf-8 path");
+    let sample = media_path("RiggedSimple.glb");
+    let encode = |extra: &[&str]| {
+        let base = ["encode", "--codec", "jpeg", &sample, "-o", o, "--quiet"];
+        json(&run(&[&base[..], &["--json", "--force"], extra].concat()))
+    };
+    // The automatic choice compares k-means with decimation, whose K is its own.
+    let auto = encode(&[]);
+    let tried: Vec<&str> = auto["choice"]["candidates"]
+        .as_array()
+        .expect("candidates")
+        .iter()
+        .filter_map(|c| c["segmentation"].as_str())
+        .collect();
+    assert!(tried.contains(&"decimation"), "{auto}");
+    // --clusters K alone: every candidate (the predictors) is k-means, and the stream has K.
+    let named = encode(&["--clusters", "3"]);
+    assert_eq!(named["segmentation"]["method"], "kmeans", "{named}");
+    assert_eq!(named["header"]["clusters"], 3, "{named}");
+    for c in named["choice"]["candidates"]
+        .as_array()
+        .into_iter()
+        .flatten()
+    {
+        assert_eq!(c["segmentation"], "kmeans", "{named}");
+    }
+    // Naming --e0 as well names both candidates: the automatic choice between them stays.
+    let both = encode(&["--clusters", "3", "--e0", "0.004"]);
+    assert!(both["choice"]["candidates"].as_array().is_some(), "{both}");
 }

@@ -199,7 +199,7 @@ mod coder {
         /// Constant quality at `crf` = the quantiser, key frames exactly every `gop` frames
         /// (`keyint_min` = `g`), one tile, no row threads; P-frame groups look ahead and code hidden
         /// alternate-reference frames, all-intra streams do not.
-        fn settings(&self, options: &deep::Options, gop: u32) -> Dictionary<'static> {
+        fn settings(&self, options: &deep::Options, gop: u32, _: (u32, u32)) -> Dictionary<'static> {
             let mut dict = Dictionary::new();
             dict.set("usage", "good");
             dict.set("cpu-used", &CPU_USED.to_string());
@@ -310,5 +310,10 @@ mod ffmpeg_tests {
     #[test]
     fn bad_settings_are_errors() {
         deep::testing::bad_settings_are_errors(Libaom, 32);
+    }
+
+    #[test]
+    fn the_same_pictures_give_the_same_bytes_every_run() {
+        deep::testing::same_bytes_every_run(&Libaom, 24, 50, 3);
     }
 }

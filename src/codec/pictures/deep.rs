@@ -154,8 +154,8 @@ mod coder {
         fn max_qp(&self) -> u8;
         /// The encoder's private options (FFmpeg's dictionary) for a fixed quantiser, deterministic
         /// output and a key frame every `gop` frames (size, format, GOP, no B-frames and one thread
-        /// are set on the context already).
-        fn settings(&self, options: &Options, gop: u32) -> Dictionary<'static>;
+        /// are set on the context already); `size` is the picture's width and height.
+        fn settings(&self, options: &Options, gop: u32, size: (u32, u32)) -> Dictionary<'static>;
     }
 
     /// How the x | y | z residual images of a frame go into a picture.
@@ -286,7 +286,10 @@ mod coder {
             video.set_max_b_frames(0);
             video.set_threading(libav::one_thread());
             let inner = video
-                .open_as_with(codec, flavour.settings(options, gop))
+                .open_as_with(
+                    codec,
+                    flavour.settings(options, gop, (picture_width, picture_height)),
+                )
                 .map_err(|e| {
                     let context = format!("open {} {width}×{height}", flavour.encoder_name());
                     libav::error(name, &context, e)
@@ -355,7 +358,9 @@ mod coder {
     }
 
     /// Copies columns `x0..x0 + width` of the plane into FFmpeg plane `index` of `picture`, as 16-bit
-    /// little-endian samples, row by row (FFmpeg pads rows to its own stride, in bytes).
+    /// little-endian samples, row by row (FFmpeg pads rows to its own stride, in bytes). The rest
+    /// of FFmpeg's buffer, which it leaves as the allocator gave it, is zeroed first: no byte an
+    /// encoder may read can differ from one run to the next.
     fn fill_samples(
         picture: &mut frame::Video,
         index: usize,
@@ -365,6 +370,7 @@ mod coder {
     ) -> Result<()> {
         let stride = picture.stride(index);
         let buffer = picture.data_mut(index);
+        buffer.fill(0);
         for (y, row) in plane.data.chunks_exact(plane.width as usize).enumerate() {
             let src = &row[x0..x0 + width];
             let start = y * stride;

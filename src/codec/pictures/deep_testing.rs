@@ -121,3 +121,65 @@ pub fn bad_settings_are_errors<F: Flavour>(flavour: F, qp: u8) {
     assert!(pictures.decoder(96, 32, &setup(9, vec![1])).is_err());
     assert!(pictures.decoder(96, 32, &setup(10, vec![2])).is_err());
 }
+
+/// A moving pattern with noise on top (a pseudo-random sequence from `seed`), the kind of picture
+/// on which x265's reference limits once gave different bytes from one encoder to the next.
+pub fn noisy(width: u32, height: u32, t: u32, seed: u64) -> Plane<u16> {
+    let mut state = seed.wrapping_add(u64::from(t)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    let data = (0..width * height)
+        .map(|i| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            let (x, y) = (f64::from(i % width), f64::from(i / width));
+            let smooth = 0.5 + 0.2 * ((x + 3.0 * f64::from(t)) / 11.0).sin() * (y / 5.0).cos();
+            let noise = ((state >> 33) % 41) as f64 - 20.0;
+            (smooth * 1023.0 + noise).clamp(0.0, 1023.0) as u16
+        })
+        .collect();
+    Plane::new(width, height, data).unwrap()
+}
+
+/// Codes the same `frames` noisy 4:4:4 pictures of one 64-pixel block (x265's largest coding
+/// tree unit), key frames every `gop`, `runs` times in this process, each with a new encoder on a
+/// heap the runs before have used, and (glibc) once more with every new allocation filled with a
+/// fixed byte: every run must give the first one's bytes, so no byte the encoder leaves unwritten
+/// can change its output.
+pub fn same_bytes_every_run(flavour: &dyn Flavour, frames: u32, gop: usize, runs: usize) {
+    let planes: Vec<_> = (0..frames).map(|t| noisy(3 * 64, 64, t, 64)).collect();
+    let options = Options {
+        qp: 22,
+        gop,
+        depth: 10,
+        planes: Planes::Yuv444,
+    };
+    let first = code(flavour, &planes, &options);
+    let same = |again: Vec<Packet>, run: &str| {
+        let differs = again.iter().zip(&first).position(|(a, b)| a != b);
+        assert_eq!(differs, None, "{run}: frame {differs:?} differs");
+        assert_eq!(again.len(), first.len(), "{run}");
+    };
+    for run in 1..runs {
+        same(code(flavour, &planes, &options), &format!("run {run}"));
+    }
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        perturb_allocations(0x55);
+        let perturbed = code(flavour, &planes, &options);
+        perturb_allocations(0);
+        same(perturbed, "filled allocations");
+    }
+}
+
+/// glibc's `M_PERTURB`: new allocations are filled with `!byte` and freed ones with `byte` (0:
+/// off), for the whole process while it lasts.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn perturb_allocations(byte: i32) {
+    extern "C" {
+        fn mallopt(param: i32, value: i32) -> i32;
+    }
+    const M_PERTURB: i32 = -6;
+    // SAFETY: mallopt only sets an allocator parameter; M_PERTURB takes any byte value.
+    let set = unsafe { mallopt(M_PERTURB, byte) };
+    assert_eq!(set, 1, "mallopt(M_PERTURB) refused");
+}

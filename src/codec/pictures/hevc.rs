@@ -11,8 +11,9 @@
 //! GOPs: an IDR every `gop` frames (every frame with `gop` 1: all-intra), P-frames between, so each
 //! frame gives exactly one packet, in order, and decoding can start at any IDR. Headers are
 //! in-band (`repeat-headers`: VPS/SPS/PPS on every IDR). x265 runs without its thread pool and with
-//! one frame thread, so its output does not depend on scheduling: the geometry-video coder runs
-//! groups of pictures on several threads instead.
+//! one frame thread, so its output does not depend on scheduling (the geometry-video coder runs
+//! groups of pictures on several threads instead), and codes trees of 32 pixels, not 64, whose
+//! path reads memory x265 never wrote (docs/design.md, "HEVC settings").
 //!
 //! The stream's codec set-up part holds the sample depth and the planes (one byte each), which the
 //! decoder needs before any picture (the depth to read the residual ranges).
@@ -111,14 +112,28 @@ mod coder {
         }
 
         /// `x265-params` of a fixed QP, IDR frames every `gop` frames, no B-frames, scene cuts or open
-        /// GOPs, headers on every IDR, no thread pool and one frame thread.
-        fn settings(&self, options: &deep::Options, gop: u32) -> Dictionary<'static> {
+        /// GOPs, headers on every IDR, and nothing whose result can depend on timing or on memory
+        /// x265 leaves unwritten: no thread pool (hence no wavefront, parallel mode or motion
+        /// analysis, lookahead slices or threads, each also turned off by name), one frame thread,
+        /// and coding tree units of 32 pixels: with x265 3.5's 64, its reference limits and its
+        /// motion compensation read memory it never wrote, so the same pictures came out as
+        /// different bytes from one encoder to the next (docs/design.md, "HEVC settings"). A
+        /// picture narrower or lower than 32 takes 16-pixel units: x265 refuses a picture smaller
+        /// than one unit ("Picture size must be at least one CTU").
+        fn settings(
+            &self,
+            options: &deep::Options,
+            gop: u32,
+            (width, height): (u32, u32),
+        ) -> Dictionary<'static> {
             let mut dict = Dictionary::new();
             dict.set("preset", "medium");
             dict.set("tune", "psnr");
+            let ctu = if width.min(height) >= 32 { 32 } else { 16 };
             let params = format!(
                 "qp={qp}:keyint={gop}:min-keyint={gop}:scenecut=0:open-gop=0:bframes=0:\
-                 repeat-headers=1:info=0:pools=none:frame-threads=1:log-level=error",
+                 repeat-headers=1:info=0:pools=none:frame-threads=1:wpp=0:pmode=0:pme=0:\
+                 lookahead-slices=0:lookahead-threads=0:ctu={ctu}:log-level=error",
                 qp = options.qp
             );
             dict.set("x265-params", &params);
@@ -141,5 +156,11 @@ mod tests {
     #[test]
     fn bad_settings_are_errors() {
         deep::testing::bad_settings_are_errors(X265, 22);
+    }
+
+    /// With x265's 64-pixel coding trees, 10 runs of this gave 4 to 9 different streams.
+    #[test]
+    fn the_same_pictures_give_the_same_bytes_every_run() {
+        deep::testing::same_bytes_every_run(&X265, 60, 50, 6);
     }
 }

@@ -281,11 +281,14 @@ mod coder {
         }
     }
 
-    /// Copies the plane into the luma of `picture`, row by row (FFmpeg pads rows to its own stride).
+    /// Copies the plane into the luma of `picture`, row by row (FFmpeg pads rows to its own stride);
+    /// the padding, which FFmpeg leaves as the allocator gave it, is zeroed first, so that no byte
+    /// the encoder may read differs from one run to the next.
     fn fill_luma(picture: &mut frame::Video, plane: &Plane) -> Result<()> {
         let stride = picture.stride(0);
         let width = plane.width as usize;
         let luma = picture.data_mut(0);
+        luma.fill(0);
         for (y, src) in plane.data.chunks_exact(width).enumerate() {
             let start = y * stride;
             let dst = luma

@@ -145,9 +145,10 @@ pub(crate) struct Decoder {
 
 impl Decoder {
     /// Checks the set-up (`setup`, the payload of its part), reads the band index and decodes the
-    /// bands, low to high, up to `max_bands`, the end of a truncated file, or the last band. A
-    /// band cut by the end of the file ends decoding (it and the rest count as zero); a band
-    /// present in full that fails its CRC is damage, an error.
+    /// bands, low to high, up to `max_bands`, the end of a truncated file, a damaged band or the
+    /// last band. A band cut by the end of the file or failing its CRC ends decoding (it and the
+    /// rest count as zero): the bands before it still give a coarser animation, and the caller
+    /// sees how many were decoded ([`Description`](crate::codec::Description)'s bands).
     pub fn open<R: Read + Seek>(
         setup: &[u8],
         stream: &StreamLayout,
@@ -182,7 +183,10 @@ impl Decoder {
                 Vec::new()
             } else {
                 let what = format!("temporal-DCT band {k}");
-                reader.chunk(Tag::TDCT, band.offset, band.len, band.crc, &what)?
+                match reader.chunk_if_intact(Tag::TDCT, band.offset, band.len, band.crc, &what)? {
+                    Some(bytes) => bytes,
+                    None => break,
+                }
             };
             decoded.push(dequantise(k, coder.decode(k, &bytes)?, step)?);
         }

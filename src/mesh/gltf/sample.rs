@@ -99,7 +99,9 @@ impl Iterator for FrameTimes {
 
 /// The clip's keyframe rate: 1 / the median step between distinct key times, rounded to a whole
 /// rate when within 0.1 % of one (key times are stored rounded); `None` when there are too few keys
-/// or the rate is implausible.
+/// or the rate is implausible for keys to interpolate between (sparse poses, dense keys). Keys
+/// that all STEP hold nothing between them: they are the frames (a baked animation, as glTF
+/// output writes it), trusted at any rate, so that a clip baked at 5 fps reads back at 5 fps.
 fn keyframe_rate(channels: &[Channel]) -> Option<f64> {
     let mut times: Vec<f64> = channels
         .iter()
@@ -118,7 +120,10 @@ fn keyframe_rate(channels: &[Channel]) -> Option<f64> {
     } else {
         rate
     };
-    PLAUSIBLE_FPS.contains(&rate).then_some(rate)
+    let stepped = channels
+        .iter()
+        .all(|c| c.interpolation == Interpolation::Step);
+    (rate.is_finite() && (stepped || PLAUSIBLE_FPS.contains(&rate))).then_some(rate)
 }
 
 impl Channel {
