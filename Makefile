@@ -106,6 +106,7 @@ test: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets --quiet -- -D warnings
 	$(CARGO) clippy --workspace --lib --bins --quiet -- -D warnings
+	$(CARGO) clippy -p mcgv-video-cli --no-default-features --quiet -- -D warnings
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps -p mcgv-video --quiet
 	MCGV_PYTHON=$(abspath $(PY)) $(CARGO) test --workspace --quiet
 	$(PY) scripts/test_peers.py
