@@ -22,8 +22,11 @@ for run in default mpeg4 jpeg; do
     "$bin" decode "$stream" -o "$out/decoded-$run/" --force --quiet
     t2=$(date +%s.%N)
     json=$("$bin" eval "$sample" "$stream" --json --quiet)
-    setting=$("$bin" inspect "$stream" --json | sed -E 's/.*"codec":"([a-z0-9]+)".*"qscale":([0-9]+).*"quality":([0-9]+).*/\1 \3 \2/')
-    read -r codec quality qscale <<<"$setting"
+    described=$("$bin" inspect "$stream" --json)
+    # Each field on its own: a codec's description has only the settings it uses (tdct: no qscale).
+    codec=$(sed -nE 's/.*"codec":"([a-z0-9]+)".*/\1/p' <<<"$described")
+    quality=$(sed -nE 's/.*"quality":([0-9.]+).*/\1/p' <<<"$described")
+    qscale=$(sed -nE 's/.*"qscale":([0-9]+).*/\1/p' <<<"$described")
     [ "$run" = default ] && codec="$codec*"
     case $codec in mpeg4) setting="qscale $qscale" ;; *) setting="quality $quality" ;; esac
     field() { sed -E "s/.*\"$1\":([0-9.eE+-]+).*/\1/" <<<"$json"; }
