@@ -278,6 +278,23 @@ impl Estimated {
     }
 }
 
+/// What the residual coder of `analysed` is given, to code or to estimate.
+fn residual_input<'a>(
+    mesh: &'a AnimatedMesh,
+    ff: &'a EncodedFirstFrame,
+    analysed: &'a Analysed,
+    progress: &'a dyn Progress,
+) -> ResidualInput<'a> {
+    ResidualInput {
+        mesh,
+        reference: &ff.decoded_positions,
+        partition: analysed.partition,
+        residuals: &analysed.prediction.residuals,
+        progress,
+        atlas: analysed.atlas,
+    }
+}
+
 /// The stream bytes of `analysed` with its residuals' parts estimated by the codec (tdct), the
 /// rest as the stream will hold it.
 fn estimate(
@@ -288,14 +305,8 @@ fn estimate(
     progress: &dyn Progress,
 ) -> Result<u64> {
     let (partition, prediction) = (analysed.partition, analysed.prediction);
-    let residuals = settings.plan.encoder()?.estimate_bytes(&ResidualInput {
-        mesh,
-        reference: &ff.decoded_positions,
-        partition,
-        residuals: &prediction.residuals,
-        progress,
-        atlas: analysed.atlas,
-    })?;
+    let input = residual_input(mesh, ff, analysed, progress);
+    let residuals = settings.plan.encoder()?.estimate_bytes(&input)?;
     let residuals = residuals.ok_or_else(|| {
         Error::Codec("the automatic choice asked for an estimate the codec does not make".into())
     })?;
@@ -347,14 +358,7 @@ fn code(
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
     let (partition, prediction) = (analysed.partition, analysed.prediction);
-    let coded = settings.plan.encoder()?.encode(&ResidualInput {
-        mesh,
-        reference: &ff.decoded_positions,
-        partition,
-        residuals: &prediction.residuals,
-        progress,
-        atlas: analysed.atlas,
-    })?;
+    let coded = (settings.plan.encoder()?).encode(&residual_input(mesh, ff, analysed, progress))?;
     clock.stages.extend(coded.stage_seconds.iter().cloned());
     clock.restart();
     let atlas = coded.atlas.clone();
