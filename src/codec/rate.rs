@@ -37,7 +37,7 @@ pub fn ijg_scale_percent(quality: u8) -> u32 {
 }
 
 /// The IJG scale in percent at a quality between the integers (1.0..=100.0, clamped): log-linear
-/// between the scales of the integers around it, so that it meets [`ijg_scale_percent`] (at least
+/// between the scales of the integers around it, so that it meets the integers' IJG scale (at least
 /// 1) at every integer and falls strictly between them.
 pub fn fine_scale_percent(quality: f64) -> f64 {
     let q = quality.clamp(1.0, 100.0);
