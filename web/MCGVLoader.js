@@ -128,6 +128,7 @@ export class MCGVAnimation extends EventDispatcher {
     this.current = -1;
     this.stream_ = null;
     this.nextOpenAt = 0;
+    this.openedBytes = 0; // bytes the open stream holds (an open stream sees no later bytes)
     this.opened = false;
   }
 
@@ -219,6 +220,8 @@ export class MCGVAnimation extends EventDispatcher {
         return;
       }
       this.opened = true;
+      this.openedBytes = this.bytesReceived;
+      this.nextOpenAt = this.nextPictureOpen();
       if (!this.previewed || !this.previewDressed) this.build();
       if (this.needsPictures()) return;
       this.decodeWhatArrived(last);
@@ -234,8 +237,21 @@ export class MCGVAnimation extends EventDispatcher {
       this.info = s.open({ partial: !last, maxBands: this.loader.maxBands });
       this.decodeWhatArrived(last);
     } else {
+      // The open stream holds the bytes of when it opened: frames whose pictures came later are
+      // reached by reopening on the bytes so far, at growing milestones and at the end.
+      if (this.bytesReceived > this.openedBytes && (last || this.bytesReceived >= this.nextOpenAt)) {
+        this.info = s.open({ partial: !last, maxBands: this.loader.maxBands });
+        this.openedBytes = this.bytesReceived;
+        this.nextOpenAt = this.nextPictureOpen();
+      }
       this.decodeWhatArrived(last);
     }
+  }
+
+  /** When to reopen a stream of pictures decoded here: a quarter more bytes (64 KiB at least), so
+   *  the copies a reopening makes add up to a few times the file, not its square. */
+  nextPictureOpen() {
+    return this.bytesReceived + Math.max(65536, this.bytesReceived >> 2);
   }
 
   /** Draws the first frame from the stream's first parts (the whole clip needs the predictor's
