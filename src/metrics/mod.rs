@@ -22,8 +22,21 @@ pub use surface::{
 };
 
 use crate::error::{Error, Result};
-use crate::mesh::AnimatedMesh;
+use crate::mesh::{AnimatedMesh, Point};
 use serde::Serialize;
+
+/// The unit of every measure: the bounding-box diagonal of the original's first frame, refused
+/// when zero (or not a number), as no error could then be a fraction of it.
+pub fn measure_unit(original_first_frame: &[Point]) -> Result<f64> {
+    let diagonal = crate::mesh::bbox_diagonal(original_first_frame);
+    if diagonal.is_nan() || diagonal <= 0.0 {
+        return Err(Error::Mesh(
+            "the original's first frame has a zero bounding-box diagonal, the unit of every measure"
+                .into(),
+        ));
+    }
+    Ok(diagonal)
+}
 
 /// The measures of one decoded animation against its original.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -165,6 +178,16 @@ impl VertexSums {
 mod tests {
     use super::*;
     use crate::mesh::{Point, Triangle};
+
+    #[test]
+    fn the_unit_is_the_first_frames_diagonal_and_never_zero() {
+        let corners: Vec<Point> = vec![[0.0, 0.0, 0.0], [1.0, 2.0, 2.0]];
+        assert_eq!(measure_unit(&corners).ok(), Some(3.0));
+        let still: Vec<Point> = vec![[1.0, 1.0, 1.0]; 4];
+        let e = measure_unit(&still).err().map(|e| e.to_string());
+        assert!(e.is_some_and(|e| e.contains("zero bounding-box diagonal")));
+        assert!(measure_unit(&[]).is_err());
+    }
 
     /// A bumpy 12×12 grid patch, swaying over `frames` frames.
     fn patch(frames: usize) -> AnimatedMesh {

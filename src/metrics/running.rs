@@ -25,14 +25,7 @@ pub struct Comparison {
 impl Comparison {
     /// A comparison sampled where the two first frames say (every frame is measured alike).
     pub fn new(original: Surface<'_>, decoded: Surface<'_>) -> Result<Self> {
-        let diagonal = crate::mesh::bbox_diagonal(original.positions);
-        if diagonal.is_nan() || diagonal <= 0.0 {
-            return Err(Error::Mesh(
-                "the original's first frame has a zero bounding-box diagonal, the unit of every \\
-                 measure"
-                    .into(),
-            ));
-        }
+        let diagonal = super::measure_unit(original.positions)?;
         let plans = SurfacePlans::new(original, decoded, sampling::sample_spacing(diagonal));
         Ok(Self {
             original_triangles: original.triangles.to_vec(),

@@ -122,14 +122,7 @@ impl Tally {
                          the decoded animation {w}; leave --fast out for the surface measures"
                     )));
                 }
-                let diagonal = mcgv_video::mesh::bbox_diagonal(original.positions);
-                if diagonal.is_nan() || diagonal <= 0.0 {
-                    return Err(Error::Mesh(
-                        "the original's first frame has a zero bounding-box diagonal, the unit \
-                         of every measure"
-                            .into(),
-                    ));
-                }
+                let diagonal = mcgv_video::metrics::measure_unit(original.positions)?;
                 *f = Some((VertexSums::default(), diagonal, v, 0));
             }
             _ => {}
