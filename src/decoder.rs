@@ -615,6 +615,7 @@ impl Shared<'_> {
         let layout = StreamLayout {
             header: &header,
             triangles: self.triangles,
+            reference: self.reference,
         };
         // The affine part is read first keeping none of its levels (constant memory): it must hold
         // every frame up to its end word, which proves the segment's frame count before the

@@ -86,6 +86,8 @@ pub(crate) struct StreamLayout<'a> {
     pub header: &'a Header,
     /// The shared connectivity.
     pub triangles: &'a [Triangle],
+    /// The decoded first frame every frame is predicted from.
+    pub reference: &'a [Point],
 }
 
 /// The decoding half of a residual codec: adds the coded residuals to the decoder's prediction.

@@ -87,8 +87,11 @@ fn av1_lands_under_a_size_and_an_error() {
 
 #[test]
 fn a_largest_error_budget_lands_though_that_error_jumps_between_qualities() {
-    // On RiggedFigure the largest vertex error is 8.97e-4 at quality 50 and 7.51e-4 at 44.99: the
-    // search brackets by neighbouring steps, not by the measure, and still lands.
+    // On RiggedFigure the largest vertex error jumps between neighbouring qualities (since the
+    // temporal DCT's copies, stream version 6: 8.89e-4 at quality 30.53, 9.51e-4 at 30.48, 1.05e-3
+    // at 30.41): the search brackets by neighbouring steps, not by the measure, never exceeds the
+    // bound, and keeps the largest error under it that it met; within 3 % of it when one exists
+    // among its encodes, which a measure set by one vertex of 370 does not promise.
     let mesh = read_media("RiggedFigure.glb");
     let budget = Budget::MaxVertexError(1e-3);
     let found = encode_to_budget(&mesh, &EncodeOptions::default(), budget).expect("within");
@@ -103,9 +106,14 @@ fn a_largest_error_budget_lands_though_that_error_jumps_between_qualities() {
         .sqrt()
         / mesh.bbox_diagonal();
     let search = &found.search;
-    assert!((0.97e-3..=1e-3).contains(&largest), "{largest}: {search:?}");
-    assert!(search.within_tolerance, "{search:?}");
+    assert!(largest <= 1e-3, "{largest}: {search:?}");
     assert!((search.achieved - largest).abs() < 1e-12, "{search:?}");
+    let best_under = (search.trials.iter())
+        .filter_map(|t| t.max_vertex_error.filter(|&e| e <= 1e-3))
+        .fold(0.0f64, f64::max);
+    assert_eq!(search.achieved, best_under, "{search:?}");
+    assert_eq!(search.within_tolerance, largest >= 0.97e-3, "{search:?}");
+    assert!(search.encodes <= 10, "{search:?}");
 }
 
 #[test]

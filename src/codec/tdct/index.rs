@@ -1,9 +1,10 @@
 //! The temporal-DCT index part: the quantiser step and, per band, where its bytes lie in the
-//! coefficients part and their CRC-32, so that a reader can stop at any band and check each one.
+//! coefficients part and their CRC-32, so that a reader can stop at any band and check each one;
+//! then the copy bit of each candidate vertex ([`super::copies`]).
 
 use crate::error::{Error, Result};
 use crate::stream::bytes::{ByteReader, ByteWriter};
-use crate::stream::entropy::{self, UIntModel};
+use crate::stream::entropy::{self, BitModel, UIntModel};
 
 /// One band's place in the coefficients part.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,6 +24,8 @@ pub struct BandIndex {
     pub step: f32,
     /// One entry per band, low to high frequency.
     pub bands: Vec<BandEntry>,
+    /// Per candidate vertex ([`super::copies::candidates`]): whether it is a copy.
+    pub copies: Vec<bool>,
 }
 
 impl BandIndex {
@@ -41,7 +44,15 @@ impl BandIndex {
                 e
             })
             .collect();
-        (Self { step, bands }, payload)
+        let copies = Vec::new();
+        (
+            Self {
+                step,
+                bands,
+                copies,
+            },
+            payload,
+        )
     }
 
     /// Serialises the index: step, band count, then lengths and CRCs entropy-coded (most lengths
@@ -54,6 +65,12 @@ impl BandIndex {
             if b.len > 0 {
                 enc.raw_bits(u64::from(b.crc), 32);
             }
+        }
+        // The candidate count is the decoder's to check: stated here, an index parses alone.
+        enc.unsigned(self.copies.len() as u64, &mut UIntModel::default());
+        let mut copy = BitModel::default();
+        for &c in &self.copies {
+            enc.bit(c, &mut copy);
         }
         let mut w = ByteWriter::new();
         w.f32(self.step)
@@ -100,6 +117,21 @@ impl BandIndex {
                 "temporal-DCT bands cover {offset} of the coefficients part's {payload_len} bytes"
             )));
         }
-        Ok(Self { step, bands })
+        let candidates = dec.unsigned(&mut UIntModel::default())?;
+        if candidates > entropy::max_symbols(bytes.len()) {
+            return Err(Error::Stream(format!(
+                "temporal-DCT index: {candidates} copy bits cannot fit in its {} bytes",
+                bytes.len()
+            )));
+        }
+        let mut copy = BitModel::default();
+        let copies = (0..candidates)
+            .map(|_| dec.bit(&mut copy))
+            .collect::<Result<Vec<bool>>>()?;
+        Ok(Self {
+            step,
+            bands,
+            copies,
+        })
     }
 }

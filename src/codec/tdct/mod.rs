@@ -7,6 +7,7 @@
 //! every complete band (a coarser animation).
 
 pub mod coefficients;
+pub mod copies;
 pub mod index;
 pub mod spatial;
 pub mod transform;
@@ -18,11 +19,12 @@ use super::ResidualDecoder;
 #[cfg(feature = "encode")]
 use super::{CodedResiduals, ResidualEncoder, ResidualInput};
 use crate::error::{Error, Result};
-use crate::mesh::Point;
+use crate::mesh::{Point, Triangle};
 use crate::motion::DEFAULT_AFFINE_PRECISION;
 use crate::progress::Progress;
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
 use coefficients::{BandCoder, Rounding};
+use copies::Copies;
 use index::BandIndex;
 use spatial::{Neighbourhood, Spatial};
 use std::io::{Read, Seek};
@@ -38,9 +40,9 @@ pub use coefficients::DEAD_ZONE;
 /// docs/design.md, "Temporal-DCT coder (rounding, contexts, spatial prediction)").
 pub const ROUNDING_LAMBDA: f64 = 0.1;
 
-/// The version of the temporal DCT's set-up part (its only byte: the step and the bands are a
-/// segment's own, in its band index).
-const SETUP_VERSION: u8 = 1;
+/// The version of the temporal DCT's set-up part (its only byte: the step, the bands and the copy
+/// bits are a segment's own, in its band index). Version 2: the copies ([`copies`]).
+const SETUP_VERSION: u8 = 2;
 
 /// The temporal DCT's options: none of its own yet (the step is every codec's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -69,13 +71,13 @@ impl ResidualEncoder for Encoder {
         let clock = Instant::now();
         input.progress.stage("temporal DCT");
         let step = self.step;
-        let coefficients = coefficients::forward(input.residuals)?;
+        let kept = Kept::of(input)?;
+        let coefficients = coefficients::forward(&kept.residuals)?;
         let step64 = f64::from(step);
         // Plain rounding here only decides which bands are empty; the levels coded are chosen by
         // rate and distortion as each band is coded.
         let levels = coefficients::quantise(&coefficients, step64, 0.0)?;
-        let neighbourhood = Neighbourhood::new(input.mesh.vertex_count(), input.mesh.triangles())?;
-        let mut coder = BandCoder::new(Arc::new(neighbourhood));
+        let mut coder = BandCoder::new(Arc::new(kept.neighbourhood));
         let chunks = (levels.iter().zip(&coefficients).enumerate())
             .map(|(k, (band, values))| {
                 let scaled: Vec<f64> = values.iter().map(|c| c / step64).collect();
@@ -86,7 +88,8 @@ impl ResidualEncoder for Encoder {
                 Ok(coder.encode_rounded(k, band, &rounding, &Spatial::ALL)?.0)
             })
             .collect::<Result<Vec<_>>>()?;
-        let (index, payload) = BandIndex::build(step, chunks);
+        let (mut index, payload) = BandIndex::build(step, chunks);
+        index.copies = kept.bits;
         input.progress.frames(input.residuals.len() as u64);
         Ok(CodedResiduals {
             setup: vec![SETUP_VERSION],
@@ -112,17 +115,60 @@ impl ResidualEncoder for Encoder {
     /// automatic choice").
     fn estimate_bytes(&self, input: &ResidualInput) -> Result<Option<u64>> {
         let step = f64::from(self.step);
-        let coefficients = coefficients::forward(input.residuals)?;
+        let kept = Kept::of(input)?;
+        let coefficients = coefficients::forward(&kept.residuals)?;
         let levels = coefficients::quantise(&coefficients, step, transform::DEAD_ZONE)?;
-        let neighbourhood = Neighbourhood::new(input.mesh.vertex_count(), input.mesh.triangles())?;
-        let mut coder = BandCoder::new(Arc::new(neighbourhood));
+        let mut coder = BandCoder::new(Arc::new(kept.neighbourhood));
         let chunks = (levels.iter().enumerate())
             .map(|(k, band)| coder.encode_among(k, band, &[Spatial::Mean]))
             .collect::<Result<Vec<_>>>()?;
-        let (index, payload) = BandIndex::build(self.step, chunks);
+        let (mut index, payload) = BandIndex::build(self.step, chunks);
+        index.copies = kept.bits;
         input.progress.frames(input.residuals.len() as u64);
         let setup = 1 + index.to_bytes()?.len() as u64;
         Ok(Some(setup + payload.len() as u64))
+    }
+}
+
+/// What the bands of an encoder's input hold: the residuals of the vertices that are not copies
+/// ([`copies`]), their neighbourhood, and the copy bits of the band index.
+#[cfg(feature = "encode")]
+struct Kept<'a> {
+    residuals: std::borrow::Cow<'a, [Vec<[f32; 3]>]>,
+    neighbourhood: Neighbourhood,
+    bits: Vec<bool>,
+}
+
+#[cfg(feature = "encode")]
+impl<'a> Kept<'a> {
+    fn of(input: &ResidualInput<'a>) -> Result<Self> {
+        let candidates = copies::candidates(input.reference);
+        let bits = copies::equal_trajectories(&candidates, input.mesh.frames());
+        let copies = Copies::new(input.mesh.vertex_count(), &candidates, &bits);
+        let (residuals, neighbourhood) = match copies.any() {
+            true => (
+                copies.keep_residuals(input.residuals).into(),
+                kept_neighbourhood(&copies, input.mesh.triangles())?,
+            ),
+            false => (
+                input.residuals.into(),
+                Neighbourhood::new(input.mesh.vertex_count(), input.mesh.triangles())?,
+            ),
+        };
+        Ok(Self {
+            residuals,
+            neighbourhood,
+            bits,
+        })
+    }
+}
+
+/// The neighbourhood the bands are coded over: of the merged connectivity when there are copies,
+/// else of the mesh's own (so a stream without copies codes its bands as version 1 did).
+fn kept_neighbourhood(copies: &Copies, triangles: &[Triangle]) -> Result<Neighbourhood> {
+    match copies.any() {
+        true => Neighbourhood::new(copies.kept_count(), &copies.merged_triangles(triangles)),
+        false => Neighbourhood::new(copies.kept_count(), triangles),
     }
 }
 
@@ -141,6 +187,8 @@ pub(crate) struct Bands {
 pub(crate) struct Decoder {
     bands: Bands,
     frames: usize,
+    /// The vertices the bands hold, and the copies of them.
+    copies: Copies,
 }
 
 impl Decoder {
@@ -166,14 +214,30 @@ impl Decoder {
         );
         let entry = reader.entry(Tag::TDCT)?;
         let declared = reader.truncated(Tag::TDCT);
+        if stream.reference.len() != vertices {
+            return Err(Error::Stream(format!(
+                "the first frame has {} vertices, the header {vertices}",
+                stream.reference.len()
+            )));
+        }
+        let candidates = copies::candidates(stream.reference);
         let index = BandIndex::from_bytes(
             &reader.part(Tag::TDCT_INDEX)?,
             frames,
             declared.unwrap_or(entry.len),
         )?;
+        if index.copies.len() != candidates.len() {
+            return Err(Error::Stream(format!(
+                "temporal-DCT index: {} copy bits for {} vertices that share a first-frame position",
+                index.copies.len(),
+                candidates.len()
+            )));
+        }
+        let copies = Copies::new(vertices, &candidates, &index.copies);
         let step = index.step;
         let limit = max_bands.unwrap_or(frames).min(frames);
-        let mut coder = BandCoder::new(Arc::new(Neighbourhood::new(vertices, stream.triangles)?));
+        let neighbourhood = kept_neighbourhood(&copies, stream.triangles)?;
+        let mut coder = BandCoder::new(Arc::new(neighbourhood));
         let mut decoded = Vec::new();
         for (k, band) in index.bands.iter().enumerate().take(limit) {
             if band.offset + band.len > entry.len {
@@ -197,6 +261,7 @@ impl Decoder {
                 step,
             },
             frames,
+            copies,
         })
     }
 }
@@ -229,7 +294,7 @@ impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
         f: usize,
         frame: &mut [Point],
     ) -> Result<()> {
-        let mut sum = vec![0.0f64; 3 * frame.len()];
+        let mut sum = vec![0.0f64; 3 * self.copies.kept_count()];
         for (k, band) in self.bands.decoded.iter().enumerate() {
             if let Some(c) = band {
                 let b = coefficients::basis(k, f, self.frames);
@@ -238,11 +303,7 @@ impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
                 }
             }
         }
-        for (p, s) in frame.iter_mut().zip(sum.chunks_exact(3)) {
-            for a in 0..3 {
-                p[a] += s[a] as f32;
-            }
-        }
+        self.copies.add_to_frame(frame, &sum);
         Ok(())
     }
 
@@ -253,18 +314,23 @@ impl<R: Read + Seek> ResidualDecoder<R> for Decoder {
         frames: &mut [Vec<Point>],
         progress: &dyn Progress,
     ) -> Result<()> {
-        let vertices = frames.first().map_or(0, Vec::len);
         let mut inverse = coefficients::Inverse::new(self.frames);
-        for v in 0..vertices {
+        for slot in 0..self.copies.kept_count() {
+            let v = self.copies.kept_vertex(slot);
             for a in 0..3 {
                 let x = inverse.run(|k| match self.bands.decoded.get(k) {
-                    Some(Some(c)) => f64::from(c[3 * v + a]),
+                    Some(Some(c)) => f64::from(c[3 * slot + a]),
                     _ => 0.0,
                 });
                 for (frame, &x) in frames.iter_mut().zip(x) {
-                    frame[v][a] += x as f32;
+                    if let Some(p) = frame.get_mut(v) {
+                        p[a] += x as f32;
+                    }
                 }
             }
+        }
+        for frame in frames.iter_mut() {
+            self.copies.copy_into(frame);
         }
         progress.frames(frames.len() as u64);
         Ok(())
