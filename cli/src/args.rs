@@ -233,8 +233,9 @@ pub struct EncodeArgs {
     /// codecs: the fewer bits at equal error).
     #[arg(long, value_enum, default_value_t = PredictorChoice::Auto)]
     pub predictor: PredictorChoice,
-    /// Bits per quantised skinning weight, sign included (the paper's 16; fewer can predict as
-    /// well for fewer bits: docs/design.md, "Skinning weights: 16 bits").
+    /// Most bits per quantised skinning weight, sign included (the paper's 16); the encoder uses
+    /// fewer where a coarser weight moves the vertices no more than the affine maps' step does
+    /// (docs/design.md, "Skinning weights: quantised by their effect").
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u8).range(2..=31))]
     pub weight_bits: u8,
     /// Bits per texture coordinate over each UV set's bounding box (inputs with UVs only).

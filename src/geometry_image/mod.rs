@@ -13,6 +13,7 @@ pub mod images;
 pub mod lattice;
 mod plane;
 pub mod quantise;
+pub mod range_coding;
 pub mod tile;
 
 pub use corrections::Corrections;

@@ -22,8 +22,6 @@
 //! never gives a higher error.
 
 use super::corrections::Corrections;
-use crate::error::{Error, Result};
-use crate::stream::bytes::{ByteReader, ByteWriter};
 
 /// The share of a group's values that may be clipped and corrected before its step is widened.
 pub const CORRECTION_SHARE: f64 = 1.0 / 256.0;
@@ -43,8 +41,6 @@ pub fn mid_level(depth: u8) -> f32 {
 fn span(depth: u8) -> f64 {
     f64::from(max_level(depth)) - 1.0
 }
-/// Bytes per frame and coordinate in the ranges part: step (f32) and offset (i32).
-const AXIS_BYTES: usize = 8;
 
 /// How one coordinate's residuals of one frame map to levels:
 /// residual = (level − mid-grey + offset) × step.
@@ -207,54 +203,6 @@ fn fullest_window(sorted: &[f64], span: f64) -> (usize, f64, f64) {
     }
 }
 
-/// Serialises the pixel step and every frame's steps and offsets.
-pub fn write_ranges(pixel_step: f32, ranges: &[FrameRanges], w: &mut ByteWriter) {
-    w.f32(pixel_step).u32(ranges.len() as u32);
-    for r in ranges.iter().flatten() {
-        w.f32(r.step).u32(r.offset as u32);
-    }
-}
-
-/// Reads what [`write_ranges`] wrote: the pixel step and the ranges of `depth`-bit pictures;
-/// `frames` is the count the header promised.
-pub fn read_ranges(
-    r: &mut ByteReader,
-    frames: usize,
-    depth: u8,
-) -> Result<(f32, Vec<FrameRanges>)> {
-    let pixel_step = r.f32()?;
-    if !(pixel_step.is_normal() && pixel_step > 0.0) {
-        return Err(Error::Stream(format!(
-            "residual pixel step {pixel_step} is not a positive number"
-        )));
-    }
-    let n = r.u32()? as usize;
-    if n != frames {
-        return Err(Error::Stream(format!(
-            "{n} residual ranges for {frames} frames"
-        )));
-    }
-    if n.saturating_mul(3 * AXIS_BYTES) > r.remaining() {
-        return Err(Error::Stream("residual ranges are truncated".into()));
-    }
-    let ranges = (0..n)
-        .map(|_| {
-            let mut fr = [AxisRange::at_depth(pixel_step, 0, depth); 3];
-            for a in fr.iter_mut() {
-                let (step, offset) = (r.f32()?, r.u32()? as i32);
-                if !(step.is_finite() && step >= pixel_step) {
-                    return Err(Error::Stream(format!(
-                        "a residual range has step {step}, below the pixel step {pixel_step}"
-                    )));
-                }
-                *a = AxisRange::at_depth(step, offset, depth);
-            }
-            Ok(fr)
-        })
-        .collect::<Result<_>>()?;
-    Ok((pixel_step, ranges))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,12 +255,11 @@ mod tests {
         assert_eq!(g[0], g[1]);
         assert_eq!(g[0][0].offset, -2);
         assert_eq!(g[2][0].offset, 16);
-        let mut w = ByteWriter::new();
-        write_ranges(0.25, &g, &mut w);
-        let bytes = w.into_bytes();
-        let (step, back) = read_ranges(&mut ByteReader::new(&bytes, "ranges"), 3, 8).unwrap();
-        assert_eq!((step, back), (0.25, g));
-        assert!(read_ranges(&mut ByteReader::new(&bytes, "ranges"), 4, 8).is_err());
+        let none = Corrections::from_frames(vec![Vec::new(); 3]);
+        let bytes = super::super::range_coding::encode_ranges(0.25, &g, &none, 1).unwrap();
+        let back = super::super::range_coding::decode_ranges(&bytes, 3, 1, 8).unwrap();
+        assert_eq!(back, (0.25, g, none));
+        assert!(super::super::range_coding::decode_ranges(&bytes, 4, 1, 8).is_err());
     }
 
     #[test]

@@ -56,6 +56,10 @@ pub struct ClusterGeometry {
     pub centroids: Vec<[f64; 3]>,
     /// RMS distance of each cluster's vertices from its centroid (0 for an empty cluster).
     pub spreads: Vec<f64>,
+    /// RMS offset of each cluster's vertices from its centroid along each axis: column `j` of the
+    /// linear part moves a vertex by its offset along axis `j`, so a thin cluster's columns
+    /// across it are quantised coarser (stream version 6).
+    pub axis_spreads: Vec<[f64; 3]>,
 }
 
 impl ClusterGeometry {
@@ -77,27 +81,41 @@ impl ClusterGeometry {
             .zip(&count)
             .map(|(s, &n)| s.map(|x| x / n.max(1) as f64))
             .collect();
-        let mut squares = vec![0.0f64; k];
+        let mut squares = vec![[0.0f64; 3]; k];
         for (p, &l) in reference.iter().zip(partition.labels()) {
             if let (Some(s), Some(c)) = (squares.get_mut(l as usize), centroids.get(l as usize)) {
                 let u = unit.to_unit(p);
-                *s += (0..3).map(|a| (u[a] - c[a]).powi(2)).sum::<f64>();
+                (0..3).for_each(|a| s[a] += (u[a] - c[a]).powi(2));
             }
         }
         let spreads = squares
             .iter()
             .zip(&count)
-            .map(|(s, &n)| (s / n.max(1) as f64).sqrt())
+            .map(|(s, &n)| (s.iter().sum::<f64>() / n.max(1) as f64).sqrt())
             .collect();
-        Self { centroids, spreads }
+        let axis_spreads = squares
+            .iter()
+            .zip(&count)
+            .map(|(s, &n)| s.map(|x| (x / n.max(1) as f64).sqrt()))
+            .collect();
+        Self {
+            centroids,
+            spreads,
+            axis_spreads,
+        }
     }
 
     /// The 12 quantiser steps of `cluster`'s map for base step `step`, in coefficient order
-    /// (`[a00 a01 a02 t0 a10 …]`): `step` for the translations, `step / r̄` for the linear part.
+    /// (`[a00 a01 a02 t0 a10 …]`): `step` for the translations, `step / (√3 σ_j)` for column `j`
+    /// of the linear part, `σ_j` the cluster's RMS offset along axis `j`. An error `e` in such an
+    /// entry moves the vertices by `e σ_j` RMS, so the three columns of a row together move them
+    /// as much as the translation does (as `step / r̄` did for every column, `r̄² = Σ σ_j²`), with
+    /// fewer levels where the cluster is thin.
     pub fn steps(&self, cluster: usize, step: f64) -> [f64; 12] {
-        let spread = self.spreads.get(cluster).copied().unwrap_or(0.0);
-        let linear = (step / spread.max(MIN_SPREAD)).min(MAX_LINEAR_STEP);
-        std::array::from_fn(|c| if c % 4 == 3 { step } else { linear })
+        let spreads = self.axis_spreads.get(cluster).copied().unwrap_or([0.0; 3]);
+        let linear = spreads
+            .map(|s| (step / (3f64.sqrt() * s).max(MIN_SPREAD)).min(MAX_LINEAR_STEP));
+        std::array::from_fn(|c| if c % 4 == 3 { step } else { linear[c % 4] })
     }
 
     /// `cluster`'s centroid (the origin for a cluster out of range).
@@ -307,6 +325,7 @@ impl AffineTrack {
         quantised.check()?;
         if geometry.centroids.len() != quantised.clusters
             || geometry.spreads.len() != quantised.clusters
+            || geometry.axis_spreads.len() != quantised.clusters
         {
             return Err(Error::Stream(format!(
                 "affine coefficients: {} clusters, the partition has {}",

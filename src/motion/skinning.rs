@@ -195,7 +195,7 @@ impl SkinningWeights {
         let neighbours = cluster_neighbours(partition, triangles);
         let unit = UnitFrame::of(reference);
         let maps = track.maps();
-        let exact: Vec<Vec<f64>> = (0..reference.len())
+        let fitted: Vec<(Vec<f64>, f64)> = (0..reference.len())
             .into_par_iter()
             .map(|v| {
                 let k = partition.labels()[v] as usize;
@@ -210,6 +210,8 @@ impl SkinningWeights {
                 problem.solve(v, k, &neighbours[k])
             })
             .collect();
+        let effect: f64 = fitted.iter().map(|f| f.1).sum();
+        let exact: Vec<Vec<f64>> = fitted.into_iter().map(|f| f.0).collect();
         let largest = exact
             .iter()
             .flatten()
@@ -217,6 +219,7 @@ impl SkinningWeights {
             .min(MAX_WEIGHT);
         // A stream without any weight (or with all zero) still needs a valid, positive limit.
         let limit = if largest > 0.0 { largest as f32 } else { 1.0 };
+        let bits = bits_by_effect(limit, bits, effect, reference.len(), track);
         let top = Self::top(bits);
         let step = limit as f64 / top as f64;
         let values = exact
@@ -296,6 +299,25 @@ impl SkinningWeights {
     }
 }
 
+/// The fewest bits (at most `most`) whose weight step moves the vertices no more than the affine
+/// maps' quantisation does: the closed loop hands both errors to the residual coder, so weights
+/// finer than the maps cost bits and buy nothing. `effect` is `Σ_v Σ_j Σ_i ‖p_j^i − p_k^i‖²`
+/// (unit frame), so a weight step `w` moves the vertices by `w² effect / 12` squared in all;
+/// the maps move each vertex by about three translation steps `s`: `3 s² / 12` a vertex and
+/// frame.
+#[cfg(feature = "encode")]
+fn bits_by_effect(limit: f32, most: u8, effect: f64, vertices: usize, track: &AffineTrack) -> u8 {
+    let step = f64::from(track.quantised().step);
+    let per_vertex_frame = effect / (vertices.max(1) * track.frame_count().max(1)) as f64;
+    if !(per_vertex_frame > 0.0 && per_vertex_frame.is_finite()) {
+        return most;
+    }
+    let target = step * (3.0 / per_vertex_frame).sqrt();
+    (2..most)
+        .find(|&b| f64::from(limit) / f64::from(SkinningWeights::top(b)) <= target)
+        .unwrap_or(most)
+}
+
 /// What every vertex's weight fit shares.
 #[cfg(feature = "encode")]
 struct VertexFit<'a> {
@@ -311,8 +333,10 @@ struct VertexFit<'a> {
 #[cfg(feature = "encode")]
 impl VertexFit<'_> {
     /// The unconstrained weights `β` of vertex `v` of cluster `k`: least squares of
-    /// `Σ_i ‖Σ_j β_j (p_j^i − p_k^i) − (x_i − p_k^i)‖²` plus the ridge.
-    fn solve(&self, v: usize, k: usize, neighbours: &[u32]) -> Vec<f64> {
+    /// `Σ_i ‖Σ_j β_j (p_j^i − p_k^i) − (x_i − p_k^i)‖²` plus the ridge; and `Σ_j Σ_i ‖p_j^i −
+    /// p_k^i‖²`, what an error of one in every weight would move the vertex by (squared, summed
+    /// over the frames).
+    fn solve(&self, v: usize, k: usize, neighbours: &[u32]) -> (Vec<f64>, f64) {
         let Self {
             frames,
             reference,
@@ -323,7 +347,7 @@ impl VertexFit<'_> {
         } = *self;
         let m = neighbours.len();
         if m == 0 {
-            return Vec::new();
+            return (Vec::new(), 0.0);
         }
         let x0 = unit.to_unit(&reference[v]);
         let mut gram = DMatrix::<f64>::zeros(m, m);
@@ -351,11 +375,12 @@ impl VertexFit<'_> {
                 gram[(a, b)] = gram[(b, a)];
             }
         }
-        let lambda = ridge * gram.trace() / m as f64 + 1e-30;
+        let effect = gram.trace();
+        let lambda = ridge * effect / m as f64 + 1e-30;
         for a in 0..m {
             gram[(a, a)] += lambda;
         }
-        match gram.cholesky() {
+        let weights = match gram.cholesky() {
             Some(ch) => ch
                 .solve(&rhs)
                 .iter()
@@ -369,7 +394,8 @@ impl VertexFit<'_> {
                 .collect(),
             // Not positive definite only if the maps are non-finite: keep the piecewise affine prediction.
             None => vec![0.0; m],
-        }
+        };
+        (weights, if effect.is_finite() { effect } else { 0.0 })
     }
 }
 
@@ -455,6 +481,39 @@ mod tests {
         assert!(skin_all < 0.5 * affine_all, "{skin_all} vs {affine_all}");
         // Seam vertices blend; weights sum to 1 by construction, so the own weight is 1 − β.
         assert!(weights.blended_vertices(&partition) > 10);
+    }
+
+    #[test]
+    fn weights_are_no_finer_than_the_maps_and_still_blend_the_seam() {
+        let (rest, tris, frames, partition) = bend();
+        let fit = |step| {
+            let track = AffineTrack::fit(&frames, &rest, &partition, step).unwrap();
+            let w = SkinningWeights::fit(&frames, &rest, &partition, &tris, &track).unwrap();
+            (track, w)
+        };
+        let ((_, fine), (coarse_track, coarse)) = (fit(1e-6), fit(1e-2));
+        assert!(fine.bits >= 14, "{} bits at step 1e-6", fine.bits);
+        assert!(coarse.bits + 4 <= fine.bits, "{} bits at step 1e-2", coarse.bits);
+        // The coarse weights still remove most of the seam's error of the coarse maps.
+        let (mut affine_seam, mut skin_seam) = (0.0, 0.0);
+        let seam: Vec<usize> = (0..rest.len())
+            .filter(|&v| rest[v][0].abs() < 0.3)
+            .collect();
+        for (f, frame) in frames.iter().enumerate() {
+            let a = residuals(frame, &coarse_track.predict(f, &rest, &partition));
+            let s = residuals(
+                frame,
+                &coarse
+                    .try_predict(f, &coarse_track, &rest, &partition)
+                    .unwrap(),
+            );
+            affine_seam += energy(&seam.iter().map(|&v| a[v]).collect::<Vec<_>>());
+            skin_seam += energy(&seam.iter().map(|&v| s[v]).collect::<Vec<_>>());
+        }
+        assert!(
+            skin_seam < 0.2 * affine_seam,
+            "seam energy: skinning {skin_seam}, affine {affine_seam}"
+        );
     }
 
     #[test]

@@ -110,3 +110,65 @@ fn truncated_or_damaged_parts_are_errors() {
     }
     assert!(errors * 10 >= trials * 9, "{errors} errors in {trials}");
 }
+
+#[test]
+fn linear_steps_follow_each_axis_extent_and_move_vertices_as_the_translation_does() {
+    // The cloth starts flat in y: every cluster is thin across it, so the middle column of its
+    // linear part (what y offsets multiply) is quantised at least as coarse as the other two,
+    // and coarser than the finest (the coarsest step is capped).
+    let (mesh, partition) = cloth_and_partition();
+    let reference = mesh.frame(0);
+    let step = 1e-3;
+    let track = AffineTrack::fit(mesh.frames(), reference, &partition, step).unwrap();
+    let geometry = track.geometry();
+    let base = f64::from(track.quantised().step);
+    for k in 0..partition.clusters() {
+        let steps = geometry.steps(k, base);
+        let spread = geometry.axis_spreads[k];
+        assert!(spread[1] < spread[0] && spread[1] < spread[2], "{spread:?}");
+        assert!(steps[1] >= steps[0] && steps[1] >= steps[2], "{steps:?}");
+        assert!(steps[1] > steps[0].min(steps[2]), "{steps:?}");
+        // The rule: a row's three linear steps, weighted by the extents, move the vertices by
+        // at most the translation's step (RMS), as the one step of the former rule did.
+        for row in 0..3 {
+            let moved: f64 = (0..3)
+                .map(|j| (steps[4 * row + j] * spread[j]).powi(2))
+                .sum();
+            assert!(
+                moved <= base * base * (1.0 + 1e-9),
+                "cluster {k}: {moved:e}"
+            );
+            assert_eq!(steps[4 * row + 3], base);
+        }
+    }
+    // And the decoded maps move the vertices by about that: RMS within √(2/12) steps (uniform
+    // rounding of the translation and of the linear part), with a margin for rounding that is
+    // not uniform on few levels.
+    let exact = AffineTrack::fit(mesh.frames(), reference, &partition, MIN_AFFINE_STEP).unwrap();
+    // Unit coordinates are fractions of the reference's bounding-box diagonal.
+    let diagonal = {
+        let (lo, hi) = mcgv_video::mesh::bounding_box(reference);
+        (0..3)
+            .map(|a| f64::from(hi[a] - lo[a]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let (mut sum, mut n) = (0.0, 0usize);
+    for f in 0..mesh.frame_count() {
+        let (got, want) = (
+            track.predict(f, reference, &partition),
+            exact.predict(f, reference, &partition),
+        );
+        for (a, b) in got.iter().zip(&want) {
+            let d2: f64 = (0..3).map(|i| f64::from(a[i] - b[i]).powi(2)).sum();
+            sum += d2 / 3.0 / (diagonal * diagonal);
+            n += 1;
+        }
+    }
+    let rms = (sum / n as f64).sqrt();
+    assert!(
+        rms <= 1.5 * base * (2.0f64 / 12.0).sqrt(),
+        "rms {rms:e}, step {base:e}"
+    );
+    assert!(rms > 0.1 * base, "rms {rms:e}: the maps were quantised");
+}

@@ -30,7 +30,10 @@ fn tdct(quality: u8) -> EncodeOptions {
 fn tdct_keeps_the_smallest_precision_and_its_stream_is_the_fixed_ones() {
     let mesh = waving_tube();
     let mut kept_bits = Vec::new();
-    for quality in [10, 90] {
+    // Quality 5, not 10: since container version 6 (per-column affine steps, weights by their
+    // effect) the 8-bit first frame at quality 10 is 1.3 % larger than the 10-bit one on this
+    // tube: both ends kept 10.
+    for quality in [5, 90] {
         let open = tdct(quality);
         assert_eq!(open.first_frame_bits, None, "open by default");
         let encoded = encode(&mesh, &open).expect("encodes");

@@ -16,13 +16,12 @@ use crate::codec::{CodedResiduals, ResidualEncoder, ResidualInput};
 use crate::error::{Error, Result};
 #[cfg(feature = "encode")]
 use crate::geometry_image::lattice::AtlasCache;
-use crate::geometry_image::{lattice, quantise, tile, Corrections, FrameRanges};
+use crate::geometry_image::{lattice, quantise, range_coding, tile, Corrections, FrameRanges};
 #[cfg(feature = "encode")]
 use crate::geometry_image::GeometryImages;
 use crate::mesh::Point;
 use crate::motion::Partition;
 use crate::progress::Progress;
-use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::container::{Checksum, ContainerReader, Part, Tag};
 use crate::stream::frame_index::{FrameChunk, FrameIndex};
 use crate::stream::side_info;
@@ -93,9 +92,12 @@ impl ResidualEncoder for Encoder {
         input.progress.stage("images");
         let (codec_data, chunks) = code_pictures(self, &images, input)?;
         let images_seconds = clock.elapsed().as_secs_f64();
-        let mut ranges = ByteWriter::new();
-        quantise::write_ranges(images.pixel_step, &images.ranges, &mut ranges);
-        images.corrections.write(&mut ranges);
+        let ranges = range_coding::encode_ranges(
+            images.pixel_step,
+            &images.ranges,
+            &images.corrections,
+            input.mesh.vertex_count(),
+        )?;
         let (index, payload) = FrameIndex::build(chunks);
         let lattice_part = side_info::encode_lattice(
             images.atlas.vertex_pixels(),
@@ -118,7 +120,7 @@ impl ResidualEncoder for Encoder {
             atlas: Some(stats),
             before_predictor: vec![Part::whole(Tag::LATTICE, lattice_part)],
             after_predictor: vec![
-                Part::whole(Tag::RANGES, ranges.into_bytes()),
+                Part::whole(Tag::RANGES, ranges),
                 Part::whole(Tag::FRAME_INDEX, index.to_bytes()),
                 Part {
                     tag: Tag::FRAMES,
@@ -263,10 +265,8 @@ impl Decoder {
             side_info::decode_lattice(&reader.part(Tag::LATTICE)?, v, lattice, stream.triangles)?;
         let depth = setup.depth;
         let ranges_bytes = reader.part(Tag::RANGES)?;
-        let mut r = ByteReader::new(&ranges_bytes, "residual ranges");
-        let (pixel_step, ranges) = quantise::read_ranges(&mut r, frames, depth)?;
-        let corrections = Corrections::read(&mut r, frames, v)?;
-        r.finish()?;
+        let (pixel_step, ranges, corrections) =
+            range_coding::decode_ranges(&ranges_bytes, frames, v, depth)?;
         // A partial stream's images part may be cut short: the index covers the declared length.
         let images_len = match reader.truncated(Tag::FRAMES) {
             Some(declared) => declared,

@@ -10,8 +10,9 @@ use crate::geometry_image::lattice::MAX_LATTICE_SIDE;
 use crate::geometry_image::Lattice;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 
-/// The version of the set-up part this build writes and reads.
-const VERSION: u8 = 1;
+/// The version of the set-up part this build writes and reads (2: the ranges part entropy-coded,
+/// `geometry_image::range_coding`).
+const VERSION: u8 = 2;
 
 /// A geometry-video stream's set-up.
 #[derive(Debug, Clone, PartialEq)]
