@@ -18,7 +18,8 @@ use std::path::Path;
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
 /// The container version this build writes and reads: 6, the affine maps' linear part quantised
-/// per column by the cluster's extent along that axis (5: the header holds what every codec
+/// per column by the cluster's extent along that axis, the temporal DCT's copies, the welded
+/// first frame (issue 35; 5: the header holds what every codec
 /// shares and each codec its own fields in its set-up part; docs/history.md lists the versions).
 /// A reader refuses any other version, so an older reader says "update" instead of misreading.
 pub const VERSION: u16 = 6;
