@@ -8,7 +8,9 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
     let dir = tempfile::tempdir().unwrap();
     let sample = media_path("RiggedSimple.glb");
     let mut bits = Vec::new();
-    for (predictor, weight_bits) in [("affine", "16"), ("skinning", "16"), ("skinning", "10")] {
+    // --weight-bits is the most: the encoder takes fewer where the maps' step allows (9 here at
+    // 16), so the cap of 6 is below what it would take.
+    for (predictor, weight_bits) in [("affine", "16"), ("skinning", "16"), ("skinning", "6")] {
         let path = dir.path().join(format!("{predictor}{weight_bits}.mcgv"));
         let s = path.to_str().unwrap();
         ok(&run(&[
@@ -29,7 +31,12 @@ fn cli_records_the_predictor_and_inspect_reports_the_weights() {
         let info = json(&run(&["inspect", s, "--json"]));
         assert_eq!(info["predictor"], predictor);
         if predictor == "skinning" {
-            assert_eq!(info["weight_bits"].to_string(), weight_bits);
+            let most: u64 = weight_bits.parse().unwrap();
+            let used = info["weight_bits"].as_u64().expect("weight bits");
+            assert!(used <= most && used >= 2, "{used} bits for at most {most}");
+            if most == 6 {
+                assert_eq!(used, 6);
+            }
         } else {
             assert!(info["weight_bits"].is_null());
         }
