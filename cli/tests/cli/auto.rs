@@ -51,8 +51,19 @@ fn auto_reports_its_candidates_and_keeps_the_smallest() {
     // With the first frame's precision open too, the stream is the smallest of its trials.
     let trials = default["first_frame_trials"].as_array().expect("trials");
     assert_eq!(trials[0]["bytes"], enc["bytes"], "{default}");
-    let least = trials.iter().filter_map(|t| t["bytes"].as_u64()).min();
+    // A precision coded in full is compared by its bytes; one its estimate ruled out lists that
+    // estimate (`estimated`), which was weighed against the kept one's estimate, not its bytes,
+    // and ends the trials.
+    let coded = |t: &&serde_json::Value| t["estimated"] == false;
+    let least = trials
+        .iter()
+        .filter(coded)
+        .filter_map(|t| t["bytes"].as_u64())
+        .min();
     assert_eq!(default["bytes"].as_u64(), least, "{default}");
+    let ruled_out = trials.iter().filter(|t| t["estimated"] == true).count();
+    assert!(ruled_out <= 1, "{default}");
+    assert!(ruled_out == 0 || trials.last().is_some_and(|t| t["estimated"] == true));
     let text = ok(&run(
         &[&base[..5], &auto[..4], &["--clusters", "5"]].concat()
     ));
