@@ -20,7 +20,7 @@ pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 /// The container version this build writes and reads: 5, the header holds what every codec shares
 /// and each codec its own fields in its set-up part (docs/history.md lists the versions before).
 /// A reader refuses any other version, so an older reader says "update" instead of misreading.
-pub const VERSION: u16 = 5;
+pub const VERSION: u16 = 6;
 
 /// Bytes of a part header: tag, checksum kind, length, CRC.
 pub const PART_HEADER_LEN: usize = 17;
