@@ -1,9 +1,9 @@
-//! Vertices that share a quantised position, coded once.
+//! Vertices at the same position, coded once.
 //!
 //! glTF meshes duplicate a vertex wherever a UV or normal seam passes, and some are triangle
 //! soups (every triangle with its own three vertices): coded as they are, each copy is a new
 //! vertex of a new component, predicted from nothing. So the traversal and the geometry run on
-//! the *welded* mesh (one vertex per occupied cell), and this module codes how the input's
+//! the *welded* mesh (one vertex per distinct position), and this module codes how the input's
 //! vertices sit on it: the number of copies of each welded vertex (a unary count, one decision
 //! per copy), then, for each corner of each triangle in coding order, which copy it uses. A
 //! corner most often uses the copy its neighbour across an edge uses (the seam is elsewhere),
@@ -15,6 +15,7 @@ use std::collections::HashMap;
 
 use super::traversal::{undirected, UNASSIGNED};
 use crate::error::{Error, Result};
+use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
 use crate::stream::entropy::{BitModel, SymbolCoder, UIntModel};
 
@@ -27,7 +28,7 @@ pub(super) struct Weld {
 }
 
 impl Weld {
-    /// Welds vertices with equal cells (they decode to the same position anyway).
+    /// Welds vertices with equal keys (equal positions: they decode to the same position).
     pub(super) fn new<K: Copy + Eq + std::hash::Hash>(cells: &[K]) -> Self {
         let mut by_cell: HashMap<K, u32> = HashMap::with_capacity(cells.len());
         let mut first = Vec::new();
@@ -66,8 +67,9 @@ pub(super) struct Numbering {
 
 #[derive(Default)]
 struct Models {
-    /// "another copy?", by how many there are already (1, 2, 3, 4+).
-    more: [BitModel; 4],
+    /// "another copy?", by how many coded neighbours have copies (0, 1, 2+) and how many copies
+    /// there are already (1, 2, 3, 4+): seams are lines, copies come in runs along them.
+    more: [[BitModel; 4]; 3],
     same_as_neighbour: BitModel,
     /// "a copy not used yet?", by whether a neighbour's copy was offered first.
     fresh: [BitModel; 2],
@@ -88,7 +90,15 @@ pub(super) fn code_copies<C: SymbolCoder>(
     actual: Option<Actual>,
 ) -> Result<Numbering> {
     let mut models = Models::default();
-    let counts = code_counts(coder, &mut models, welded_count, vertex_count, actual)?;
+    let adjacency = VertexAdjacency::new(welded_count, triangles);
+    let counts = code_counts(
+        coder,
+        &mut models,
+        &adjacency,
+        welded_count,
+        vertex_count,
+        actual,
+    )?;
     let mut state = State {
         used: vec![Vec::new(); welded_count],
         out: Numbering {
@@ -140,6 +150,7 @@ pub(super) fn code_copies<C: SymbolCoder>(
 fn code_counts<C: SymbolCoder>(
     coder: &mut C,
     models: &mut Models,
+    adjacency: &VertexAdjacency,
     welded_count: usize,
     vertex_count: usize,
     actual: Option<Actual>,
@@ -148,8 +159,14 @@ fn code_counts<C: SymbolCoder>(
     let mut total = 0usize;
     for w in 0..welded_count {
         let want = actual.map_or(1, |a| a.copies_of[w].len());
+        let seamed = adjacency
+            .neighbours(w)
+            .iter()
+            .filter(|&&n| counts.get(n as usize).is_some_and(|&c| c > 1))
+            .count()
+            .min(2);
         let mut count = 1;
-        while coder.bit(count < want, &mut models.more[(count - 1).min(3)])? {
+        while coder.bit(count < want, &mut models.more[seamed][(count - 1).min(3)])? {
             count += 1;
             if total + count > vertex_count {
                 return Err(corrupt("more copies than vertices"));
