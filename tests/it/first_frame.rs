@@ -411,3 +411,31 @@ fn cesium_man_first_frame_stays_small() {
     // preserve_order 39 333, free to reorder and drop the seams' copies 5 238).
     assert!(bytes <= 9_100, "CesiumMan first frame: {bytes} bytes");
 }
+
+#[test]
+fn vertices_sharing_a_cell_at_low_bits_stay_apart() {
+    // At 4 bits a 40 × 30 grid puts several distinct vertices in each cell: welding them would
+    // make degenerate and non-manifold triangles and a dearer connectivity. Only equal positions
+    // are welded, so the connectivity does not depend on the bits.
+    let (p, t) = grid(40, 30);
+    let connectivity = |bits| {
+        let opts = FirstFrameOptions {
+            bits,
+            reorder: true,
+        };
+        encode(&p, &t, &opts).unwrap().sizes.connectivity
+    };
+    assert_eq!(connectivity(4), connectivity(12));
+    let coded = encode(
+        &p,
+        &t,
+        &FirstFrameOptions {
+            bits: 4,
+            reorder: false,
+        },
+    )
+    .unwrap();
+    let (tris, pos) = decode(&coded.bytes).unwrap();
+    assert_eq!(canonical(&tris), canonical(&t));
+    assert_eq!(pos.len(), p.len());
+}
