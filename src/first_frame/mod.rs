@@ -166,6 +166,7 @@ pub fn encode(
             &numbering.triangles,
             &degenerate,
             &numbering.inputs,
+            &numbering.welded,
             vertex_count,
         )?
     };
@@ -311,12 +312,18 @@ fn encode_order(
     traversed: &[Triangle],
     degenerate: &[Triangle],
     from_traversal: &[u32],
+    welded: &[u32],
     vertex_count: usize,
 ) -> Result<Vec<u8>> {
     let mut order_coder = Encoder::new();
     let all: Vec<Triangle> = traversed.iter().chain(degenerate).copied().collect();
     let adjacency = VertexAdjacency::new(vertex_count, &all);
-    order::code_order(&mut order_coder, &mut from_traversal.to_vec(), &adjacency)?;
+    order::code_order(
+        &mut order_coder,
+        &mut from_traversal.to_vec(),
+        &adjacency,
+        welded,
+    )?;
     order_coder.finish()
 }
 
@@ -388,15 +395,20 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
         decode_degenerate(&mut connectivity, header.degenerate as usize, vertex_count)?;
     let mut triangles = numbering.triangles;
     triangles.extend(degenerate);
-    let mut positions: Vec<Point> = numbering
-        .welded
+    let welded = numbering.welded;
+    let mut positions: Vec<Point> = welded
         .iter()
         .map(|&w| grid.dequantise(cells[w as usize]))
         .collect();
     if header.has_order {
         let mut order_indices = vec![0u32; vertex_count];
         let adjacency = VertexAdjacency::new(vertex_count, &triangles);
-        order::code_order(&mut Decoder::new(order)?, &mut order_indices, &adjacency)?;
+        order::code_order(
+            &mut Decoder::new(order)?,
+            &mut order_indices,
+            &adjacency,
+            &welded,
+        )?;
         let mut reordered = vec![[0.0; 3]; vertex_count];
         for (t, &input) in order_indices.iter().enumerate() {
             reordered[input as usize] = positions[t];
