@@ -2,8 +2,9 @@
 //!
 //! Each traversal vertex's input index is coded as a small correction to one of a few guesses,
 //! the guess named by an adaptive symbol: one past the largest index so far (input orders often
-//! follow face order), one past the previous vertex's, or a coded neighbour's (modellers tend
-//! to number neighbours close together).
+//! follow face order), one past the previous vertex's, a coded neighbour's (modellers tend
+//! to number neighbours close together), or one past the newest earlier copy of the same
+//! position (see `weld`).
 
 use std::collections::HashMap;
 
