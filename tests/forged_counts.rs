@@ -83,9 +83,10 @@ const SMALL: usize = 1 << 20;
 /// Byte offsets in the first frame's header: counts, then the three stream lengths, then the CRC.
 const VERTEX_COUNT: usize = 4;
 const TRAVERSED: usize = 8;
-const CONNECTIVITY_LEN: usize = 40;
-const GEOMETRY_LEN: usize = 44;
-const FIRST_FRAME_HEADER_LEN: usize = 56;
+const WELDED: usize = 16;
+const CONNECTIVITY_LEN: usize = 44;
+const GEOMETRY_LEN: usize = 48;
+const FIRST_FRAME_HEADER_LEN: usize = 60;
 
 fn word(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(bytes[at..at + 4].try_into().expect("four bytes"))
@@ -173,14 +174,34 @@ fn the_forgery_keeps_an_honest_first_frame_valid() {
 
 #[test]
 fn vertices_past_what_the_geometry_stream_holds_are_refused_before_allocating() {
-    // 4 KB of geometry hold at most max_symbols / 3 vertices (three residuals each); the whole
-    // payload, which the old check used, holds three times as many symbols as that needs.
-    let (claim, msg) = refused(true, GEOMETRY_LEN, 4000, VERTEX_COUNT, |b| {
-        (max_symbols(word(b, GEOMETRY_LEN) as usize) / 3 + 1) as u32
+    // 4 KB of geometry hold at most max_symbols / 3 welded vertices (three residuals each); the
+    // vertex count is raised with them, as welded vertices are never more than the vertices.
+    let pad = |b: &[u8]| (max_symbols(word(b, GEOMETRY_LEN) as usize) / 3 + 1) as u32;
+    let claim = pad(&forged_first_frame(true, GEOMETRY_LEN, 4000, |_| {}));
+    let bytes = forged_first_frame(true, GEOMETRY_LEN, 4000, |b| {
+        set_word(b, VERTEX_COUNT, claim);
+        set_word(b, WELDED, claim);
     });
+    let (result, peak) = peak_of(|| first_frame::decode(&bytes));
+    let msg = result
+        .expect_err("a forged first frame was accepted")
+        .to_string();
+    assert!(peak < SMALL, "refusing took {peak} bytes: {msg}");
     assert!(claim > 7_000_000, "a claim worth refusing: {claim}");
     assert!(
-        msg.contains(&format!("{claim} vertices")) && msg.contains("geometry stream"),
+        msg.contains(&format!("{claim} welded vertices")) && msg.contains("geometry stream"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn vertices_past_what_the_connectivity_stream_holds_are_refused_before_allocating() {
+    // Each vertex is at least one "another copy?" decision in the connectivity stream.
+    let (claim, msg) = refused(true, CONNECTIVITY_LEN, 4000, VERTEX_COUNT, |b| {
+        max_symbols(word(b, CONNECTIVITY_LEN) as usize) as u32
+    });
+    assert!(
+        msg.contains(&format!("{claim} vertices")) && msg.contains("connectivity stream"),
         "{msg}"
     );
 }
@@ -302,7 +323,19 @@ fn a_first_frame_claiming_the_vertices_its_padding_could_hold_is_refused_in_litt
     let pad = 15_000;
     let claim = |b: &[u8]| (max_symbols(word(b, GEOMETRY_LEN) as usize) / 3) as u32;
     let c = claim(&forged_first_frame(true, GEOMETRY_LEN, pad, |_| {}));
-    let bytes = forged_first_frame(true, GEOMETRY_LEN, pad, |b| set_word(b, VERTEX_COUNT, c));
+    // The connectivity stream padded as well, for its one decision per vertex.
+    let mut bytes = forged_first_frame(true, GEOMETRY_LEN, pad, |b| {
+        set_word(b, VERTEX_COUNT, c);
+        set_word(b, WELDED, c);
+    });
+    let end = FIRST_FRAME_HEADER_LEN + word(&bytes, CONNECTIVITY_LEN) as usize;
+    bytes.splice(end..end, vec![0u8; 2 * pad]);
+    let grown = word(&bytes, CONNECTIVITY_LEN) + 2 * pad as u32;
+    set_word(&mut bytes, CONNECTIVITY_LEN, grown);
+    let mut hasher = crc32fast::Hasher::new();
+    hasher.update(&bytes[..FIRST_FRAME_HEADER_LEN - 4]);
+    hasher.update(&bytes[FIRST_FRAME_HEADER_LEN..]);
+    set_word(&mut bytes, FIRST_FRAME_HEADER_LEN - 4, hasher.finalize());
     let (result, peak) = peak_of(|| first_frame::decode(&bytes).map(|_| ()));
     let msg = result
         .expect_err("zero bytes are not 28M positions")

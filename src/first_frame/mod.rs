@@ -2,14 +2,18 @@
 //!
 //! Layout of [`EncodedFirstFrame::bytes`] (little endian):
 //! `version u8, bits u8, flags u8, 0u8, vertices u32, traversed triangles u32,
-//! degenerate triangles u32, bbox lo 3×f32, bbox hi 3×f32, connectivity length u32,
-//! geometry length u32, order length u32, crc32 u32` then the three range-coded streams:
-//! - connectivity: the [`traversal`] symbols, then the degenerate triangles (a repeated index),
-//!   which no traversal can reach, as plain adaptive-coded indices;
-//! - geometry: the quantised positions in traversal order (vertices in no triangle appended in
-//!   input order), coded after the connectivity by [`geometry`]: multi-parallelogram prediction,
-//!   else the mean of coded neighbours, else the previous vertex;
-//! - order: the traversal → input vertex permutation, absent with `reorder`.
+//! degenerate triangles u32, welded vertices u32, bbox lo 3×f32, bbox hi 3×f32,
+//! connectivity length u32, geometry length u32, order length u32, crc32 u32` then the three
+//! range-coded streams, all over the *welded* mesh, whose vertices are the distinct positions (see
+//! [`weld`]: seam copies and triangle soups become one connected surface):
+//! - connectivity: the [`traversal`] symbols of the triangles whose corners are three welded
+//!   vertices, then the copies of each welded vertex and which one each corner uses, then the
+//!   degenerate triangles (a repeated welded vertex), which no traversal can reach, as plain
+//!   adaptive-coded indices;
+//! - geometry: the quantised welded positions in traversal order (those in no triangle appended
+//!   in input order), coded after the connectivity by [`geometry`]: multi-parallelogram
+//!   prediction, else the mean of coded neighbours, else the previous vertex;
+//! - order: the output → input vertex permutation, absent with `reorder`.
 //!
 //! Triangles come back in traversal order (face order is not kept: coding it would cost
 //! log2(F!) bits) with the input's vertex indices and orientation, possibly rotated.
@@ -18,6 +22,7 @@ mod geometry;
 mod order;
 mod quantise;
 mod traversal;
+mod weld;
 
 pub use quantise::{Cell, Grid};
 
@@ -26,9 +31,10 @@ use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::{Point, Triangle};
 use crate::stream::entropy::{max_symbols, Decoder, Encoder, SymbolCoder, UIntModel};
 use traversal::{Models, Oracle, UNASSIGNED};
+use weld::Weld;
 
-const VERSION: u8 = 1;
-const HEADER_LEN: usize = 56;
+const VERSION: u8 = 2;
+const HEADER_LEN: usize = 60;
 const FLAG_ORDER: u8 = 1;
 /// Refuses headers past this many vertices or triangles whatever the input length.
 const MAX_ELEMENTS: u64 = 1 << 28;
@@ -109,26 +115,47 @@ pub fn encode(
     check_encode_input(triangles, vertex_count)?;
     let grid = Grid::fit(positions, opts.bits)?;
     let cells: Vec<Cell> = positions.iter().map(|&p| grid.quantise(p)).collect();
-    let (traversable, mut degenerate): (Vec<Triangle>, Vec<Triangle>) = triangles
+    // Welded by exact position, not by cell: distinct vertices that only share a cell at low bits
+    // would weld into degenerate and non-manifold triangles (horse-gallop at 10 bits: 129 of
+    // 8 431, connectivity 2.2 -> 3.5 bits a vertex). Equal positions have equal cells.
+    let keys: Vec<[u32; 3]> = positions
         .iter()
-        .partition(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+        .map(|p| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() }))
+        .collect();
+    let weld = Weld::new(&keys);
+    let welded_count = weld.first.len();
+    let (mut traversable, mut sources, mut degenerate) = (Vec::new(), Vec::new(), Vec::new());
+    for tri in triangles {
+        let w = tri.map(|v| weld.welded_of[v as usize]);
+        if w[0] != w[1] && w[1] != w[2] && w[0] != w[2] {
+            traversable.push(w);
+            sources.push(*tri);
+        } else {
+            degenerate.push(*tri);
+        }
+    }
 
     let mut connectivity = Encoder::new();
     let mut geometry = Encoder::new();
-    let (state, oracle) = encode_traversal(&mut connectivity, &traversable, vertex_count)?;
+    let (state, oracle) = encode_traversal(&mut connectivity, &traversable, welded_count)?;
     let traversal_cells: Vec<Cell> = oracle
         .from_traversal
         .iter()
-        .map(|&v| cells[v as usize])
+        .map(|&w| cells[weld.first[w as usize] as usize])
         .collect();
     let decoded_cells = geometry::code_positions(
         &mut geometry,
         &grid,
         &state.triangles,
-        vertex_count,
+        welded_count,
         &traversal_cells,
     )?;
-    to_traversal_indices(&mut degenerate, &oracle.to_traversal);
+    let numbering = encode_copies(&mut connectivity, &state, &oracle, &weld, &sources)?;
+    let mut to_output = vec![0u32; vertex_count];
+    for (o, &input) in numbering.inputs.iter().enumerate() {
+        to_output[input as usize] = o as u32;
+    }
+    to_traversal_indices(&mut degenerate, &to_output);
     let mut model = UIntModel::default();
     code_degenerate(&mut connectivity, &mut model, &mut degenerate, vertex_count)?;
 
@@ -136,16 +163,22 @@ pub fn encode(
         Vec::new()
     } else {
         encode_order(
-            &state.triangles,
+            &numbering.triangles,
             &degenerate,
-            &oracle.from_traversal,
+            &numbering.inputs,
+            &numbering.welded,
             vertex_count,
         )?
     };
+    let output_cells: Vec<Cell> = numbering
+        .welded
+        .iter()
+        .map(|&w| decoded_cells[w as usize])
+        .collect();
     let (decoded_positions, permutation) = place_decoded_positions(
         &grid,
-        &decoded_cells,
-        &oracle.from_traversal,
+        &output_cells,
+        &numbering.inputs,
         vertex_count,
         opts.reorder,
     );
@@ -158,6 +191,7 @@ pub fn encode(
         vertex_count: vertex_count as u32,
         traversed: traversable.len() as u32,
         degenerate: degenerate.len() as u32,
+        welded: welded_count as u32,
         grid,
         lengths: [
             connectivity.len() as u32,
@@ -176,6 +210,48 @@ pub fn encode(
             order: order_stream.len(),
         },
     })
+}
+
+/// Codes which input vertex (copy of a welded vertex) each corner of the coded triangles uses.
+fn encode_copies(
+    connectivity: &mut Encoder,
+    state: &traversal::Traversal,
+    oracle: &Oracle,
+    weld: &Weld,
+    sources: &[Triangle],
+) -> Result<weld::Numbering> {
+    let welded_count = weld.first.len();
+    let mut copies_of = vec![Vec::new(); welded_count];
+    for (v, &w) in weld.welded_of.iter().enumerate() {
+        copies_of[oracle.to_traversal[w as usize] as usize].push(v as u32);
+    }
+    // The input triangle behind each coded one, its corners in the coded triangle's rotation.
+    let corners: Vec<Triangle> = oracle
+        .coded_order
+        .iter()
+        .zip(&state.triangles)
+        .map(|(&i, coded)| {
+            let source = sources[i as usize];
+            coded.map(|tw| {
+                let w = oracle.from_traversal[tw as usize];
+                source
+                    .into_iter()
+                    .find(|&v| weld.welded_of[v as usize] == w)
+                    .unwrap_or(source[0])
+            })
+        })
+        .collect();
+    let actual = weld::Actual {
+        copies_of: &copies_of,
+        corners: &corners,
+    };
+    weld::code_copies(
+        connectivity,
+        &state.triangles,
+        welded_count,
+        weld.welded_of.len(),
+        Some(actual),
+    )
 }
 
 /// Refuses inputs too large for the header and triangles indexing past the vertices.
@@ -236,12 +312,18 @@ fn encode_order(
     traversed: &[Triangle],
     degenerate: &[Triangle],
     from_traversal: &[u32],
+    welded: &[u32],
     vertex_count: usize,
 ) -> Result<Vec<u8>> {
     let mut order_coder = Encoder::new();
     let all: Vec<Triangle> = traversed.iter().chain(degenerate).copied().collect();
     let adjacency = VertexAdjacency::new(vertex_count, &all);
-    order::code_order(&mut order_coder, &mut from_traversal.to_vec(), &adjacency)?;
+    order::code_order(
+        &mut order_coder,
+        &mut from_traversal.to_vec(),
+        &adjacency,
+        welded,
+    )?;
     order_coder.finish()
 }
 
@@ -288,6 +370,7 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
         return Err(truncated());
     }
     let vertex_count = header.vertex_count as usize;
+    let welded_count = header.welded as usize;
     let mut connectivity = Decoder::new(connectivity)?;
     let mut geometry = Decoder::new(geometry)?;
     let mut models = Models::default();
@@ -296,20 +379,36 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
         &mut connectivity,
         None,
         header.traversed as usize,
-        vertex_count,
+        welded_count,
         &mut models,
     )?;
     let cells =
-        geometry::code_positions(&mut geometry, &grid, &state.triangles, vertex_count, &[])?;
+        geometry::code_positions(&mut geometry, &grid, &state.triangles, welded_count, &[])?;
+    let numbering = weld::code_copies(
+        &mut connectivity,
+        &state.triangles,
+        welded_count,
+        vertex_count,
+        None,
+    )?;
     let degenerate =
         decode_degenerate(&mut connectivity, header.degenerate as usize, vertex_count)?;
-    let mut triangles = state.triangles;
+    let mut triangles = numbering.triangles;
     triangles.extend(degenerate);
-    let mut positions: Vec<Point> = cells.iter().map(|&c| grid.dequantise(c)).collect();
+    let welded = numbering.welded;
+    let mut positions: Vec<Point> = welded
+        .iter()
+        .map(|&w| grid.dequantise(cells[w as usize]))
+        .collect();
     if header.has_order {
         let mut order_indices = vec![0u32; vertex_count];
         let adjacency = VertexAdjacency::new(vertex_count, &triangles);
-        order::code_order(&mut Decoder::new(order)?, &mut order_indices, &adjacency)?;
+        order::code_order(
+            &mut Decoder::new(order)?,
+            &mut order_indices,
+            &adjacency,
+            &welded,
+        )?;
         let mut reordered = vec![[0.0; 3]; vertex_count];
         for (t, &input) in order_indices.iter().enumerate() {
             reordered[input as usize] = positions[t];
@@ -353,6 +452,8 @@ struct Header {
     vertex_count: u32,
     traversed: u32,
     degenerate: u32,
+    /// Vertices after welding equal cells (see [`weld`]).
+    welded: u32,
     grid: Grid,
     lengths: [u32; 3],
 }
@@ -366,7 +467,7 @@ impl Header {
             if self.has_order { FLAG_ORDER } else { 0 },
             0,
         ];
-        for v in [self.vertex_count, self.traversed, self.degenerate] {
+        for v in [self.vertex_count, self.traversed, self.degenerate, self.welded] {
             out.extend_from_slice(&v.to_le_bytes());
         }
         for c in self.grid.lo.iter().chain(&self.grid.hi) {
@@ -399,8 +500,8 @@ impl Header {
         if !(1..=Grid::MAX_BITS).contains(&bits) {
             return Err(Error::Stream(format!("first frame: {bits} position bits")));
         }
-        let lo = [float(16), float(20), float(24)];
-        let hi = [float(28), float(32), float(36)];
+        let lo = [float(20), float(24), float(28)];
+        let hi = [float(32), float(36), float(40)];
         if lo.iter().chain(&hi).any(|c| !c.is_finite()) {
             return Err(Error::Stream("first frame: non-finite bounding box".into()));
         }
@@ -410,16 +511,17 @@ impl Header {
             vertex_count: word(4),
             traversed: word(8),
             degenerate: word(12),
+            welded: word(16),
             grid: Grid { bits, lo, hi },
-            lengths: [word(40), word(44), word(48)],
+            lengths: [word(44), word(48), word(52)],
         };
         // What each stream must hold, in adaptive-coded symbols (each at least 1/710 bit, see
-        // `max_symbols`): every vertex is three coded residuals in the geometry stream and, when the
-        // order is stored, a choice among 8 guesses (3 binary decisions) and a difference in the
-        // order stream; every triangle is at least three decisions in the connectivity stream (a
-        // seed: three new/old bits; a gate: more, flipped and the 5-way kind of its third vertex; a
-        // degenerate one: three indices). Checked per stream, before the decoders allocate anything
-        // per vertex or triangle.
+        // `max_symbols`): every welded vertex is three coded residuals in the geometry stream;
+        // every vertex is one "another copy?" decision and every triangle at least three in the
+        // connectivity stream (a seed: three new/old bits; a gate: more, flipped and the 5-way kind
+        // of its third vertex; a degenerate one: three indices); when the order is stored, every
+        // vertex is a choice among 8 guesses (3 binary decisions) and a difference in the order
+        // stream. Checked per stream, before the decoders allocate anything per vertex or triangle.
         let [lc, lg, lo] = header.lengths;
         let vertices = u64::from(header.vertex_count);
         let triangles = u64::from(header.traversed) + u64::from(header.degenerate);
@@ -429,15 +531,26 @@ impl Header {
                  {MAX_ELEMENTS}"
             )));
         }
+        let welded = u64::from(header.welded);
+        if welded > vertices {
+            return Err(Error::Stream(format!(
+                "first frame: {welded} welded vertices of {vertices}"
+            )));
+        }
         let ordered = if header.has_order { vertices } else { 0 };
-        for (what, n, per, stream, len) in [
-            ("vertices", vertices, 3, "geometry", lg),
-            ("triangles", triangles, 3, "connectivity", lc),
-            ("vertices", ordered, 4, "order", lo),
+        for (what, symbols, stream, len) in [
+            (format!("{welded} welded vertices"), 3 * welded, "geometry", lg),
+            (
+                format!("{vertices} vertices and {triangles} triangles"),
+                vertices + 3 * triangles,
+                "connectivity",
+                lc,
+            ),
+            (format!("{ordered} vertices"), 4 * ordered, "order", lo),
         ] {
-            if n * per > max_symbols(len as usize) {
+            if symbols > max_symbols(len as usize) {
                 return Err(Error::Stream(format!(
-                    "first frame: {n} {what} cannot fit in a {stream} stream of {len} bytes"
+                    "first frame: {what} cannot fit in a {stream} stream of {len} bytes"
                 )));
             }
         }

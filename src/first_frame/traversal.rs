@@ -93,6 +93,8 @@ pub(super) struct Oracle<'a> {
     pub(super) to_traversal: Vec<u32>,
     /// Traversal index → input index.
     pub(super) from_traversal: Vec<u32>,
+    /// Indices of the input triangles in coding order.
+    pub(super) coded_order: Vec<u32>,
 }
 
 impl<'a> Oracle<'a> {
@@ -105,6 +107,7 @@ impl<'a> Oracle<'a> {
             next_seed: 0,
             to_traversal: vec![UNASSIGNED; vertex_count],
             from_traversal: Vec::new(),
+            coded_order: Vec::new(),
         }
     }
 
@@ -303,6 +306,7 @@ pub(super) fn run<C: SymbolCoder>(
                 if let Some(c) = o.coded.get_mut(index) {
                     *c = true;
                 }
+                o.coded_order.push(index as u32);
             }
             let tri = if flipped { [a, b, x] } else { [b, a, x] };
             t.add_triangle(tri, Some(edge));
@@ -446,6 +450,7 @@ fn seed<C: SymbolCoder>(
             if let Some(c) = o.coded.get_mut(s) {
                 *c = true;
             }
+            o.coded_order.push(s as u32);
             o.triangles.get(s).copied()
         }
         None => None,

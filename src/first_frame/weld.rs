@@ -1,0 +1,267 @@
+//! Vertices at the same position, coded once.
+//!
+//! glTF meshes duplicate a vertex wherever a UV or normal seam passes, and some are triangle
+//! soups (every triangle with its own three vertices): coded as they are, each copy is a new
+//! vertex of a new component, predicted from nothing. So the traversal and the geometry run on
+//! the *welded* mesh (one vertex per distinct position), and this module codes how the input's
+//! vertices sit on it: the number of copies of each welded vertex (a unary count, one decision
+//! per copy), then, for each corner of each triangle in coding order, which copy it uses. A
+//! corner most often uses the copy its neighbour across an edge uses (the seam is elsewhere),
+//! else a copy not used yet (a soup), else one named among those used. Copies no triangle uses
+//! come last. Output vertices are numbered in order of first use, which is what the vertex
+//! order stream and `reorder` see.
+
+use std::collections::HashMap;
+
+use super::traversal::{undirected, UNASSIGNED};
+use crate::error::{Error, Result};
+use crate::mesh::topology::VertexAdjacency;
+use crate::mesh::Triangle;
+use crate::stream::entropy::{BitModel, SymbolCoder, UIntModel};
+
+/// The welded vertices of quantised positions.
+pub(super) struct Weld {
+    /// Input vertex → welded vertex.
+    pub(super) welded_of: Vec<u32>,
+    /// Welded vertex → its first input vertex (welded vertices follow first appearance).
+    pub(super) first: Vec<u32>,
+}
+
+impl Weld {
+    /// Welds vertices with equal keys (equal positions: they decode to the same position).
+    pub(super) fn new<K: Copy + Eq + std::hash::Hash>(cells: &[K]) -> Self {
+        let mut by_cell: HashMap<K, u32> = HashMap::with_capacity(cells.len());
+        let mut first = Vec::new();
+        let welded_of = cells
+            .iter()
+            .enumerate()
+            .map(|(v, &c)| {
+                *by_cell.entry(c).or_insert_with(|| {
+                    first.push(v as u32);
+                    (first.len() - 1) as u32
+                })
+            })
+            .collect();
+        Self { welded_of, first }
+    }
+}
+
+/// What only the encoder knows.
+#[derive(Clone, Copy)]
+pub(super) struct Actual<'a> {
+    /// Input vertices of each welded vertex (traversal numbering), in input order.
+    pub(super) copies_of: &'a [Vec<u32>],
+    /// The input vertex at each corner of each coded triangle.
+    pub(super) corners: &'a [Triangle],
+}
+
+/// The output vertices.
+pub(super) struct Numbering {
+    /// The coded triangles in output vertex indices.
+    pub(super) triangles: Vec<Triangle>,
+    /// Output vertex → welded vertex (traversal numbering).
+    pub(super) welded: Vec<u32>,
+    /// Output vertex → input vertex (encoder only).
+    pub(super) inputs: Vec<u32>,
+}
+
+#[derive(Default)]
+struct Models {
+    /// "another copy?", by how many coded neighbours have copies (0, 1, 2+) and how many copies
+    /// there are already (1, 2, 3, 4+): seams are lines, copies come in runs along them.
+    more: [[BitModel; 4]; 3],
+    same_as_neighbour: BitModel,
+    /// "a copy not used yet?", by whether a neighbour's copy was offered first.
+    fresh: [BitModel; 2],
+    which: UIntModel,
+}
+
+fn corrupt(what: &str) -> Error {
+    Error::Stream(format!("first frame copies: {what}"))
+}
+
+/// Codes the copies of `welded_count` welded vertices, `vertex_count` in all, and which copy
+/// each corner of `triangles` (welded traversal indices) uses.
+pub(super) fn code_copies<C: SymbolCoder>(
+    coder: &mut C,
+    triangles: &[Triangle],
+    welded_count: usize,
+    vertex_count: usize,
+    actual: Option<Actual>,
+) -> Result<Numbering> {
+    let mut models = Models::default();
+    let adjacency = VertexAdjacency::new(welded_count, triangles);
+    let counts = code_counts(
+        coder,
+        &mut models,
+        &adjacency,
+        welded_count,
+        vertex_count,
+        actual,
+    )?;
+    let mut state = State {
+        used: vec![Vec::new(); welded_count],
+        out: Numbering {
+            triangles: Vec::with_capacity(triangles.len()),
+            welded: Vec::new(),
+            inputs: Vec::new(),
+        },
+        output_of: actual.map_or_else(Vec::new, |_| vec![UNASSIGNED; vertex_count]),
+    };
+    let mut first_on_edge: HashMap<u64, u32> = HashMap::new();
+    for (t, tri) in triangles.iter().enumerate() {
+        let mut corners = [0u32; 3];
+        for k in 0..3 {
+            let w = tri[k] as usize;
+            let count = *counts.get(w).ok_or_else(|| corrupt("vertex out of range"))?;
+            let input = actual.and_then(|a| a.corners.get(t)).map(|c| c[k]);
+            corners[k] = if count == 1 {
+                match state.used[w].first() {
+                    Some(&o) => o,
+                    None => state.fresh(w, input),
+                }
+            } else {
+                let pred = neighbour_copy(tri, k, &first_on_edge, triangles, &state.out);
+                choose(coder, &mut models, &mut state, w, count, pred, input)?
+            };
+        }
+        state.out.triangles.push(corners);
+        for k in 0..3 {
+            first_on_edge
+                .entry(undirected(tri[k], tri[(k + 1) % 3]))
+                .or_insert(t as u32);
+        }
+    }
+    // Copies no triangle uses, welded vertex by welded vertex.
+    for (w, &count) in counts.iter().enumerate() {
+        let mut spare = actual.map(|a| a.copies_of[w].iter());
+        while state.used[w].len() < count {
+            let input = spare.as_mut().and_then(|s| {
+                s.find(|&&v| state.output_of.get(v as usize) == Some(&UNASSIGNED))
+                    .copied()
+            });
+            state.fresh(w, input);
+        }
+    }
+    Ok(state.out)
+}
+
+/// The number of copies of each welded vertex, checked to add up to `vertex_count`.
+fn code_counts<C: SymbolCoder>(
+    coder: &mut C,
+    models: &mut Models,
+    adjacency: &VertexAdjacency,
+    welded_count: usize,
+    vertex_count: usize,
+    actual: Option<Actual>,
+) -> Result<Vec<usize>> {
+    let mut counts = Vec::with_capacity(welded_count);
+    let mut total = 0usize;
+    for w in 0..welded_count {
+        let want = actual.map_or(1, |a| a.copies_of[w].len());
+        let seamed = adjacency
+            .neighbours(w)
+            .iter()
+            .filter(|&&n| counts.get(n as usize).is_some_and(|&c| c > 1))
+            .count()
+            .min(2);
+        let mut count = 1;
+        while coder.bit(count < want, &mut models.more[seamed][(count - 1).min(3)])? {
+            count += 1;
+            if total + count > vertex_count {
+                return Err(corrupt("more copies than vertices"));
+            }
+        }
+        total += count;
+        counts.push(count);
+    }
+    if total != vertex_count {
+        return Err(corrupt("copies do not add up to the vertices"));
+    }
+    Ok(counts)
+}
+
+struct State {
+    /// Output vertices of each welded vertex so far.
+    used: Vec<Vec<u32>>,
+    out: Numbering,
+    /// Input → output vertex (encoder only).
+    output_of: Vec<u32>,
+}
+
+impl State {
+    /// A new output vertex for welded vertex `w` (input vertex `input` on the encoder).
+    fn fresh(&mut self, w: usize, input: Option<u32>) -> u32 {
+        let o = self.out.welded.len() as u32;
+        self.out.welded.push(w as u32);
+        self.used[w].push(o);
+        if let Some(slot) = input.and_then(|v| self.output_of.get_mut(v as usize)) {
+            *slot = o;
+            self.out.inputs.push(input.unwrap_or(0));
+        }
+        o
+    }
+}
+
+/// The copy that corner `k` of `tri` uses in the first coded triangle sharing one of its edges
+/// (the entry edge, corners 0 and 1, first).
+fn neighbour_copy(
+    tri: &Triangle,
+    k: usize,
+    first_on_edge: &HashMap<u64, u32>,
+    triangles: &[Triangle],
+    out: &Numbering,
+) -> Option<u32> {
+    (0..3).filter(|&j| j != k).find_map(|j| {
+        let t = *first_on_edge.get(&undirected(tri[k], tri[j]))? as usize;
+        let pos = triangles.get(t)?.iter().position(|&x| x == tri[k])?;
+        out.triangles.get(t).map(|c| c[pos])
+    })
+}
+
+/// Codes which of `count` copies of welded vertex `w` a corner uses.
+fn choose<C: SymbolCoder>(
+    coder: &mut C,
+    models: &mut Models,
+    state: &mut State,
+    w: usize,
+    count: usize,
+    pred: Option<u32>,
+    input: Option<u32>,
+) -> Result<u32> {
+    let known = input
+        .and_then(|v| state.output_of.get(v as usize).copied())
+        .filter(|&o| o != UNASSIGNED);
+    if let Some(p) = pred {
+        if coder.bit(known == Some(p), &mut models.same_as_neighbour)? {
+            return Ok(p);
+        }
+    }
+    let others: Vec<u32> = state.used[w]
+        .iter()
+        .copied()
+        .filter(|&o| Some(o) != pred)
+        .collect();
+    let can_be_fresh = state.used[w].len() < count;
+    let fresh = match (can_be_fresh, others.is_empty()) {
+        (true, false) => coder.bit(known.is_none(), &mut models.fresh[usize::from(pred.is_some())])?,
+        (true, true) => true,
+        (false, false) => false,
+        (false, true) => return Err(corrupt("no copy left")),
+    };
+    if fresh {
+        return Ok(state.fresh(w, input));
+    }
+    let index = known
+        .and_then(|o| others.iter().position(|&x| x == o))
+        .unwrap_or(0);
+    let index = if others.len() > 1 {
+        coder.unsigned(index as u64, &mut models.which)?
+    } else {
+        0
+    };
+    usize::try_from(index)
+        .ok()
+        .and_then(|i| others.get(i).copied())
+        .ok_or_else(|| corrupt("no such copy"))
+}
