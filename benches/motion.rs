@@ -230,7 +230,7 @@ fn measure(name: &str, mesh: &AnimatedMesh, method: Method) {
         skin_largest = skin_largest.max(longest(&e));
     }
     let skin_time = start.elapsed().as_secs_f64();
-    let weight_bits = encode_weights(&weights, &partition, mesh.triangles())
+    let weight_bits = encode_weights(&weights, &partition, (mesh.triangles(), reference))
         .map_or(f64::NAN, |b| 8.0 * b.len() as f64);
     let mean = |e: &[f64]| e.iter().sum::<f64>() / e.len().max(1) as f64;
     let max = |e: &[f64]| e.iter().copied().fold(0f64, f64::max);

@@ -125,13 +125,16 @@ fn main() {
                 analysis::predict_on(&mesh, reference, &partition, 16, model.predictor, track)
                     .unwrap();
             let t_pred = t0.elapsed().as_secs_f64();
-            let mut side =
-                side_info::encode_partition(partition.labels(), partition.clusters(), tris)
-                    .unwrap()
-                    .len()
-                    + side_info::encode_affine(&pred.track).unwrap().len();
+            let mut side = side_info::encode_partition(
+                partition.labels(),
+                partition.clusters(),
+                (tris, reference),
+            )
+            .unwrap()
+            .len()
+                + side_info::encode_affine(&pred.track).unwrap().len();
             if let Some(w) = &pred.weights {
-                side += side_info::encode_weights(w, &partition, tris)
+                side += side_info::encode_weights(w, &partition, (tris, reference))
                     .unwrap()
                     .len();
             }

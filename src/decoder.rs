@@ -155,7 +155,7 @@ impl<R: Read + Seek> Decoder<R> {
             &reader.part(Tag::PARTITION)?,
             v,
             header.clusters as usize,
-            &triangles,
+            (&triangles, &reference),
         )?;
         let partition = Partition::from_labels(labels, header.clusters as usize)?;
         if options.max_bands.is_some() && !codec.has_bands() {
@@ -173,7 +173,7 @@ impl<R: Read + Seek> Decoder<R> {
                 ),
             ));
         }
-        let weights = read_weights(&mut reader, &header, &partition, &triangles)?;
+        let weights = read_weights(&mut reader, &header, &partition, (&triangles, &reference))?;
         let segments = segments::read_ranges(&mut reader, f)?;
         let shared = Shared {
             header: &header,
@@ -647,7 +647,7 @@ fn read_weights<R: Read + Seek>(
     reader: &mut ContainerReader<R>,
     header: &Header,
     partition: &Partition,
-    triangles: &[Triangle],
+    first_frame: (&[Triangle], &[Point]),
 ) -> Result<Option<SkinningWeights>> {
     match header.predictor {
         PredictorKind::Affine if reader.has(Tag::WEIGHTS) => Err(Error::Stream(
@@ -657,7 +657,7 @@ fn read_weights<R: Read + Seek>(
         PredictorKind::Skinning => Ok(Some(side_info::decode_weights(
             &reader.part(Tag::WEIGHTS)?,
             partition,
-            triangles,
+            first_frame,
         )?)),
     }
 }

@@ -477,7 +477,7 @@ impl Sample {
         let sample_stream = assemble(
             &header_of(&self.mesh),
             leading.to_vec(),
-            &self.mesh,
+            (&self.mesh, reference),
             partition,
             &sampled,
             parts.clone(),
@@ -487,7 +487,7 @@ impl Sample {
         let whole = assemble(
             &header_of(mesh),
             leading.to_vec(),
-            mesh,
+            (mesh, reference),
             partition,
             prediction,
             parts,

@@ -43,7 +43,7 @@ use crate::codec::{Codec, RatePlan, ResidualInput};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::AtlasCache;
-use crate::mesh::AnimatedMesh;
+use crate::mesh::{AnimatedMesh, Point};
 use crate::motion::Partition;
 use crate::progress::{Progress, Silent};
 use crate::stream::container::{ContainerWriter, Part, Tag};
@@ -314,7 +314,7 @@ fn estimate(
     let side = assemble(
         &header,
         leading.to_vec(),
-        mesh,
+        (mesh, &ff.decoded_positions),
         partition,
         prediction,
         (vec![], vec![]),
@@ -365,7 +365,8 @@ fn code(
     let model = analysed.model;
     let header = header(mesh, settings, model, partition);
     let parts = coded.into_parts();
-    let container = assemble(&header, leading, mesh, partition, prediction, parts)?;
+    let first_frame = (mesh, &ff.decoded_positions[..]);
+    let container = assemble(&header, leading, first_frame, partition, prediction, parts)?;
     clock.lap("side information");
     let report = EncodeReport {
         parts: container.part_sizes(),
@@ -450,17 +451,17 @@ fn header(
 fn assemble(
     header: &Header,
     leading: Vec<Part>,
-    mesh: &AnimatedMesh,
+    (mesh, reference): (&AnimatedMesh, &[Point]),
     partition: &Partition,
     prediction: &Prediction,
     (before, after): (Vec<Part>, Vec<Part>),
 ) -> Result<ContainerWriter> {
-    let triangles = mesh.triangles();
+    let first_frame = (mesh.triangles(), reference);
     let mut parts = vec![Part::whole(Tag::HEADER, header.to_bytes())];
     parts.extend(leading);
     parts.push(Part::whole(
         Tag::PARTITION,
-        side_info::encode_partition(partition.labels(), partition.clusters(), triangles)?,
+        side_info::encode_partition(partition.labels(), partition.clusters(), first_frame)?,
     ));
     parts.extend(before);
     parts.push(Part::whole(
@@ -468,7 +469,7 @@ fn assemble(
         side_info::encode_affine(&prediction.track)?,
     ));
     if let Some(weights) = &prediction.weights {
-        let bytes = side_info::encode_weights(weights, partition, triangles)?;
+        let bytes = side_info::encode_weights(weights, partition, first_frame)?;
         parts.push(Part::whole(Tag::WEIGHTS, bytes));
     }
     parts.extend(after);

@@ -2,8 +2,21 @@
 //!
 //! Non-manifold and multi-component meshes are normal input: everything here works on any triangle soup.
 
-use super::Triangle;
+use super::{Point, Triangle};
 use std::collections::HashMap;
+
+/// For each vertex, the first vertex at exactly its position, when that is an earlier one: the
+/// copies a mesh made for rendering splits at seams and hard edges. Coders that know the decoded
+/// first frame predict a copy's data from its first (`codec/tdct/copies.rs`, `stream/side_info.rs`).
+pub fn coincident_first(positions: &[Point]) -> Vec<Option<u32>> {
+    let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
+    (positions.iter().enumerate())
+        .map(|(v, p)| {
+            let f = *first.entry(p.map(f32::to_bits)).or_insert(v as u32);
+            (f as usize != v).then_some(f)
+        })
+        .collect()
+}
 
 /// Vertex adjacency in compressed-sparse-row form: the neighbours of `v` are `neighbours(v)`, sorted, no repeats.
 #[derive(Debug, Clone)]

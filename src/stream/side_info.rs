@@ -8,8 +8,8 @@
 //! toward.
 
 use crate::error::{Error, Result};
-use crate::mesh::topology::VertexAdjacency;
-use crate::mesh::Triangle;
+use crate::mesh::topology::{coincident_first, VertexAdjacency};
+use crate::mesh::{Point, Triangle};
 use crate::motion::{cluster_neighbours, Partition, SkinningWeights};
 
 pub(crate) use super::affine_coding::decode_checked_affine;
@@ -52,20 +52,25 @@ fn predicted_label(
         .map(|&(l, _)| l)
 }
 
+/// Labels are guessed, in this order of trust, from the vertex's first copy at its first-frame
+/// position (a seam or hard-edge copy moves with it), its already-coded neighbours' commonest
+/// label, or the previous vertex's; one hit bit per vertex, a context per kind of guess.
 fn code_partition<C: SymbolCoder>(
     c: &mut C,
     labels: &mut [u32],
     clusters: usize,
-    adj: &VertexAdjacency,
+    (adj, coincident): (&VertexAdjacency, &[Option<u32>]),
 ) -> Result<()> {
-    let mut hit = [BitModel::default(), BitModel::default()];
+    let mut hit: [BitModel; 3] = Default::default();
     let mut small = SymbolModel::new(clusters);
     let mut large = UIntModel::default();
     let mut counts = Vec::new();
     for v in 0..labels.len() {
-        let (ctx, guess) = match predicted_label(adj, labels, v, &mut counts) {
-            Some(l) => (0, l),
-            None => (1, if v > 0 { labels[v - 1] } else { 0 }),
+        let copy_of = coincident.get(v).copied().flatten();
+        let (ctx, guess) = match (copy_of, predicted_label(adj, labels, v, &mut counts)) {
+            (Some(f), _) => (2, labels[f as usize]),
+            (None, Some(l)) => (0, l),
+            (None, None) => (1, if v > 0 { labels[v - 1] } else { 0 }),
         };
         if c.bit(labels[v] == guess, &mut hit[ctx])? {
             labels[v] = guess;
@@ -86,30 +91,32 @@ fn code_partition<C: SymbolCoder>(
     Ok(())
 }
 
-/// Codes the cluster label of each vertex.
+/// Codes the cluster label of each vertex over the decoded first frame (`triangles`, `reference`).
 pub fn encode_partition(
     labels: &[u32],
     clusters: usize,
-    triangles: &[Triangle],
+    (triangles, reference): (&[Triangle], &[Point]),
 ) -> Result<Vec<u8>> {
     let adj = VertexAdjacency::new(labels.len(), triangles);
+    let coincident = coincident_first(reference);
     let mut enc = Encoder::new();
-    code_partition(&mut enc, &mut labels.to_vec(), clusters, &adj)?;
+    code_partition(&mut enc, &mut labels.to_vec(), clusters, (&adj, &coincident))?;
     enc.finish()
 }
 
-/// Decodes `vertices` cluster labels in `0..clusters`.
+/// Decodes `vertices` cluster labels in `0..clusters` over the decoded first frame.
 pub fn decode_partition(
     bytes: &[u8],
     vertices: usize,
     clusters: usize,
-    triangles: &[Triangle],
+    (triangles, reference): (&[Triangle], &[Point]),
 ) -> Result<Vec<u32>> {
     check_capacity(vertices as u64, bytes.len(), "partition")?;
     let adj = VertexAdjacency::new(vertices, triangles);
+    let coincident = coincident_first(reference);
     let mut dec = Decoder::new(bytes)?;
     let mut labels = vec![0u32; vertices];
-    code_partition(&mut dec, &mut labels, clusters, &adj)?;
+    code_partition(&mut dec, &mut labels, clusters, (&adj, &coincident))?;
     Ok(labels)
 }
 
@@ -178,17 +185,18 @@ pub fn decode_lattice(
     Ok(pixels)
 }
 
-/// Per vertex, the weight toward each neighbouring cluster as a difference from the rounded mean of
-/// the same weight at the vertex's already-coded mesh neighbours of the same cluster (0 if none).
-/// Contexts: whether such a guess exists, and whether the target cluster touches the vertex's 1-ring
-/// (seam vertices carry the large weights).
+/// Per vertex, the weight toward each neighbouring cluster as a difference from a guess: the same
+/// weight of the vertex's first copy at its first-frame position when that is in the same cluster,
+/// else the rounded mean of the same weight at the vertex's already-coded mesh neighbours of the
+/// same cluster (0 if none). Contexts: which guess, and whether the target cluster touches the
+/// vertex's 1-ring (seam vertices carry the large weights).
 fn code_weight_values<C: SymbolCoder>(
     c: &mut C,
     w: &mut SkinningWeights,
     labels: &[u32],
-    adj: &VertexAdjacency,
+    (adj, coincident): (&VertexAdjacency, &[Option<u32>]),
 ) -> Result<()> {
-    let mut models: [[IntModel; 2]; 2] = Default::default();
+    let mut models: [[IntModel; 2]; 3] = Default::default();
     let top = SkinningWeights::top(w.bits) as i64;
     let mut offsets = Vec::with_capacity(labels.len());
     let mut next = 0usize;
@@ -207,6 +215,8 @@ fn code_weight_values<C: SymbolCoder>(
             continue;
         };
         let ring = adj.neighbours(v);
+        let copy_of = coincident.get(v).copied().flatten().map(|f| f as usize);
+        let copy_of = copy_of.filter(|&f| labels[f] == k);
         for (idx, &j) in neighbours.iter().enumerate() {
             let (mut sum, mut n) = (0i64, 0i64);
             for &u in ring.iter().filter(|&&u| (u as usize) < v) {
@@ -215,13 +225,13 @@ fn code_weight_values<C: SymbolCoder>(
                     n += 1;
                 }
             }
-            let guess = if n > 0 {
-                (sum as f64 / n as f64).round() as i64
-            } else {
-                0
+            let (kind, guess) = match copy_of {
+                Some(f) => (2, w.values[offsets[f] + idx] as i64),
+                None if n > 0 => (1, (sum as f64 / n as f64).round() as i64),
+                None => (0, 0),
             };
             let touches = ring.iter().any(|&u| labels[u as usize] == j);
-            let model = &mut models[(n > 0) as usize][touches as usize];
+            let model = &mut models[kind][touches as usize];
             let slot = offsets[v] + idx;
             let value = guess + c.signed(w.values[slot] as i64 - guess, model)?;
             if value.abs() > top {
@@ -251,23 +261,25 @@ const WEIGHTS_END: u32 = 0x5EED_C0DE;
 pub fn encode_weights(
     weights: &SkinningWeights,
     partition: &Partition,
-    triangles: &[Triangle],
+    (triangles, reference): (&[Triangle], &[Point]),
 ) -> Result<Vec<u8>> {
     weights.check(partition)?;
     let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
+    let coincident = coincident_first(reference);
     let mut w = ByteWriter::new();
     w.u8(weights.bits).f32(weights.limit);
     let mut enc = Encoder::new();
-    code_weight_values(&mut enc, &mut weights.clone(), partition.labels(), &adj)?;
+    let mesh = (&adj, &coincident[..]);
+    code_weight_values(&mut enc, &mut weights.clone(), partition.labels(), mesh)?;
     w.raw(&enc.finish()?);
     Ok(w.into_bytes())
 }
 
-/// Decodes the skinning weights of `partition` on the mesh of `triangles`.
+/// Decodes the skinning weights of `partition` on the decoded first frame.
 pub fn decode_weights(
     bytes: &[u8],
     partition: &Partition,
-    triangles: &[Triangle],
+    (triangles, reference): (&[Triangle], &[Point]),
 ) -> Result<SkinningWeights> {
     let mut r = ByteReader::new(bytes, "skinning weights");
     let bits = r.u8()?;
@@ -286,8 +298,10 @@ pub fn decode_weights(
     // Bits and limit first: the coder's range check depends on them.
     weights.check(partition)?;
     let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
+    let coincident = coincident_first(reference);
     let mut dec = Decoder::new(rest)?;
-    code_weight_values(&mut dec, &mut weights, partition.labels(), &adj)?;
+    let mesh = (&adj, &coincident[..]);
+    code_weight_values(&mut dec, &mut weights, partition.labels(), mesh)?;
     weights.check(partition)?;
     Ok(weights)
 }

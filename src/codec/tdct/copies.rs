@@ -15,24 +15,15 @@
 //! the kept vertices only, over the connectivity with every copy merged into its first: the
 //! seams close, and the spatial prediction sees across them.
 
+use crate::mesh::topology::coincident_first;
 use crate::mesh::{Point, Triangle};
-use std::collections::HashMap;
 
 /// The vertices after the first at their reference position, each with that first vertex, in
 /// vertex order: what a copy bit is coded for.
 pub fn candidates(reference: &[Point]) -> Vec<(u32, u32)> {
-    let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(reference.len());
-    let mut out = Vec::new();
-    for (v, p) in reference.iter().enumerate() {
-        let key = p.map(f32::to_bits);
-        match first.get(&key) {
-            Some(&f) => out.push((v as u32, f)),
-            None => {
-                first.insert(key, v as u32);
-            }
-        }
-    }
-    out
+    (coincident_first(reference).into_iter().enumerate())
+        .filter_map(|(v, f)| Some((v as u32, f?)))
+        .collect()
 }
 
 /// The encoder's copy bit of each candidate: whether its trajectory in `frames` equals its first
