@@ -120,6 +120,8 @@ export class MCGVAnimation extends EventDispatcher {
     this.framesDecoded = 0;
     this.decodeMsPerFrame = 0;
     this.firstFrameBytes = 0; // bytes received when a frame could first be drawn (the first frame)
+    this.firstFrameChunkStart = 0; // … and where the chunk that brought them started
+    this.chunkStart = 0; // where the chunk being fed starts in the stream
     this.firstClipBytes = 0; // … when every frame could (a tdct stream's first band)
     this.previewed = false;
     this.previewDressed = false;
@@ -178,6 +180,7 @@ export class MCGVAnimation extends EventDispatcher {
     if (this.error) return;
     try {
       this.stream_.append(bytes);
+      this.chunkStart = this.bytesReceived;
       this.bytesReceived += bytes.length;
       this.dispatchEvent({ type: 'progress', event: { loaded: this.bytesReceived, total: this.bytesTotal, lengthComputable: this.bytesTotal > 0 } });
       this.advance(false);
@@ -281,6 +284,7 @@ export class MCGVAnimation extends EventDispatcher {
     this.geometry.boundingBox = new Box3(new Vector3(...min), new Vector3(...max));
     this.geometry.boundingSphere = this.geometry.boundingBox.getBoundingSphere(new Sphere());
     this.firstFrameBytes = this.bytesReceived;
+    this.firstFrameChunkStart = this.chunkStart;
     this.dispatchEvent({ type: 'frames', preview: true });
   }
 
@@ -343,7 +347,10 @@ export class MCGVAnimation extends EventDispatcher {
   }
 
   shown() {
-    if (!this.firstFrameBytes) this.firstFrameBytes = this.bytesReceived;
+    if (!this.firstFrameBytes) {
+      this.firstFrameBytes = this.bytesReceived;
+      this.firstFrameChunkStart = this.chunkStart;
+    }
     if (!this.firstClipBytes) this.firstClipBytes = this.bytesReceived;
     this.updateBounds();
     const x = this.current < 0 ? 0 : this.current;

@@ -57,7 +57,8 @@ const state = {
   error: null,
   bytesReceived: 0,
   bytesTotal: 0,
-  firstFrameBytes: 0,
+  firstFrameBytes: 0, // bytes received when the first frame was drawn
+  firstFrameChunkStart: 0, // where the chunk that brought them started
   firstClipBytes: 0,
   firstBands: null,
   steps: [],
@@ -94,6 +95,7 @@ function updatePanel() {
     bytesReceived: a.bytesReceived,
     bytesTotal: a.bytesTotal,
     firstFrameBytes: a.firstFrameBytes,
+    firstFrameChunkStart: a.firstFrameChunkStart,
     firstClipBytes: a.firstClipBytes,
     bandsDecoded: a.bandsDecoded,
     bandsTotal: a.info?.bands?.total ?? 0,
@@ -121,7 +123,7 @@ function open(source, name) {
   }
   $('error').style.display = 'none';
   $('hint').style.display = 'none';
-  Object.assign(state, { phase: 'loading', error: null, firstFrameBytes: 0, firstClipBytes: 0, firstBands: null, steps: [] });
+  Object.assign(state, { phase: 'loading', error: null, firstFrameBytes: 0, firstFrameChunkStart: 0, firstClipBytes: 0, firstBands: null, steps: [] });
   framed = false;
   const loader = new MCGVLoader();
   if (like) loader.setLike(like);

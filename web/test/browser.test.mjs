@@ -64,6 +64,18 @@ function pc2(file) {
   return new Float32Array(b.buffer.slice(b.byteOffset + 32, b.byteOffset + b.length));
 }
 
+/** Where a stream's first-frame part (MESH) ends: after the 16-byte file header, parts of a
+ *  17-byte header (tag, checksum kind, u64 length, CRC) and their payload (docs/design.md). */
+function firstFrameEnd(bytes) {
+  let at = 16;
+  while (at + 17 <= bytes.length) {
+    const tag = bytes.toString('latin1', at, at + 4);
+    at += 17 + Number(bytes.readBigUInt64LE(at + 5));
+    if (tag === 'MESH') return at;
+  }
+  throw new Error('the stream has no MESH part');
+}
+
 /** The diagonal of the bounding box of the first `3 × vertices` numbers. */
 function diagonal(xyz, vertices) {
   const lo = [Infinity, Infinity, Infinity];
@@ -212,7 +224,12 @@ test('streaming at 1 MB/s: the first frame early, the first bands as decode --ba
   console.log(`q100 (${total} bytes) at 1 MB/s: first frame at ${s.firstFrameBytes} bytes ` +
     `(${((100 * s.firstFrameBytes) / total).toFixed(1)} %), whole clip at ${s.firstClipBytes} ` +
     `(${((100 * s.firstClipBytes) / total).toFixed(1)} %) from ${s.firstBands.bands} of ${s.info.bands.total} bands`);
-  assert.ok(s.firstFrameBytes > 0 && s.firstFrameBytes < 0.25 * total, `first frame at ${s.firstFrameBytes}`);
+  // Drawn on the chunk that completed the first frame's parts: where that is depends on how the
+  // page's reads are cut (12, 30 and 60 KB of this stream in three runs, the latter on a loaded
+  // machine), so the check is against the chunk, not a share of the file.
+  const end = firstFrameEnd(fs.readFileSync(data('q100.mcgv')));
+  assert.ok(s.firstFrameChunkStart < end && end <= s.firstFrameBytes,
+    `first frame at ${s.firstFrameBytes} (chunk from ${s.firstFrameChunkStart}), its parts end at ${end}`);
   // When the whole clip is first drawn depends on how busy the page's thread is as the bytes come
   // (SwiftShader renders on the CPU): whatever the bands then, the frame is `decode --bands N`'s.
   const v3 = 3 * s.info.vertices;
