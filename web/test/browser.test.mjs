@@ -3,7 +3,7 @@
 //   - positions decoded in the browser equal the native decoder's (1e-6 of the diagonal, every
 //     frame) for tdct and JPEG streams of CesiumMan, whole and in temporal segments; AV1 through
 //     WebCodecs within the error docs/web.md reports; HEVC and MPEG-4 name the missing codec;
-//   - streaming at 1 MB/s: the first frame is drawn before 25 % of the file has arrived, and the
+//   - streaming at 1 MB/s: the first frame is drawn on the chunk that completed its parts, and the
 //     frames first drawn from N bands (and from 3, asked for) are `decode --bands N`'s;
 //   - the page's pictures at frames 0 and 20 match the glTF test render of `decode -o x.glb`
 //     (PSNR ≥ 35 dB, as cli/tests/cli/browser.rs measures; frame 0 against 20 must not);
@@ -137,8 +137,8 @@ before(async () => {
     'jpeg-segments': ['--codec', 'jpeg', '--segment-frames', '16'],
     av1: ['--codec', 'av1'],
     'av1-12': ['--codec', 'av1', '--bit-depth', '12'],
-    // A fine stream baked at 120 frames/s in one segment (231 KB): its first frame is 5 % of it,
-    // so that 25 % leaves the page some 46 ms at 1 MB/s (docs/web.md, "Streaming").
+    // A fine stream baked at 120 frames/s in one segment (189 KB): its first frame is 5 % of it,
+    // so the page streams it over many chunks at 1 MB/s (docs/web.md, "Streaming").
     q100: ['--quality', '100', '--fps', '120', '--segment-frames', '0'],
   };
   for (const [name, args] of Object.entries(streams)) {
