@@ -145,16 +145,11 @@ impl<'a> Kept<'a> {
         let candidates = copies::candidates(input.reference);
         let bits = copies::equal_trajectories(&candidates, input.mesh.frames());
         let copies = Copies::new(input.mesh.vertex_count(), &candidates, &bits);
-        let (residuals, neighbourhood) = match copies.any() {
-            true => (
-                copies.keep_residuals(input.residuals).into(),
-                kept_neighbourhood(&copies, input.mesh.triangles())?,
-            ),
-            false => (
-                input.residuals.into(),
-                Neighbourhood::new(input.mesh.vertex_count(), input.mesh.triangles())?,
-            ),
+        let residuals = match copies.any() {
+            true => copies.keep_residuals(input.residuals).into(),
+            false => input.residuals.into(),
         };
+        let neighbourhood = kept_neighbourhood(&copies, input.mesh.triangles())?;
         Ok(Self {
             residuals,
             neighbourhood,
