@@ -547,7 +547,7 @@ pub fn encode(
     progress: &dyn Progress,
 ) -> Result<Encoded> {
     let frames = mesh.frame_count();
-    let read = |list: &[usize]| Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect());
+    let read = |list: &[usize], _| Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect());
     encode_runs(mesh, frames, length, opts, progress, read)
 }
 
@@ -565,9 +565,20 @@ pub fn encode_source(
         _ => return super::encode_with_progress(&source.clip(0..frames)?, opts, progress),
     };
     let first = source.first().clone();
-    encode_runs(&first, frames, length, opts, progress, |list| {
-        source.read_list(list)
+    encode_runs(&first, frames, length, opts, progress, |list, again| {
+        match again {
+            ReadAgain::Yes => source.read_list_keeping(list),
+            ReadAgain::No => source.read_list(list),
+        }
     })
+}
+
+/// Whether frames being read will be read again (the analysis clip's, once more in their
+/// segments): a source that parses its frames keeps them.
+#[derive(Clone, Copy)]
+enum ReadAgain {
+    Yes,
+    No,
 }
 
 /// Encodes a clip of `frames` frames in segments of `length`, reading its frames by ranges with
@@ -579,9 +590,9 @@ fn encode_runs(
     length: usize,
     opts: &EncodeOptions,
     progress: &dyn Progress,
-    mut read: impl FnMut(&[usize]) -> Result<Vec<Vec<Point>>>,
+    mut read: impl FnMut(&[usize], ReadAgain) -> Result<Vec<Vec<Point>>>,
 ) -> Result<Encoded> {
-    let analysis = spread_clip(first, frames, length, &mut read)?;
+    let analysis = spread_clip(first, frames, length, |list| read(list, ReadAgain::Yes))?;
     progress.total(frames as u64);
     let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
     drop(analysis);
@@ -590,7 +601,7 @@ fn encode_runs(
     for batch in ranges.chunks(opts.parallel_segments.max(1)) {
         let runs = batch
             .iter()
-            .map(|r| Ok((r.start, read(&r.clone().collect::<Vec<_>>())?)))
+            .map(|r| Ok((r.start, read(&r.clone().collect::<Vec<_>>(), ReadAgain::No)?)))
             .collect::<Result<Vec<_>>>()?;
         let coded: Vec<Result<CodedSegment>> = runs
             .into_par_iter()

@@ -7,6 +7,7 @@ use super::{gltf, pc2, AnimatedMesh, Point, ReadOptions};
 use crate::error::{Error, Result};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
+use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -20,8 +21,14 @@ pub struct FrameSource {
 
 /// Where the frames come from.
 enum Origin {
-    /// One OBJ file per frame (the first one's connectivity checked in each).
-    Obj(Vec<PathBuf>),
+    /// One OBJ file per frame (the first one's connectivity checked in each), and frames read
+    /// once already that a later read will ask for again ([`FrameSource::read_list_keeping`]):
+    /// parsing an OBJ file costs far more than holding its positions (a tenth of a default
+    /// encode of a 7 000-vertex OBJ clip went to parsing its analysis frames a second time).
+    Obj {
+        files: Vec<PathBuf>,
+        kept: HashMap<usize, Vec<Point>>,
+    },
     /// A PC2 cache: `points` positions of 12 bytes per sample.
     Pc2 {
         file: File,
@@ -69,7 +76,10 @@ impl FrameSource {
         Ok(Self {
             frames: files.len(),
             first,
-            origin: Origin::Obj(files),
+            origin: Origin::Obj {
+                files,
+                kept: HashMap::new(),
+            },
         })
     }
 
@@ -126,6 +136,18 @@ impl FrameSource {
 
     /// The positions of the frames `list` names, in its order (OBJ files read on rayon's threads).
     pub fn read_list(&mut self, list: &[usize]) -> Result<Vec<Vec<Point>>> {
+        self.read_frames(list, false)
+    }
+
+    /// [`FrameSource::read_list`], keeping a copy of each frame read from an OBJ file for the
+    /// next read that asks for it (which takes it): for frames read twice, as a segmented
+    /// encode's analysis clip's are (once spread, once in their segment). PC2 samples and frames
+    /// in memory cost nothing to read again and are not kept.
+    pub fn read_list_keeping(&mut self, list: &[usize]) -> Result<Vec<Vec<Point>>> {
+        self.read_frames(list, true)
+    }
+
+    fn read_frames(&mut self, list: &[usize], keep: bool) -> Result<Vec<Vec<Point>>> {
         if let Some(f) = list.iter().find(|&&f| f >= self.frames) {
             return Err(Error::Usage(format!(
                 "frame {f}: the animation has {}",
@@ -134,15 +156,32 @@ impl FrameSource {
         }
         match &mut self.origin {
             Origin::Memory(mesh) => Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect()),
-            Origin::Obj(files) => {
+            Origin::Obj { files, kept } => {
                 let (vertices, triangles) = (self.first.vertex_count(), self.first.triangles());
                 let first_path = &files[0];
-                let chosen: Vec<PathBuf> = list.iter().map(|&f| files[f].clone()).collect();
-                read_frames(&chosen, |path| {
+                let mut missing: Vec<usize> =
+                    list.iter().copied().filter(|f| !kept.contains_key(f)).collect();
+                missing.sort_unstable();
+                missing.dedup();
+                let chosen: Vec<PathBuf> = missing.iter().map(|&f| files[f].clone()).collect();
+                let read = read_frames(&chosen, |path| {
                     let frame = read_obj(path)?;
                     check_same_mesh(triangles, vertices, first_path, &frame, path)?;
                     Ok(frame.positions)
-                })
+                })?;
+                let mut fresh: HashMap<usize, Vec<Point>> = missing.into_iter().zip(read).collect();
+                let out = list
+                    .iter()
+                    .map(|f| match fresh.get(f) {
+                        Some(p) => p.clone(),
+                        None => kept.get(f).cloned().unwrap_or_default(),
+                    })
+                    .collect();
+                match keep {
+                    true => kept.extend(fresh.drain()),
+                    false => list.iter().for_each(|f| drop(kept.remove(f))),
+                }
+                Ok(out)
             }
             Origin::Pc2 { file, path, points } => {
                 let bytes = *points as u64 * 12;
