@@ -11,7 +11,7 @@
 //! The index part ([`super::index::BandIndex`]) holds the step and, per band, its byte length and CRC-32; a band
 //! of length 0 is all zero and costs no coded bytes at all.
 
-use super::spatial::{self, Neighbourhood, Spatial};
+use super::spatial::{Around, Neighbourhood, Spatial};
 use crate::error::{Error, Result};
 use crate::stream::entropy::{self, BitModel, SignedModels, SymbolCoder, UIntModel};
 use std::sync::Arc;
@@ -34,7 +34,7 @@ const MAGNITUDES: usize = 6;
 const CONTEXTS: usize = MAGNITUDES * 2 * MAGNITUDES;
 
 /// Sign contexts per frequency class: the sign (−, 0, +) of the sum of the signs of the values the
-/// vertex's earlier neighbours coded for the same axis in this band ([`spatial::sign_class`]).
+/// vertex's earlier neighbours coded for the same axis in this band ([`Around::sign_class`]).
 const SIGNS: usize = 3;
 
 /// Largest level magnitude the encoder writes: far above any sensible step, far below where the
@@ -139,23 +139,21 @@ impl BandCoder {
             coder.bit(spatial == Spatial::Mean, &mut self.mode)?,
         ));
         for (v, earlier) in self.neighbourhood.visit() {
+            let around = Around::of(levels, &self.coded, earlier);
             let mut sibling = 0;
             for a in 0..3 {
                 let i = 3 * v + a;
                 let prediction = match spatial {
                     Spatial::None => 0,
-                    Spatial::Mean => spatial::mean(levels, earlier, a),
+                    Spatial::Mean => around.mean(a),
                 };
                 let prev = magnitude_class(u64::from(self.previous[i]));
                 // With the mean predictor the neighbours' coded values tell how well it predicts,
                 // their levels how large the coefficients are; both help (see the struct's doc).
-                let near = (spatial::largest(levels, earlier, a))
-                    .saturating_add(spatial::largest(&self.coded, earlier, a))
-                    .div_ceil(2);
-                let near = magnitude_class(near);
+                let near = magnitude_class(around.magnitude(a));
                 let model = SignedModels {
                     magnitude: &mut magnitudes[(prev * 2 + sibling) * MAGNITUDES + near],
-                    sign: &mut signs[spatial::sign_class(&self.coded, earlier, a)],
+                    sign: &mut signs[around.sign_class(a)],
                 };
                 if let Some(r) = rounding {
                     levels[i] = r.choose(i, prediction, &model);
