@@ -114,6 +114,23 @@ impl<'a> Segmenter<'a> {
         Ok((partition, report))
     }
 
+    /// Makes ahead what every k-means segmentation into at most `largest` clusters shares: the
+    /// motion descriptors and the k-means++ seeds for `largest` (the first k of which are the
+    /// seeds of k). For a ladder of K segmented in parallel, which then only read them.
+    pub fn prepare_kmeans(&self, largest: usize) {
+        if largest.min(self.mesh.vertex_count()) <= 1 {
+            return;
+        }
+        let options = SegmentOptions {
+            clusters: largest,
+            ..SegmentOptions::default()
+        };
+        let descriptors = self
+            .descriptors
+            .get_or_init(|| MotionDescriptors::new(self.mesh, &options));
+        descriptors.prepare_seeds(largest, options.seed);
+    }
+
     /// k-means into `clusters` on the descriptors made at the first call.
     fn kmeans(&self, clusters: usize) -> Result<Partition> {
         let options = SegmentOptions {

@@ -124,6 +124,13 @@ pub(super) fn choose(
     };
     let segmenter = analysis::Segmenter::new(mesh);
     let segmentations = segmentations(models);
+    let largest = segmentations.iter().filter(|(s, _)| *s == Segmentation::KMeans);
+    if let Some(&(_, k)) = largest.max_by_key(|(_, k)| *k) {
+        let start = Instant::now();
+        segmenter.prepare_kmeans(k);
+        let seconds = start.elapsed().as_secs_f64();
+        clock.stages.push(("motion descriptors and seeds".into(), seconds));
+    }
     let atlases: Vec<AtlasCache> = segmentations
         .iter()
         .map(|_| AtlasCache::default())

@@ -8,7 +8,8 @@ use super::sampled_motion::{welded_adjacency, SampledMotion, SAMPLED_FIT_LAMBDA}
 use crate::error::{Error, Result};
 use crate::mesh::topology::{KRingScratch, VertexAdjacency};
 use crate::mesh::AnimatedMesh;
-use super::lloyd;
+use super::lloyd::{self, Seeding};
+use std::sync::OnceLock;
 use ndarray::{Array2, ArrayView1, Axis};
 use rand_xoshiro::rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256Plus;
@@ -99,6 +100,16 @@ pub struct MotionDescriptors {
     /// The training rows: the inliers', or every row when fewer than K are inliers.
     training: Option<Array2<f32>>,
     spread: f32,
+    /// Seeds grown ahead for the largest K of a ladder ([`MotionDescriptors::prepare_seeds`]).
+    prepared: OnceLock<Prepared>,
+}
+
+/// A k-means++ seeding grown ahead, and what it was grown for.
+struct Prepared {
+    seed: u64,
+    /// Whether it seeded the inliers' rows (`training`) or every row.
+    inliers: bool,
+    seeding: Seeding<Xoshiro256Plus>,
 }
 
 impl MotionDescriptors {
@@ -117,6 +128,53 @@ impl MotionDescriptors {
             inliers,
             training,
             spread,
+            prepared: OnceLock::new(),
+        }
+    }
+
+    /// Grows the k-means++ seeds of `clusters` with `seed` ahead of [`MotionDescriptors::segment`]
+    /// calls for that many or fewer: the first k seeds of a seeding for K > k are the k seeds, so
+    /// a ladder of K's seeds once, for its largest, instead of once per K. Called before the
+    /// ladder's segmentations run in parallel, which then only read the seeds (a second call
+    /// changes nothing).
+    pub fn prepare_seeds(&self, clusters: usize, seed: u64) {
+        let Some((training, inliers)) = self.training_rows(clusters) else {
+            return;
+        };
+        self.prepared.get_or_init(|| {
+            let mut seeding = Seeding::new(training, Xoshiro256Plus::seed_from_u64(seed));
+            seeding.grow(training, clusters.min(training.nrows()));
+            Prepared {
+                seed,
+                inliers,
+                seeding,
+            }
+        });
+    }
+
+    /// The rows k-means into `clusters` trains on, and whether they are the inliers', for a K
+    /// k-means can make (1 < K); `None` otherwise.
+    fn training_rows(&self, clusters: usize) -> Option<(&Array2<f32>, bool)> {
+        let k = clusters.min(self.features.nrows());
+        match &self.training {
+            _ if k <= 1 => None,
+            Some(t) if self.inliers.len() >= k => Some((t, true)),
+            _ => Some((&self.features, false)),
+        }
+    }
+
+    /// The first `k` k-means++ seeds of `training` with `seed`: the prepared ones when they
+    /// cover them, else seeded now.
+    fn seeds(&self, training: &Array2<f32>, inliers: bool, k: usize, seed: u64) -> Array2<f32> {
+        match self.prepared.get() {
+            Some(p) if (p.seed, p.inliers) == (seed, inliers) && p.seeding.grown() >= k => {
+                p.seeding.first(training, k)
+            }
+            _ => {
+                let mut seeding = Seeding::new(training, Xoshiro256Plus::seed_from_u64(seed));
+                seeding.grow(training, k);
+                seeding.first(training, k)
+            }
         }
     }
 
@@ -125,10 +183,9 @@ impl MotionDescriptors {
         check(opts)?;
         let v_count = self.features.nrows();
         let k = opts.clusters.min(v_count);
-        let training = match &self.training {
-            Some(t) if self.inliers.len() >= k => t,
-            _ => &self.features,
-        };
+        let (training, from_inliers) = self
+            .training_rows(k)
+            .unwrap_or((&self.features, false));
         let spread = if self.inliers.len() >= k {
             self.spread
         } else {
@@ -138,9 +195,9 @@ impl MotionDescriptors {
             // One cluster, or every vertex moves alike: k-means would only split ties.
             return Partition::from_labels(vec![0; v_count], 1);
         }
-        let mut rng = Xoshiro256Plus::seed_from_u64(opts.seed);
         let tolerance = (1e-4 * spread).max(f32::MIN_POSITIVE);
-        let centroids = lloyd::kmeans(training, k, &mut rng, opts.max_iterations, tolerance);
+        let seeds = self.seeds(training, from_inliers, k, opts.seed);
+        let centroids = lloyd::kmeans_from(training, seeds, opts.max_iterations, tolerance);
         let mut labels = lloyd::nearest(&self.features, &centroids);
         if self.inliers.len() >= k && self.inliers.len() < v_count {
             assign_by_trajectory(&mut labels, &self.inliers, &self.sampled, k);
