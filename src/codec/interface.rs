@@ -17,6 +17,8 @@ use crate::stream::container::ContainerReader;
 #[cfg(feature = "encode")]
 use crate::stream::container::{Part, Tag};
 use crate::stream::header::Header;
+#[cfg(feature = "encode")]
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// What the encoder hands a residual coder: the animation, the decoder's reference frame and
 /// partition, and every frame's residual against the quantised predictor. The coder's settings
@@ -74,10 +76,40 @@ pub(crate) trait ResidualEncoder {
 
     /// The bytes of the parts [`Self::encode`] would give, estimated at a fraction of its cost,
     /// close enough to rank the automatic choice's candidates; `None` when the codec has no such
-    /// estimate (its trials code in full).
-    fn estimate_bytes(&self, _input: &ResidualInput) -> Result<Option<u64>> {
+    /// estimate (its trials code in full). The coder may stop once the estimate is sure to pass
+    /// `limit` (a candidate that cannot win), returning how far it got.
+    fn estimate_bytes(&self, _input: &ResidualInput, _limit: &Limit) -> Result<Option<Estimate>> {
         Ok(None)
     }
+}
+
+/// Where an estimate may stop: once the stream's bytes pass the smallest estimate so far, read as
+/// the estimate goes (parallel trials lower it), `counted` bytes of the stream (its other parts)
+/// already known.
+#[cfg(feature = "encode")]
+pub(crate) struct Limit<'a> {
+    /// The smallest estimate so far; `u64::MAX` for none.
+    pub smallest: &'a AtomicU64,
+    /// The stream's bytes outside the estimated parts.
+    pub counted: u64,
+}
+
+#[cfg(feature = "encode")]
+impl Limit<'_> {
+    /// Whether an estimate of `bytes` (of the estimated parts, so far) has passed the limit.
+    pub fn passed(&self, bytes: u64) -> bool {
+        self.counted.saturating_add(bytes) > self.smallest.load(Ordering::Relaxed)
+    }
+}
+
+/// An estimate of a stream's (or its residual parts') bytes.
+#[cfg(feature = "encode")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Estimate {
+    /// The bytes estimated; when `stopped`, a lower bound above the limit the estimate was given.
+    pub bytes: u64,
+    /// Whether the estimate stopped once it passed its limit.
+    pub stopped: bool,
 }
 
 /// What every residual decoder may need of the stream, read before it.

@@ -33,7 +33,7 @@ internal! {
 
 pub use interface::{BandsDescription, Description, PicturesDescription};
 #[cfg(feature = "encode")]
-pub(crate) use interface::{CodedResiduals, ResidualEncoder, ResidualInput};
+pub(crate) use interface::{CodedResiduals, Estimate, Limit, ResidualEncoder, ResidualInput};
 pub(crate) use interface::{ResidualDecoder, StreamLayout};
 pub use pictures::deep::DeepConfig;
 pub(crate) use pictures::geometry_video;

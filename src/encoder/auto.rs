@@ -27,6 +27,7 @@ use crate::motion::{Partition, PredictorKind};
 use crate::progress::Progress;
 use crate::stream::container::Part;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Frames the picture codecs' trials code per candidate when the animation has more than twice
@@ -62,6 +63,10 @@ pub struct Candidate {
     pub bytes: u64,
     /// Whether `bytes` is an estimate.
     pub estimated: bool,
+    /// Whether its estimate stopped once it passed the smallest one so far (tdct): it could not
+    /// win, and `bytes` is how far it got. Which candidates stop depends on the order the
+    /// parallel trials end in; the one kept does not.
+    pub stopped: bool,
     /// The estimate the choice ranked it by, when tdct's trials estimated it (the kept one's too,
     /// whose `bytes` are then measured).
     pub estimate: Option<u64>,
@@ -121,6 +126,7 @@ pub(super) fn choose(
         leading: &leading,
         settings,
         sample: sample.as_ref(),
+        smallest_estimate: AtomicU64::new(u64::MAX),
     };
     let segmenter = analysis::Segmenter::new(mesh);
     let segmentations = segmentations(models);
@@ -239,7 +245,7 @@ impl<'a> Job<'a> {
                 prediction: &prediction,
                 atlas: Some(self.atlas),
             };
-            let (bytes, encoded, error) = trial(shared, &analysed, &progress)?;
+            let (bytes, encoded, error, stopped) = trial(shared, &analysed, &progress)?;
             let cost = distortion::cost(8.0 * bytes as f64, error);
             outcome.candidates.push(Candidate {
                 predictor: model.predictor,
@@ -247,6 +253,7 @@ impl<'a> Job<'a> {
                 clusters: partition.clusters(),
                 bytes,
                 estimated: encoded.is_none(),
+                stopped,
                 estimate: (encoded.is_none() && shared.sample.is_none()).then_some(bytes),
                 vertex_rmse: error.map(|e| e / diagonal),
                 seconds: start.elapsed().as_secs_f64(),
@@ -281,23 +288,31 @@ struct Shared<'a> {
     leading: &'a [Part],
     settings: Settings<'a>,
     sample: Option<&'a Sample>,
+    /// The smallest complete estimate so far (tdct), past which an estimate stops: a candidate
+    /// above it cannot be the smallest, whichever trials end first, so the stream kept is the
+    /// same on any number of threads ("early exit when a candidate cannot win").
+    smallest_estimate: AtomicU64,
 }
 
 /// Codes one candidate: its bytes, whole stream and (picture codecs) decoded error, or (sampled
-/// trials) its estimated bytes and the sample's error.
+/// trials) its estimated bytes and the sample's error; and whether its estimate stopped.
 fn trial(
     shared: &Shared,
     analysed: &Analysed,
     progress: &dyn Progress,
-) -> Result<(u64, Option<Encoded>, Option<f64>)> {
+) -> Result<(u64, Option<Encoded>, Option<f64>, bool)> {
     let Shared {
         mesh, ff, settings, ..
     } = *shared;
     match shared.sample {
         None if settings.opts.codec.codec().estimated_trials() => {
             let ff_and_leading = (shared.ff, shared.leading);
-            let bytes = estimate(mesh, ff_and_leading, settings, analysed, progress)?;
-            Ok((bytes, None, None))
+            let smallest = &shared.smallest_estimate;
+            let estimate = estimate(mesh, ff_and_leading, settings, analysed, progress, smallest)?;
+            if !estimate.stopped {
+                (shared.smallest_estimate).fetch_min(estimate.bytes, Ordering::Relaxed);
+            }
+            Ok((estimate.bytes, None, None, estimate.stopped))
         }
         None => {
             let leading = shared.leading.to_vec();
@@ -315,12 +330,12 @@ fn trial(
                 true => Some(distortion::vertex_rmse(mesh, &encoded)?),
                 false => None,
             };
-            Ok((encoded.report.bytes, Some(encoded), error))
+            Ok((encoded.report.bytes, Some(encoded), error, false))
         }
         Some(sample) => {
             let trial = (ff.decoded_positions.as_slice(), shared.leading);
             let (bytes, error) = sample.estimate(mesh, trial, settings, analysed, progress)?;
-            Ok((bytes, None, Some(error)))
+            Ok((bytes, None, Some(error), false))
         }
     }
 }
@@ -404,8 +419,12 @@ fn reason(
                          coded in full)",
                 false => "smallest stream",
             };
+            let at_least = match next.stopped {
+                true => "at least ",
+                false => "",
+            };
             format!(
-                "{what} at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
+                "{what} at the quality's step: {} bytes, {:.1} % below {} ({at_least}{} bytes)",
                 winner.bytes,
                 100.0 * (1.0 - winner.bytes as f64 / next.bytes.max(1) as f64),
                 name(next),

@@ -28,6 +28,9 @@ pub struct FirstFrameTrial {
     /// Whether `bytes` is the codec's estimate (tdct: a precision whose estimate did not beat
     /// the kept one's is not coded in full).
     pub estimated: bool,
+    /// Whether the estimate stopped once sure not to beat the kept one's: `bytes` is then how far
+    /// it got, at least the kept one's estimate.
+    pub stopped: bool,
 }
 
 /// Codes `mesh` at the precisions of [`FIRST_FRAME_BITS_TRIED`], finer to coarser until one does
@@ -68,6 +71,7 @@ pub(super) fn choose(
         bits: default,
         bytes: best.report.bytes,
         estimated: false,
+        stopped: false,
     }];
     // With a codec that estimates (tdct), precisions are compared by their estimates, and only
     // one that beats the kept one's is coded in full.
@@ -84,15 +88,20 @@ pub(super) fn choose(
         let encoded = match best_estimate {
             Some(estimate_before) => {
                 let fixed = (best.model, known.clone());
-                let Some((estimate, analysis)) = estimate_once(mesh, settings, &progress, fixed)?
+                // Its estimate stops once it is sure not to be below the kept one's.
+                let limit = estimate_before.saturating_sub(1);
+                let Some((estimate, analysis)) =
+                    estimate_once(mesh, settings, &progress, fixed, limit)?
                 else {
                     break;
                 };
-                if estimate >= estimate_before {
+                let (estimate, stopped) = (estimate.bytes, estimate.stopped);
+                if stopped || estimate >= estimate_before {
                     trials.push(FirstFrameTrial {
                         bits,
                         bytes: estimate,
                         estimated: true,
+                        stopped,
                     });
                     progress.retell(trials.len() as u64 - 1, frames);
                     break;
@@ -108,6 +117,7 @@ pub(super) fn choose(
             bits,
             bytes: encoded.report.bytes,
             estimated: false,
+            stopped: false,
         });
         if encoded.report.bytes >= best.report.bytes {
             // Coarser has not helped where this did not

@@ -39,7 +39,7 @@ pub use segments::{
     analysis_clip, analysis_frames, encode_source, segment_ranges, CodedSegment, SegmentedEncoder,
 };
 
-use crate::codec::{Codec, RatePlan, ResidualInput};
+use crate::codec::{Codec, Estimate, Limit, RatePlan, ResidualInput};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::AtlasCache;
@@ -50,6 +50,7 @@ use crate::stream::container::{ContainerWriter, Part, Tag};
 use crate::stream::header::Header;
 use crate::stream::side_info;
 use std::path::Path;
+use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
 /// What an encoding produced, for reports.
@@ -228,14 +229,15 @@ impl Once {
 }
 
 /// The bytes of one motion model's stream at one first-frame precision, its residual parts
-/// estimated by the codec (`None` without an estimate), and what coding it needs; `model` and
-/// its `known` segmentation fixed.
+/// estimated by the codec (`None` without an estimate) and stopped past `limit` (`u64::MAX`: none),
+/// and what coding it needs; `model` and its `known` segmentation fixed.
 fn estimate_once(
     mesh: &AnimatedMesh,
     settings: Settings,
     progress: &dyn Progress,
     (model, known): (MotionModel, Option<(Partition, SegmentationReport)>),
-) -> Result<Option<(u64, Estimated)>> {
+    limit: u64,
+) -> Result<Option<(Estimate, Estimated)>> {
     if !settings.opts.codec.codec().estimated_trials() {
         return Ok(None);
     }
@@ -244,7 +246,15 @@ fn estimate_once(
     let mesh = permuted.unwrap_or_else(|| mesh.clone());
     let leading = leading_parts(&mesh, &ff.bytes, settings.opts)?;
     let once = Once::analyse(&mesh, &ff, settings, model, known, &mut clock)?;
-    let bytes = estimate(&mesh, (&ff, &leading), settings, &once.analysed(), progress)?;
+    let limit = AtomicU64::new(limit);
+    let bytes = estimate(
+        &mesh,
+        (&ff, &leading),
+        settings,
+        &once.analysed(),
+        progress,
+        &limit,
+    )?;
     let estimated = Estimated {
         mesh,
         ff,
@@ -296,20 +306,17 @@ fn residual_input<'a>(
 }
 
 /// The stream bytes of `analysed` with its residuals' parts estimated by the codec (tdct), the
-/// rest as the stream will hold it.
+/// rest as the stream will hold it. The estimate may stop once it is sure to pass `smallest` (read
+/// as it goes; `u64::MAX` for no limit): then its bytes are how far it got.
 fn estimate(
     mesh: &AnimatedMesh,
     (ff, leading): (&EncodedFirstFrame, &[Part]),
     settings: Settings,
     analysed: &Analysed,
     progress: &dyn Progress,
-) -> Result<u64> {
+    smallest: &AtomicU64,
+) -> Result<Estimate> {
     let (partition, prediction) = (analysed.partition, analysed.prediction);
-    let input = residual_input(mesh, ff, analysed, progress);
-    let residuals = settings.plan.encoder()?.estimate_bytes(&input)?;
-    let residuals = residuals.ok_or_else(|| {
-        Error::Codec("the automatic choice asked for an estimate the codec does not make".into())
-    })?;
     let header = header(mesh, settings, analysed.model, partition);
     let side = assemble(
         &header,
@@ -319,7 +326,19 @@ fn estimate(
         prediction,
         (vec![], vec![]),
     )?;
-    Ok(side.len() + residuals)
+    let input = residual_input(mesh, ff, analysed, progress);
+    let limit = Limit {
+        smallest,
+        counted: side.len(),
+    };
+    let residuals = settings.plan.encoder()?.estimate_bytes(&input, &limit)?;
+    let residuals = residuals.ok_or_else(|| {
+        Error::Codec("the automatic choice asked for an estimate the codec does not make".into())
+    })?;
+    Ok(Estimate {
+        bytes: side.len() + residuals.bytes,
+        stopped: residuals.stopped,
+    })
 }
 
 /// The first frame's part and, for inputs with texture coordinates, the attributes'.
