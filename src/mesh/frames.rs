@@ -2,7 +2,8 @@
 //! caches sample by sample, so that a long clip is never held whole. glTF clips are baked whole
 //! (the baker poses every frame from the clip's channels) and served from memory.
 
-use super::obj::{check_same_mesh, frame_files, read_frames, read_obj};
+use super::obj::{frame_files, read_frames, read_obj};
+use super::obj_skeleton::FirstObj;
 use super::{gltf, pc2, AnimatedMesh, Point, ReadOptions};
 use crate::error::{Error, Result};
 use std::fs::File;
@@ -28,6 +29,7 @@ enum Origin {
     Obj {
         files: Vec<PathBuf>,
         kept: HashMap<usize, Vec<Point>>,
+        first: FirstObj,
     },
     /// A PC2 cache: `points` positions of 12 bytes per sample.
     Pc2 {
@@ -70,7 +72,7 @@ impl FrameSource {
         let path = files
             .first()
             .ok_or_else(|| Error::Usage("no .obj files to read".into()))?;
-        let frame = read_obj(path)?;
+        let (frame, first_obj) = FirstObj::read(path)?;
         let first = AnimatedMesh::new(frame.triangles, vec![frame.positions])?
             .with_attributes(frame.attributes)?;
         Ok(Self {
@@ -79,6 +81,7 @@ impl FrameSource {
             origin: Origin::Obj {
                 files,
                 kept: HashMap::new(),
+                first: first_obj,
             },
         })
     }
@@ -156,19 +159,13 @@ impl FrameSource {
         }
         match &mut self.origin {
             Origin::Memory(mesh) => Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect()),
-            Origin::Obj { files, kept } => {
-                let (vertices, triangles) = (self.first.vertex_count(), self.first.triangles());
-                let first_path = &files[0];
+            Origin::Obj { files, kept, first } => {
                 let mut missing: Vec<usize> =
                     list.iter().copied().filter(|f| !kept.contains_key(f)).collect();
                 missing.sort_unstable();
                 missing.dedup();
                 let chosen: Vec<PathBuf> = missing.iter().map(|&f| files[f].clone()).collect();
-                let read = read_frames(&chosen, |path| {
-                    let frame = read_obj(path)?;
-                    check_same_mesh(triangles, vertices, first_path, &frame, path)?;
-                    Ok(frame.positions)
-                })?;
+                let read = read_frames(&chosen, |path| first.read_later(path))?;
                 let mut fresh: HashMap<usize, Vec<Point>> = missing.into_iter().zip(read).collect();
                 let out = list
                     .iter()

@@ -17,6 +17,7 @@
 //! vertices would break the vertex-for-vertex match of the frames. `usemtl` names each triangle's
 //! material (`default` before the first).
 
+use super::obj_skeleton::FirstObj;
 use super::{AnimatedMesh, Attributes, Point, Triangle};
 use crate::error::{Error, Result};
 use std::borrow::Cow;
@@ -124,13 +125,18 @@ impl Looks {
 
 /// Reads and parses one OBJ file.
 pub(crate) fn read_obj(path: &Path) -> Result<ObjFrame> {
+    parse_obj(&read_text(path)?, path)
+}
+
+/// The text of the file at `path`, invalid UTF-8 replaced.
+pub(super) fn read_text(path: &Path) -> Result<String> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     // `from_utf8` checks ASCII a word at a time, the lossy decoder byte by byte: the fast check
     // first (an OBJ file is ASCII but for names and comments), the lossy one where it fails.
-    match std::str::from_utf8(&bytes) {
-        Ok(text) => parse_obj(text, path),
-        Err(_) => parse_obj(&String::from_utf8_lossy(&bytes), path),
-    }
+    Ok(match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => String::from_utf8_lossy(e.as_bytes()).into_owned(),
+    })
 }
 
 /// Parses OBJ text; `path` only names the file in error messages.
@@ -181,13 +187,13 @@ pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
 }
 
 /// An error on line `line` of the file at `path`.
-fn line_error(path: &Path, line: usize, what: String) -> Error {
+pub(super) fn line_error(path: &Path, line: usize, what: String) -> Error {
     Error::Mesh(format!("{}: line {line}: {what}", path.display()))
 }
 
 /// The position of a `v` line (the words after `v`), divided by its homogeneous w if it has one;
 /// `read` is the number of vertices before it.
-fn parse_vertex<'a>(
+pub(super) fn parse_vertex<'a>(
     mut words: impl Iterator<Item = &'a str>,
     read: usize,
 ) -> std::result::Result<Point, String> {
@@ -296,7 +302,7 @@ fn resolve_corners(
 }
 
 /// Lines with their 1-based numbers, a trailing `\` joining a line to the next, comments removed.
-fn logical_lines(text: &str) -> impl Iterator<Item = (usize, Cow<'_, str>)> + '_ {
+pub(super) fn logical_lines(text: &str) -> impl Iterator<Item = (usize, Cow<'_, str>)> + '_ {
     let mut lines = physical_lines(text).enumerate();
     std::iter::from_fn(move || {
         let (i, first) = lines.next()?;
@@ -344,13 +350,8 @@ pub(crate) fn read_sequence(files: &[PathBuf]) -> Result<AnimatedMesh> {
     let (first_path, rest) = files
         .split_first()
         .ok_or_else(|| Error::Usage("no .obj files to read".into()))?;
-    let first = read_obj(first_path)?;
-    let vertices = first.positions.len();
-    let rest = read_frames(rest, |path| {
-        let frame = read_obj(path)?;
-        check_same_mesh(&first.triangles, vertices, first_path, &frame, path)?;
-        Ok(frame.positions)
-    })?;
+    let (first, skeleton) = FirstObj::read(first_path)?;
+    let rest = read_frames(rest, |path| skeleton.read_later(path))?;
     let frames = std::iter::once(first.positions).chain(rest).collect();
     AnimatedMesh::new(first.triangles, frames)?.with_attributes(first.attributes)
 }
@@ -367,7 +368,7 @@ pub(crate) fn read_frames<T: Send>(
 }
 
 /// The error naming `path` and the first way its mesh differs from the first frame's.
-pub(crate) fn check_same_mesh(
+pub(super) fn check_same_mesh(
     triangles: &[Triangle],
     vertex_count: usize,
     first_path: &Path,
