@@ -26,8 +26,8 @@ use crate::mesh::{AnimatedMesh, Point};
 use crate::motion::{Partition, PredictorKind};
 use crate::progress::Progress;
 use crate::stream::container::Part;
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// Frames the picture codecs' trials code per candidate when the animation has more than twice
@@ -153,10 +153,7 @@ pub(super) fn choose(
             atlas,
         });
     }
-    let outcomes = jobs
-        .par_iter()
-        .map(|job| job.run(&shared, &segmenter, progress))
-        .collect::<Result<Vec<Outcome>>>()?;
+    let outcomes = in_order(&jobs, |job| job.run(&shared, &segmenter, progress))?;
     let (mut candidates, mut costs, mut best) = (Vec::new(), Vec::new(), None::<Best>);
     for outcome in outcomes {
         clock.stages.extend(outcome.stages);
@@ -184,6 +181,39 @@ pub(super) fn choose(
         candidates,
     });
     Ok(encoded)
+}
+
+/// `run` of every job on rayon's threads, each thread taking the next job not yet started, so that
+/// jobs start in their order (a split work list would start the last half's first job beside the
+/// first one): the default candidates' estimates are known soonest, and the later jobs' stop
+/// sooner. The outcomes in the jobs' order; the first job's error in that order if any fails.
+fn in_order<'a, J: Sync, T: Send>(
+    jobs: &'a [J],
+    run: impl Fn(&'a J) -> Result<T> + Sync,
+) -> Result<Vec<T>> {
+    let next = AtomicUsize::new(0);
+    let done: Vec<Mutex<Option<Result<T>>>> = jobs.iter().map(|_| Mutex::new(None)).collect();
+    let workers = rayon::current_num_threads().clamp(1, jobs.len().max(1));
+    rayon::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|_| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(job) = jobs.get(i) else {
+                    break;
+                };
+                let outcome = run(job);
+                if let Ok(mut slot) = done[i].lock() {
+                    *slot = Some(outcome);
+                }
+            });
+        }
+    });
+    done.into_iter()
+        .map(|slot| {
+            let outcome = slot.into_inner().ok().flatten();
+            outcome.unwrap_or_else(|| Err(Error::Codec("a trial of the choice did not end".into())))
+        })
+        .collect()
 }
 
 /// One segmentation and the candidates that use it, numbered from `first` among all.
@@ -398,9 +428,11 @@ fn reason(
         format!("{model} ({} clusters)", c.clusters)
     };
     let winner = &candidates[chosen];
+    // The runner-up among the complete estimates: a stopped one's bytes are how far it got.
     let runner_up = (0..candidates.len())
-        .filter(|&i| i != chosen)
+        .filter(|&i| i != chosen && !candidates[i].stopped)
         .min_by(|&a, &b| costs[a].total_cmp(&costs[b]));
+    let stopped = candidates.iter().filter(|c| c.stopped).count();
     let mut reason = match (runner_up, winner.vertex_rmse) {
         (Some(next), Some(rmse)) => format!(
             "fewest bits at equal error (RMSE ∝ rate^-{}): {} bytes at vertex RMSE {rmse:.3e}; \
@@ -419,20 +451,22 @@ fn reason(
                          coded in full)",
                 false => "smallest stream",
             };
-            let at_least = match next.stopped {
-                true => "at least ",
-                false => "",
-            };
             format!(
-                "{what} at the quality's step: {} bytes, {:.1} % below {} ({at_least}{} bytes)",
+                "{what} at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
                 winner.bytes,
                 100.0 * (1.0 - winner.bytes as f64 / next.bytes.max(1) as f64),
                 name(next),
                 next.bytes
             )
         }
+        (None, _) if stopped > 0 => "the smallest estimate".to_string(),
         (None, _) => "the only candidate".to_string(),
     };
+    if stopped > 0 {
+        reason.push_str(&format!(
+            "; {stopped} estimates stopped once they passed the smallest so far"
+        ));
+    }
     if trial_frames < frames {
         reason.push_str(&format!(
             "; sizes estimated from {trial_frames} of {frames} frames"
