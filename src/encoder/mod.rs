@@ -16,6 +16,7 @@ internal! {
     auto;
     distortion;
     first_frame_bits;
+    segment_runs;
     segments;
 }
 
@@ -35,9 +36,8 @@ pub use options::{
     EncodeOptions, PredictorChoice, Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS,
     DEFAULT_PARALLEL_SEGMENTS, DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
-pub use segments::{
-    analysis_clip, analysis_frames, encode_source, segment_ranges, CodedSegment, SegmentedEncoder,
-};
+pub use segment_runs::{analysis_clip, analysis_frames, encode_source, segment_ranges};
+pub use segments::{CodedSegment, SegmentedEncoder};
 
 use crate::codec::{Codec, Estimate, Limit, RatePlan, ResidualInput};
 use crate::error::{Error, Result};
@@ -130,7 +130,7 @@ pub fn encode_with_progress(
 ) -> Result<Encoded> {
     opts.check(mesh)?;
     if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
-        return segments::encode(mesh, opts, length, progress);
+        return segment_runs::encode(mesh, opts, length, progress);
     }
     let plan = opts.plan(mesh.bbox_diagonal())?;
     let settings = Settings { opts, plan: &plan };

@@ -3,7 +3,7 @@
 //! of a segment whatever the clip's length.
 //!
 //! The *analysis clip* — a segment's worth of frames spread evenly over the clip, the first frame
-//! first ([`analysis_frames`]) — is encoded as a clip of its own, with every automatic choice
+//! first ([`super::analysis_frames`]) — is encoded as a clip of its own, with every automatic choice
 //! (motion model, K, first-frame precision). Its first frame, partition, lattice and skinning
 //! weights become the whole stream's; each segment gets its own affine maps and residual parts,
 //! predicted from the shared parts *as the decoder reads them* (decoded from the analysis clip's
@@ -20,7 +20,7 @@ use crate::codec::{RatePlan, ResidualInput};
 use crate::decoder::Decoder;
 use crate::error::{Error, Result};
 use crate::geometry_image::lattice::AtlasCache;
-use crate::mesh::{AnimatedMesh, FrameSource, Point, Triangle};
+use crate::mesh::{AnimatedMesh, Point, Triangle};
 use crate::motion::{AffineTrack, Partition, PredictorKind, SkinningWeights};
 use crate::progress::Progress;
 use crate::stream::bytes::{ByteReader, ByteWriter};
@@ -28,7 +28,6 @@ use crate::stream::container::{ContainerReader, ContainerWriter, Part, Tag};
 use crate::stream::header::Header;
 use crate::stream::segments::SegmentStart;
 use crate::stream::side_info;
-use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Instant;
 
@@ -225,7 +224,7 @@ fn options_checksum(opts: &EncodeOptions) -> u32 {
 
 impl SegmentedEncoder {
     /// Makes the choices of an encoding in segments of `length` frames on `analysis`, the clip's
-    /// [`analysis_frames`] (frame 0 first), with every automatic choice `opts` leaves open.
+    /// [`super::analysis_frames`] (frame 0 first), with every automatic choice `opts` leaves open.
     pub fn start(
         analysis: &AnimatedMesh,
         opts: &EncodeOptions,
@@ -497,121 +496,6 @@ impl SegmentedEncoder {
         }
         Ok(())
     }
-}
-
-/// The frames of the analysis clip of a clip of `frames` frames cut into segments of `length`:
-/// `length` frames spread evenly from the first to the last (all of a clip no longer than that).
-pub fn analysis_frames(frames: usize, length: usize) -> Vec<usize> {
-    let n = length.clamp(1, frames.max(1));
-    if n == 1 {
-        return vec![0];
-    }
-    (0..n).map(|i| i * (frames - 1) / (n - 1)).collect()
-}
-
-/// The segments of a clip of `frames` frames cut into runs of `length` (the last one shorter):
-/// the ranges [`SegmentedEncoder::code_segment`] codes and [`SegmentedEncoder::add`] takes, in
-/// order.
-pub fn segment_ranges(frames: usize, length: usize) -> Vec<Range<usize>> {
-    crate::stream::segments::split(frames, length)
-}
-
-/// The analysis clip of `source` cut into segments of `length` frames: its
-/// [`analysis_frames`], with the first frame's connectivity, attributes and frame rate — what
-/// [`SegmentedEncoder::start`] takes, as [`encode_source`] builds it (so that segments coded
-/// elsewhere from it join into the stream `encode_source` writes).
-pub fn analysis_clip(source: &mut FrameSource, length: usize) -> Result<AnimatedMesh> {
-    let (frames, first) = (source.frame_count(), source.first().clone());
-    spread_clip(&first, frames, length, |list| source.read_list(list))
-}
-
-/// The analysis clip of a clip of `frames` frames read by ranges with `read`, one frame at a
-/// time; `first` gives the connectivity, attributes and frame rate.
-fn spread_clip(
-    first: &AnimatedMesh,
-    frames: usize,
-    length: usize,
-    mut read: impl FnMut(&[usize]) -> Result<Vec<Vec<Point>>>,
-) -> Result<AnimatedMesh> {
-    let spread = read(&analysis_frames(frames, length))?;
-    AnimatedMesh::new(first.triangles().to_vec(), spread)?
-        .with_attributes(first.attributes().clone())
-        .map(|mesh| mesh.with_frame_rate(first.frame_rate()))
-}
-
-/// Encodes `mesh` in segments of `length` frames.
-pub fn encode(
-    mesh: &AnimatedMesh,
-    opts: &EncodeOptions,
-    length: usize,
-    progress: &dyn Progress,
-) -> Result<Encoded> {
-    let frames = mesh.frame_count();
-    let read = |list: &[usize], _| Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect());
-    encode_runs(mesh, frames, length, opts, progress, read)
-}
-
-/// Encodes the animation `source` reads, in segments when it is longer than the options' segment
-/// length: memory holds `parallel_segments` segments' frames and working data (one by default),
-/// whatever the clip's length.
-pub fn encode_source(
-    source: &mut FrameSource,
-    opts: &EncodeOptions,
-    progress: &dyn Progress,
-) -> Result<Encoded> {
-    let frames = source.frame_count();
-    let length = match opts.segment_frames {
-        Some(n) if frames > n => n,
-        _ => return super::encode_with_progress(&source.clip(0..frames)?, opts, progress),
-    };
-    let first = source.first().clone();
-    encode_runs(&first, frames, length, opts, progress, |list, again| {
-        match again {
-            ReadAgain::Yes => source.read_list_keeping(list),
-            ReadAgain::No => source.read_list(list),
-        }
-    })
-}
-
-/// Whether frames being read will be read again (the analysis clip's, once more in their
-/// segments): a source that parses its frames keeps them.
-#[derive(Clone, Copy)]
-enum ReadAgain {
-    Yes,
-    No,
-}
-
-/// Encodes a clip of `frames` frames in segments of `length`, reading its frames by ranges with
-/// `read`: the analysis clip's frames, then `parallel_segments` segments at a time,
-/// coded on rayon's threads. `first` gives the connectivity, attributes and frame rate.
-fn encode_runs(
-    first: &AnimatedMesh,
-    frames: usize,
-    length: usize,
-    opts: &EncodeOptions,
-    progress: &dyn Progress,
-    mut read: impl FnMut(&[usize], ReadAgain) -> Result<Vec<Vec<Point>>>,
-) -> Result<Encoded> {
-    let analysis = spread_clip(first, frames, length, |list| read(list, ReadAgain::Yes))?;
-    progress.total(frames as u64);
-    let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
-    drop(analysis);
-    progress.stage("segments");
-    let ranges = segment_ranges(frames, length);
-    for batch in ranges.chunks(opts.parallel_segments.max(1)) {
-        let runs = batch
-            .iter()
-            .map(|r| Ok((r.start, read(&r.clone().collect::<Vec<_>>(), ReadAgain::No)?)))
-            .collect::<Result<Vec<_>>>()?;
-        let coded: Vec<Result<CodedSegment>> = runs
-            .into_par_iter()
-            .map(|(start, frames)| encoder.code_segment(start, frames, progress))
-            .collect();
-        for segment in coded {
-            encoder.add(segment?)?;
-        }
-    }
-    encoder.finish()
 }
 
 /// One coded segment, a separable unit of the stream: its start marker, affine maps and residual

@@ -3,7 +3,7 @@
 //! refused.
 
 use crate::common::{animate, config, decoder, encode_bytes, harness, parts, rebuild, tube};
-use mcgv_video::encoder::segments::{analysis_frames, CodedSegment, SegmentedEncoder};
+use mcgv_video::encoder::{analysis_frames, CodedSegment, SegmentedEncoder};
 use mcgv_video::stream::container::{Checksum, Tag, VERSION};
 use mcgv_video::{encode, AnimatedMesh, Codec, EncodeOptions, Lattice, PredictorChoice, Silent};
 use mcgv_video::{PredictorKind, SegmentationChoice};
