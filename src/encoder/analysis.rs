@@ -125,10 +125,15 @@ impl<'a> Segmenter<'a> {
             clusters: largest,
             ..SegmentOptions::default()
         };
-        let descriptors = self
-            .descriptors
-            .get_or_init(|| MotionDescriptors::new(self.mesh, &options));
-        descriptors.prepare_seeds(largest, options.seed);
+        self.descriptors(&options)
+            .prepare_seeds(largest, options.seed);
+    }
+
+    /// The motion descriptors, made at the first call (with `options`' ring and feature frames,
+    /// the defaults').
+    fn descriptors(&self, options: &SegmentOptions) -> &MotionDescriptors {
+        self.descriptors
+            .get_or_init(|| MotionDescriptors::new(self.mesh, options))
     }
 
     /// k-means into `clusters` on the descriptors made at the first call.
@@ -140,10 +145,7 @@ impl<'a> Segmenter<'a> {
         if clusters.min(self.mesh.vertex_count()) <= 1 {
             return motion::segment(self.mesh, &options);
         }
-        let descriptors = self
-            .descriptors
-            .get_or_init(|| MotionDescriptors::new(self.mesh, &options));
-        descriptors.segment(&options)
+        self.descriptors(&options).segment(&options)
     }
 }
 

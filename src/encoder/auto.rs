@@ -340,7 +340,7 @@ fn trial(
             let smallest = &shared.smallest_estimate;
             let estimate = estimate(mesh, ff_and_leading, settings, analysed, progress, smallest)?;
             if !estimate.stopped {
-                (shared.smallest_estimate).fetch_min(estimate.bytes, Ordering::Relaxed);
+                smallest.fetch_min(estimate.bytes, Ordering::Relaxed);
             }
             Ok((estimate.bytes, None, None, estimate.stopped))
         }

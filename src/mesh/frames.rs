@@ -167,12 +167,9 @@ impl FrameSource {
                 let chosen: Vec<PathBuf> = missing.iter().map(|&f| files[f].clone()).collect();
                 let read = read_frames(&chosen, |path| first.read_later(path))?;
                 let mut fresh: HashMap<usize, Vec<Point>> = missing.into_iter().zip(read).collect();
-                let out = list
-                    .iter()
-                    .map(|f| match fresh.get(f) {
-                        Some(p) => p.clone(),
-                        None => kept.get(f).cloned().unwrap_or_default(),
-                    })
+                // Every frame of `list` is fresh or kept.
+                let out = (list.iter())
+                    .map(|f| fresh.get(f).or_else(|| kept.get(f)).cloned().unwrap_or_default())
                     .collect();
                 match keep {
                     true => kept.extend(fresh.drain()),

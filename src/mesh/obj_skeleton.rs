@@ -81,19 +81,18 @@ impl FirstObj {
         let mut positions = Vec::with_capacity(self.vertices);
         let mut rest = &self.skeleton[..];
         for (line_no, line) in logical_lines(text) {
-            let expected: &[u8] = match role(&line) {
+            let role = role(&line);
+            let expected: &[u8] = match role {
                 Role::Vertex => b"v",
                 Role::Kept => line.as_bytes(),
                 Role::Ignored => continue,
             };
-            let Some(after) = rest.strip_prefix(expected) else {
-                return Ok(None);
-            };
-            let Some(after) = after.strip_prefix(b"\n") else {
+            let after = rest.strip_prefix(expected);
+            let Some(after) = after.and_then(|a| a.strip_prefix(b"\n")) else {
                 return Ok(None);
             };
             rest = after;
-            if let Role::Vertex = role(&line) {
+            if let Role::Vertex = role {
                 let mut words = line.split_ascii_whitespace();
                 words.next();
                 let p = parse_vertex(words, positions.len());

@@ -8,7 +8,7 @@ use super::sampled_motion::{welded_adjacency, SampledMotion, SAMPLED_FIT_LAMBDA}
 use crate::error::{Error, Result};
 use crate::mesh::topology::{KRingScratch, VertexAdjacency};
 use crate::mesh::AnimatedMesh;
-use super::lloyd::{self, Seeding};
+use super::lloyd;
 use std::sync::OnceLock;
 use ndarray::{Array2, ArrayView1, Axis};
 use rand_xoshiro::rand_core::SeedableRng;
@@ -104,12 +104,13 @@ pub struct MotionDescriptors {
     prepared: OnceLock<Prepared>,
 }
 
-/// A k-means++ seeding grown ahead, and what it was grown for.
+/// k-means++ seeds picked ahead, and what they were picked for.
 struct Prepared {
     seed: u64,
-    /// Whether it seeded the inliers' rows (`training`) or every row.
+    /// Whether they are rows of the inliers' (`training`) or of every row.
     inliers: bool,
-    seeding: Seeding<Xoshiro256Plus>,
+    /// The rows picked, in order ([`lloyd::seed_rows`]).
+    picked: Vec<usize>,
 }
 
 impl MotionDescriptors {
@@ -141,14 +142,10 @@ impl MotionDescriptors {
         let Some((training, inliers)) = self.training_rows(clusters) else {
             return;
         };
-        self.prepared.get_or_init(|| {
-            let mut seeding = Seeding::new(training, Xoshiro256Plus::seed_from_u64(seed));
-            seeding.grow(training, clusters.min(training.nrows()));
-            Prepared {
-                seed,
-                inliers,
-                seeding,
-            }
+        self.prepared.get_or_init(|| Prepared {
+            seed,
+            inliers,
+            picked: seed_rows(training, clusters.min(training.nrows()), seed),
         });
     }
 
@@ -167,14 +164,10 @@ impl MotionDescriptors {
     /// cover them, else seeded now.
     fn seeds(&self, training: &Array2<f32>, inliers: bool, k: usize, seed: u64) -> Array2<f32> {
         match self.prepared.get() {
-            Some(p) if (p.seed, p.inliers) == (seed, inliers) && p.seeding.grown() >= k => {
-                p.seeding.first(training, k)
+            Some(p) if (p.seed, p.inliers) == (seed, inliers) && p.picked.len() >= k => {
+                training.select(Axis(0), &p.picked[..k])
             }
-            _ => {
-                let mut seeding = Seeding::new(training, Xoshiro256Plus::seed_from_u64(seed));
-                seeding.grow(training, k);
-                seeding.first(training, k)
-            }
+            _ => training.select(Axis(0), &seed_rows(training, k, seed)),
         }
     }
 
@@ -290,6 +283,11 @@ fn motion_features(
     let features = Array2::from_shape_vec((v_count, dim), data)
         .unwrap_or_else(|_| Array2::zeros((v_count, dim)));
     (features, misfit)
+}
+
+/// The k-means++ seeds of `training` drawn with `seed` ([`lloyd::seed_rows`]).
+fn seed_rows(training: &Array2<f32>, k: usize, seed: u64) -> Vec<usize> {
+    lloyd::seed_rows(training, k, &mut Xoshiro256Plus::seed_from_u64(seed))
 }
 
 /// RMS distance of the feature rows to their mean: the scale k-means' tolerance is relative to.

@@ -14,10 +14,8 @@ use rand::distributions::{Distribution, WeightedIndex};
 use rand::Rng;
 use rayon::prelude::*;
 
-/// The `k` centroids of the rows of `x` (1 ≤ k ≤ rows): k-means++ seeding from `rng`, then
-/// Lloyd rounds until the centroids (as one vector) move less than `tolerance`, or `max_rounds`.
-/// Each update averages a centroid's rows together with the old centroid (m_k-means), so that an
-/// emptied centroid stays where it was.
+/// The `k` centroids of the rows of `x` (1 ≤ k ≤ rows): k-means++ seeding from `rng`
+/// ([`seed_rows`]), then [`kmeans_from`] those seeds.
 #[cfg(test)]
 pub(crate) fn kmeans(
     x: &Array2<f32>,
@@ -26,12 +24,14 @@ pub(crate) fn kmeans(
     max_rounds: u64,
     tolerance: f32,
 ) -> Array2<f32> {
-    let mut seeding = Seeding::new(x, rng);
-    seeding.grow(x, k);
-    kmeans_from(x, seeding.first(x, k), max_rounds, tolerance)
+    let seeds = x.select(Axis(0), &seed_rows(x, k, rng));
+    kmeans_from(x, seeds, max_rounds, tolerance)
 }
 
-/// Lloyd rounds from the seeds `centroids` (see [`kmeans`]).
+/// The centroids Lloyd rounds reach from the seeds `centroids` (rows like `x`'s): rounds until
+/// the centroids (as one vector) move less than `tolerance`, or `max_rounds`. Each update
+/// averages a centroid's rows together with the old centroid (m_k-means), so that an emptied
+/// centroid stays where it was.
 pub(crate) fn kmeans_from(
     x: &Array2<f32>,
     mut centroids: Array2<f32>,
@@ -82,56 +82,24 @@ fn row_slice<'a>(row: &'a ArrayView1<'_, f32>) -> std::borrow::Cow<'a, [f32]> {
     }
 }
 
-/// k-means++ seeds, grown on demand: the first centroid a row drawn uniformly (as a weighted draw
-/// over weights one), each next one a row drawn with probability proportional to its squared
-/// distance to the nearest centroid so far (the first row if every distance is zero). The first k
-/// seeds of K > k are the k seeds (the same draws in the same order), so one seeding grown to the
-/// largest K serves every K of the automatic choice's ladder: the sum of the ladder's seeding
-/// work becomes its largest's.
-pub(crate) struct Seeding<R> {
-    /// The draws' source, as the last growth left it.
-    rng: R,
-    /// The rows picked, in order.
-    picked: Vec<usize>,
-    /// Each row's squared distance to the nearest pick but the last.
-    nearest_d2: Vec<f32>,
-}
-
-impl<R: Rng> Seeding<R> {
-    /// The first seed of the rows of `x`, drawn from `rng`.
-    pub(crate) fn new(x: &Array2<f32>, mut rng: R) -> Self {
-        let rows = x.nrows();
-        let first =
-            WeightedIndex::new(std::iter::repeat_n(1f32, rows)).map_or(0, |w| w.sample(&mut rng));
-        Self {
-            rng,
-            picked: vec![first],
-            nearest_d2: vec![f32::INFINITY; rows],
-        }
+/// The rows k-means++ picks as the `k` seeds of `x` (1 ≤ k ≤ rows), in order: the first a row
+/// drawn uniformly from `rng` (as a weighted draw over weights one), each next one a row drawn
+/// with probability proportional to its squared distance to the nearest seed so far (the first
+/// row if every distance is zero). The first k seeds of K > k are the k seeds (the same draws in
+/// the same order), so the seeds of a ladder's largest K serve every K of it.
+pub(crate) fn seed_rows(x: &Array2<f32>, k: usize, rng: &mut impl Rng) -> Vec<usize> {
+    let rows = x.nrows();
+    let first = WeightedIndex::new(std::iter::repeat_n(1f32, rows)).map_or(0, |w| w.sample(rng));
+    let mut picked = vec![first];
+    let mut nearest_d2 = vec![f32::INFINITY; rows];
+    while picked.len() < k {
+        let newest = x.row(picked[picked.len() - 1]).to_vec();
+        nearest_d2.par_iter_mut().enumerate().for_each(|(i, d)| {
+            *d = d.min(exact_sq_distance(&row_slice(&x.row(i)), &newest));
+        });
+        picked.push(WeightedIndex::new(nearest_d2.iter()).map_or(0, |w| w.sample(rng)));
     }
-
-    /// Seeds up to `k` of the rows of `x` (the rows [`Seeding::new`] was given).
-    pub(crate) fn grow(&mut self, x: &Array2<f32>, k: usize) {
-        while self.picked.len() < k {
-            let newest = x.row(self.picked[self.picked.len() - 1]).to_vec();
-            self.nearest_d2.par_iter_mut().enumerate().for_each(|(i, d)| {
-                *d = d.min(exact_sq_distance(&row_slice(&x.row(i)), &newest));
-            });
-            let weights = WeightedIndex::new(self.nearest_d2.iter());
-            let pick = weights.map_or(0, |w| w.sample(&mut self.rng));
-            self.picked.push(pick);
-        }
-    }
-
-    /// Seeds grown so far.
-    pub(crate) fn grown(&self) -> usize {
-        self.picked.len()
-    }
-
-    /// The first `k` seeds (at most as many as grown): rows of `x`.
-    pub(crate) fn first(&self, x: &Array2<f32>, k: usize) -> Array2<f32> {
-        x.select(Axis(0), &self.picked[..k.min(self.picked.len())])
-    }
+    picked
 }
 
 /// Rows ready for the matrix product: moved so that their mean is the origin (distances do not
