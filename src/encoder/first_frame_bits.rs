@@ -95,8 +95,9 @@ pub(super) fn choose(
                 else {
                     break;
                 };
+                // A stopped estimate is at least `estimate_before`.
                 let (estimate, stopped) = (estimate.bytes, estimate.stopped);
-                if stopped || estimate >= estimate_before {
+                if estimate >= estimate_before {
                     trials.push(FirstFrameTrial {
                         bits,
                         bytes: estimate,

@@ -123,20 +123,25 @@ impl ResidualEncoder for Encoder {
         let levels = coefficients::quantise(&coefficients, step, transform::DEAD_ZONE)?;
         let mut coder = BandCoder::new(Arc::new(kept.neighbourhood));
         let mut chunks = Vec::with_capacity(levels.len());
-        let mut so_far = 1;
+        let (mut so_far, mut stopped) = (1, false);
         for (k, band) in levels.iter().enumerate() {
             let chunk = coder.encode_among(k, band, &[Spatial::Mean])?;
             so_far += chunk.len() as u64;
             chunks.push(chunk);
-            if limit.passed(so_far) {
-                input.progress.frames(input.residuals.len() as u64);
-                let bytes = so_far;
-                return Ok(Some(Estimate { bytes, stopped: true }));
+            stopped = limit.passed(so_far);
+            if stopped {
+                break;
             }
+        }
+        input.progress.frames(input.residuals.len() as u64);
+        if stopped {
+            return Ok(Some(Estimate {
+                bytes: so_far,
+                stopped,
+            }));
         }
         let (mut index, payload) = BandIndex::build(self.step, chunks);
         index.copies = kept.bits;
-        input.progress.frames(input.residuals.len() as u64);
         let setup = 1 + index.to_bytes()?.len() as u64;
         let bytes = setup + payload.len() as u64;
         Ok(Some(Estimate { bytes, stopped: false }))

@@ -140,7 +140,7 @@ fn breadth_first(adjacency: &VertexAdjacency) -> Vec<u32> {
 /// What a vertex's coding reads of its neighbours coded before it in the band, for its three
 /// axes at once: one pass over the neighbours instead of four per axis (the bands' context
 /// gathering was a fifth of a default encode). Every neighbour's values are final when the vertex
-/// is coded (it is not its own earlier neighbour), so the vertex's own axes may be read from it.
+/// is coded (it is not its own earlier neighbour), so one reading serves its three axes.
 pub struct Around {
     /// Per axis: the sum of the neighbours' levels (i128: a damaged band's levels are checked only
     /// once it is decoded, and may be near ±2^63).
