@@ -5,8 +5,9 @@
 //! quality — between the integers too ([`EncodeOptions::fine_quality`]) — whose stream stays
 //! within the budget and lands within [`Budget::tolerance`] of it, in as few full encodes as it
 //! can: the first at the caller's quality (with the automatic choices, which the later encodes
-//! keep), then a model of the measure against the log of the target step (a straight line: its
-//! slope a prior per measure and codec, then the secant through the encodes made), then
+//! keep), then a model of the measure — a size's bytes beyond its fixed parts — against the log
+//! of the target step (a straight line: its slope a prior per measure and codec, then the secant
+//! through the encodes made), then
 //! regula falsi inside the bracket if the model misses. It never returns a stream over the budget
 //! (docs/design.md, "Budgets").
 
@@ -16,6 +17,7 @@ use crate::codec::{fine_scale_percent, ijg_scale_percent};
 use crate::error::{Error, Result};
 use crate::mesh::AnimatedMesh;
 use crate::progress::{Progress, Silent};
+use crate::stream::container::Tag;
 use crate::Decoder;
 use serde::Serialize;
 
@@ -89,12 +91,15 @@ impl Budget {
         }
     }
 
-    /// The first guess of d ln(measure) / d ln(target step): sizes fall about as the step's
-    /// 0.7th power; the temporal DCT's error follows the step nearly in proportion, the picture
-    /// codecs' about as its 0.6th power (docs/design.md, "Quality laws").
+    /// The first guess of d ln(measure) / d ln(target step), the measure of a size budget being the
+    /// bytes the step moves: the temporal DCT's fall about as the step's 0.75th power, the
+    /// picture codecs' about as its 1.3th (0.6–2.1 between qualities 10 and 90); the temporal
+    /// DCT's error follows the step nearly in proportion, the picture codecs' about as its 0.6th
+    /// power (docs/design.md, "Budgets").
     fn prior_slope(&self, codec: Codec) -> f64 {
         match (self.is_size(), codec) {
-            (true, _) => -0.7,
+            (true, Codec::Tdct) => -0.75,
+            (true, _) => -1.3,
             (false, Codec::Tdct) => 0.9,
             (false, _) => 0.6,
         }
@@ -247,8 +252,12 @@ struct Search<'a> {
     budget: Budget,
     codec: Codec,
     limit: f64,
-    /// (log scale, ln measure) of each encode.
+    /// (log scale, measure) of each encode.
     points: Vec<(f64, f64)>,
+    /// A size budget's bytes outside the temporal segments' parts in the latest encode (first
+    /// frame, partition, atlas, skinning weights…), which the model leaves out; 0 for an error
+    /// budget.
+    fixed: f64,
     trials: Vec<BudgetTrial>,
     best: Option<(Encoded, usize)>,
     model: String,
@@ -262,6 +271,7 @@ impl<'a> Search<'a> {
             codec: opts.codec.codec(),
             limit: budget.limit(mesh),
             points: Vec::new(),
+            fixed: 0.0,
             trials: Vec::new(),
             best: None,
             model: String::new(),
@@ -291,8 +301,11 @@ impl<'a> Search<'a> {
             max_vertex_error: errors.map(|e| e.1),
         };
         let measure = self.budget.measure(&trial);
-        self.points
-            .push((log_scale(quality), measure.max(1e-300).ln()));
+        if self.budget.is_size() {
+            let segments = encoded.container.bytes_of(Tag::per_segment) as f64;
+            self.fixed = measure - segments;
+        }
+        self.points.push((log_scale(quality), measure));
         self.trials.push(trial);
         let better = match &self.best {
             Some((_, i)) => measure > self.budget.measure(&self.trials[*i]),
@@ -314,9 +327,7 @@ impl<'a> Search<'a> {
         if best.is_some_and(|m| self.landed(m)) || self.trials.len() >= MAX_BUDGET_ENCODES {
             return Ok(None);
         }
-        // Aim at the middle of the window, so that a model off by half the tolerance lands.
-        let aim = (self.limit * (1.0 - 0.5 * self.budget.tolerance())).ln();
-        let u = self.next_log_scale(aim);
+        let u = self.next_log_scale(self.aim()?);
         let (lowest, highest) = (log_scale(100.0), log_scale(1.0));
         let mut quality = quality_of(u.clamp(lowest, highest));
         // A quality already coded: step a hundredth at a time towards the budget's side.
@@ -331,20 +342,59 @@ impl<'a> Search<'a> {
         Ok(Some(quality))
     }
 
+    /// What the model is linear in against the log scale: the log of an error, or of the bytes
+    /// of a size beyond the latest encode's fixed bytes — the segments' parts, which the step
+    /// moves smoothly, while the fixed bytes are the same at every quality or jump (the skinning
+    /// weights' bits follow the affine step), so that a jump moves the aim instead of bending
+    /// the line (docs/design.md, "Budgets").
+    fn modelled(&self, measure: f64) -> f64 {
+        match self.budget.is_size() {
+            true => (measure - self.fixed).max(1.0).ln(),
+            false => measure.max(1e-300).ln(),
+        }
+    }
+
+    /// (log scale, modelled measure) of each encode.
+    fn modelled_points(&self) -> Vec<(f64, f64)> {
+        (self.points.iter())
+            .map(|&(u, measure)| (u, self.modelled(measure)))
+            .collect()
+    }
+
+    /// The modelled measure to aim at: the middle of the window, so that a model off by half
+    /// the tolerance lands (a size: at least half of what the fixed bytes leave under the
+    /// limit); fails when the fixed bytes alone fill a size budget.
+    fn aim(&self) -> Result<f64> {
+        let aim = self.limit * (1.0 - 0.5 * self.budget.tolerance());
+        let room = self.limit - self.fixed;
+        if self.budget.is_size() && room <= 0.0 {
+            return Err(Error::option(
+                self.option(),
+                format!(
+                    "out of reach: the parts no quality changes (first frame, partition, atlas) \
+                     take {} bytes with {}, over {:.0}",
+                    self.fixed, self.model, self.limit
+                ),
+            ));
+        }
+        Ok(self.modelled(aim.max(self.fixed + 0.5 * room)))
+    }
+
     /// Where the model puts the aim: inside the bracket when there is one (the secant through
     /// its ends, pulled towards the middle if it would land at an end: regula falsi's fix), else
     /// along the secant of the last two encodes (its slope kept within a factor of 4 of the prior,
     /// and of the prior's sign), or the prior's slope after one encode.
     fn next_log_scale(&self, aim: f64) -> f64 {
         let prior = self.budget.prior_slope(self.codec);
-        if let Some((below, above)) = self.bracket(aim) {
+        let points = self.modelled_points();
+        if let Some((below, above)) = bracket(&points, aim) {
             let t = ((aim - below.1) / (above.1 - below.1)).clamp(0.1, 0.9);
             return below.0 + t * (above.0 - below.0);
         }
-        let last = self.points[self.points.len() - 1];
-        let slope = match self.points.len() {
+        let last = points[points.len() - 1];
+        let slope = match points.len() {
             n if n >= 2 => {
-                let before = self.points[n - 2];
+                let before = points[n - 2];
                 let s = (last.1 - before.1) / (last.0 - before.0);
                 if s.is_finite() && s * prior > 0.0 {
                     prior.signum() * s.abs().clamp(prior.abs() / 4.0, prior.abs() * 4.0)
@@ -355,27 +405,6 @@ impl<'a> Search<'a> {
             _ => prior,
         };
         last.0 + (aim - last.1) / slope
-    }
-
-    /// Two encodes next to each other in log scale whose measures lie on either side of the aim
-    /// (below, above): of such pairs, the one with an end nearest the aim. Adjacent in the step,
-    /// not nearest in the measure, so that a measure that is not monotone (the largest vertex
-    /// error jumps from one quality to the next) still narrows the bracket at each encode.
-    fn bracket(&self, aim: f64) -> Option<((f64, f64), (f64, f64))> {
-        let mut sorted = self.points.clone();
-        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-        sorted
-            .windows(2)
-            .filter(|w| (w[0].1 > aim) != (w[1].1 > aim))
-            .map(|w| match w[0].1 > aim {
-                true => (w[1], w[0]),
-                false => (w[0], w[1]),
-            })
-            .min_by(|x, y| {
-                let near =
-                    |p: &((f64, f64), (f64, f64))| (p.0 .1 - aim).abs().min((p.1 .1 - aim).abs());
-                near(x).total_cmp(&near(y))
-            })
     }
 
     /// The model asks for a quality already coded: the search is at an end of the quality range
@@ -439,6 +468,27 @@ impl<'a> Search<'a> {
         };
         Ok(Budgeted { encoded, search })
     }
+}
+
+/// Two encodes next to each other in log scale whose measures lie on either side of the aim
+/// (below, above): of such pairs, the one with an end nearest the aim. Adjacent in the step,
+/// not nearest in the measure, so that a measure that is not monotone (the largest vertex
+/// error jumps from one quality to the next) still narrows the bracket at each encode.
+fn bracket(points: &[(f64, f64)], aim: f64) -> Option<((f64, f64), (f64, f64))> {
+    let mut sorted = points.to_vec();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    sorted
+        .windows(2)
+        .filter(|w| (w[0].1 > aim) != (w[1].1 > aim))
+        .map(|w| match w[0].1 > aim {
+            true => (w[1], w[0]),
+            false => (w[0], w[1]),
+        })
+        .min_by(|x, y| {
+            let near =
+                |p: &((f64, f64), (f64, f64))| (p.0 .1 - aim).abs().min((p.1 .1 - aim).abs());
+            near(x).total_cmp(&near(y))
+        })
 }
 
 /// The vertex RMSE and the largest vertex error of `encoded` against `mesh`, as fractions of the

@@ -189,6 +189,14 @@ impl ContainerWriter {
         self.parts.is_empty()
     }
 
+    /// Bytes the parts of the tags `which` selects take in the file, part headers included.
+    pub fn bytes_of(&self, which: impl Fn(Tag) -> bool) -> u64 {
+        (self.parts.iter())
+            .filter(|(tag, _, _)| which(*tag))
+            .map(|(_, p, _)| (PART_HEADER_LEN + p.len()) as u64)
+            .sum()
+    }
+
     /// Bytes each part takes in the file (payload plus its part header), by part name, in the
     /// order of first appearance; a segmented stream's parts of one kind are summed.
     pub fn part_sizes(&self) -> Vec<(String, u64)> {
