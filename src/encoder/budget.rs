@@ -91,11 +91,11 @@ impl Budget {
         }
     }
 
-    /// The first guess of d ln(measure) / d ln(target step), the measure of a size budget being the
-    /// bytes the step moves: the temporal DCT's fall about as the step's 0.75th power, the
-    /// picture codecs' about as its 1.3th (0.6–2.1 between qualities 10 and 90); the temporal
-    /// DCT's error follows the step nearly in proportion, the picture codecs' about as its 0.6th
-    /// power (docs/design.md, "Budgets").
+    /// The first guess of d ln(measure) / d ln(target step), a size's measure being its bytes
+    /// beyond the fixed ones: the temporal DCT's fall about as the step to the power 0.75, the
+    /// picture codecs' as its power 1.3 (0.6 to 2.1 between qualities 10 and 90); the temporal
+    /// DCT's error follows the step nearly in proportion, the picture codecs' about as its power
+    /// 0.6 (docs/design.md, "Budgets").
     fn prior_slope(&self, codec: Codec) -> f64 {
         match (self.is_size(), codec) {
             (true, Codec::Tdct) => -0.75,
@@ -258,6 +258,8 @@ struct Search<'a> {
     /// frame, partition, atlas, skinning weights…), which the model leaves out; 0 for an error
     /// budget.
     fixed: f64,
+    /// Of those, the bytes no quality changes (all but the skinning weights).
+    unchanging: f64,
     trials: Vec<BudgetTrial>,
     best: Option<(Encoded, usize)>,
     model: String,
@@ -272,6 +274,7 @@ impl<'a> Search<'a> {
             limit: budget.limit(mesh),
             points: Vec::new(),
             fixed: 0.0,
+            unchanging: 0.0,
             trials: Vec::new(),
             best: None,
             model: String::new(),
@@ -303,7 +306,9 @@ impl<'a> Search<'a> {
         let measure = self.budget.measure(&trial);
         if self.budget.is_size() {
             let segments = encoded.container.bytes_of(Tag::per_segment) as f64;
+            let weights = encoded.container.bytes_of(|tag| tag == Tag::WEIGHTS) as f64;
             self.fixed = measure - segments;
+            self.unchanging = self.fixed - weights;
         }
         self.points.push((log_scale(quality), measure));
         self.trials.push(trial);
@@ -363,20 +368,20 @@ impl<'a> Search<'a> {
 
     /// The modelled measure to aim at: the middle of the window, so that a model off by half
     /// the tolerance lands (a size: at least half of what the fixed bytes leave under the
-    /// limit); fails when the fixed bytes alone fill a size budget.
+    /// limit); fails when the bytes no quality changes fill a size budget alone.
     fn aim(&self) -> Result<f64> {
         let aim = self.limit * (1.0 - 0.5 * self.budget.tolerance());
-        let room = self.limit - self.fixed;
-        if self.budget.is_size() && room <= 0.0 {
+        if self.budget.is_size() && self.unchanging >= self.limit {
             return Err(Error::option(
                 self.option(),
                 format!(
                     "out of reach: the parts no quality changes (first frame, partition, atlas) \
                      take {} bytes with {}, over {:.0}",
-                    self.fixed, self.model, self.limit
+                    self.unchanging, self.model, self.limit
                 ),
             ));
         }
+        let room = self.limit - self.fixed;
         Ok(self.modelled(aim.max(self.fixed + 0.5 * room)))
     }
 
