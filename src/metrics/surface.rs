@@ -65,7 +65,7 @@ pub fn one_sided(
     same_triangles: bool,
     twins: Option<&[u32]>,
 ) -> Result<OneSided> {
-    let (mut area, mut sum, mut sum_sq, mut max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut area, mut sum, mut sum_sq, mut max_sq) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut last = None;
     let mut stack = Vec::new();
     for s in samples {
@@ -84,14 +84,20 @@ pub fn one_sided(
                 distance_squared: 0.0,
             }
         } else {
-            b.nearest_with(s.point, hints, &mut stack)
+            let hinted = b.nearest_hint(s.point, hints);
+            // A sample of no weight counts only for the maximum: when its hint is no farther
+            // than the maximum so far, the exact distance (no farther still) cannot change it.
+            if s.weight == 0.0 && hinted.distance_squared <= max_sq {
+                last = Some(hinted.triangle);
+                continue;
+            }
+            b.nearest_from(s.point, hinted, &mut stack)
         };
         last = Some(nearest.triangle);
-        let d = nearest.distance_squared.sqrt();
         area += s.weight;
-        sum += s.weight * d;
+        sum += s.weight * nearest.distance_squared.sqrt();
         sum_sq += s.weight * nearest.distance_squared;
-        max = max.max(d);
+        max_sq = max_sq.max(nearest.distance_squared);
     }
     if area <= 0.0 || !area.is_finite() {
         return Err(Error::Mesh(
@@ -101,7 +107,7 @@ pub fn one_sided(
     Ok(OneSided {
         rms: (sum_sq / area).sqrt(),
         mean: sum / area,
-        max,
+        max: max_sq.sqrt(),
         samples: samples.len(),
         area,
     })
