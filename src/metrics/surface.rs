@@ -69,13 +69,14 @@ pub fn one_sided(
     let mut last = None;
     let mut stack = Vec::new();
     for s in samples {
-        // The same-numbered face is right when the surfaces barely differ; the previous sample's
-        // answer when they differ a lot (a neighbouring sample has a neighbouring answer).
+        // The same-numbered face is right when the surfaces barely differ; without one, the
+        // previous sample's answer (a neighbouring sample has a neighbouring answer). Both at
+        // once cost an exact distance per query for a bound seldom tighter.
         let same_face = match twins {
             Some(t) => t.get(s.face as usize).copied().filter(|&f| f != NO_TWIN),
             None => same_triangles.then_some(s.face),
         };
-        let hints = same_face.into_iter().chain(last.filter(|&l| Some(l) != same_face));
+        let hints = same_face.or(last);
         // A face that did not move holds its samples exactly (a query would add rounding noise).
         let unmoved = same_triangles && b.corners(s.face) == Some(&corners(a, s.face));
         let nearest = if unmoved {
