@@ -208,17 +208,14 @@ impl TriangleBvh {
     /// The triangle nearest to `p`. `hint`, a triangle likely to be near (out-of-range hints are
     /// ignored), only speeds the search up: the answer is exact either way.
     pub fn nearest(&self, p: Vec3, hint: Option<u32>) -> Nearest {
-        self.nearest_with(p, hint, &mut Vec::with_capacity(MAX_DEPTH))
+        let best = self.nearest_hint(p, hint);
+        self.nearest_from(p, best, &mut Vec::with_capacity(MAX_DEPTH))
     }
 
-    /// [`Self::nearest`] with several hints (the nearest of them bounds the search) and a
-    /// caller-kept traversal stack, so that a run of queries allocates nothing.
-    pub fn nearest_with(
-        &self,
-        p: Vec3,
-        hints: impl IntoIterator<Item = u32>,
-        stack: &mut Vec<(u32, f64)>,
-    ) -> Nearest {
+    /// The nearest of the `hints` to `p` (infinitely far when there is none): an upper bound on
+    /// the distance to the surface, which is all a sample that only counts for the maximum may
+    /// need.
+    pub fn nearest_hint(&self, p: Vec3, hints: impl IntoIterator<Item = u32>) -> Nearest {
         let mut best = Nearest {
             triangle: 0,
             distance_squared: f64::INFINITY,
@@ -232,6 +229,13 @@ impl TriangleBvh {
                 };
             }
         }
+        best
+    }
+
+    /// The triangle nearest to `p`, searching from `best` (a triangle of this tree and its
+    /// distance, or an infinite distance; see [`Self::nearest_hint`]), which only bounds the
+    /// search; a caller-kept traversal `stack` spares a run of queries any allocation.
+    pub fn nearest_from(&self, p: Vec3, mut best: Nearest, stack: &mut Vec<(u32, f64)>) -> Nearest {
         // A near hint bounds the search to a few grid cells.
         let mut found = (best.distance_squared, best.triangle);
         if self.grid.improve(p, &self.corners, &mut found) {

@@ -46,6 +46,8 @@ pub struct TriangleGrid {
     oversized: Vec<u32>,
     /// Bounding box (low, high corner) of each triangle.
     boxes: Vec<[Vec3; 2]>,
+    /// (bucket, triangle) of each entry, in triangle order: kept for its memory.
+    listed: Vec<(u32, u32)>,
 }
 
 /// A triangle listed in a bucket, with its bounding box widened to `f32` (a query tests the box
@@ -149,6 +151,9 @@ impl TriangleGrid {
     fn fill(&mut self, triangles: usize) {
         let buckets = (2 * triangles).next_power_of_two();
         let mut count = vec![0u32; buckets + 1];
+        // Each (bucket, triangle) listing, found once: placing then needs no cell arithmetic.
+        let mut listed = std::mem::take(&mut self.listed);
+        listed.clear();
         for (t, b) in self.boxes.iter().enumerate() {
             let range = self.cells(b[0], b[1]);
             if cell_count(&range) > MAX_CELLS_PER_TRIANGLE {
@@ -156,13 +161,16 @@ impl TriangleGrid {
                 continue;
             }
             for_each_cell(&range, |c| {
-                if let Some(n) = count.get_mut(bucket(c, buckets) + 1) {
+                let k = bucket(c, buckets);
+                if let Some(n) = count.get_mut(k + 1) {
                     *n += 1;
+                    listed.push((k as u32, t as u32));
                 }
             });
         }
         if self.oversized.len() > MAX_OVERSIZED {
             self.oversized.clear();
+            self.listed = listed;
             return;
         }
         for b in 1..count.len() {
@@ -172,20 +180,20 @@ impl TriangleGrid {
             .resize(count.last().copied().unwrap_or(0) as usize, Entry::default());
         // `next[b]`: where bucket b's next entry goes.
         let mut next = count.clone();
-        for (t, b) in self.boxes.iter().enumerate() {
-            let range = self.cells(b[0], b[1]);
-            if cell_count(&range) > MAX_CELLS_PER_TRIANGLE {
-                continue;
+        let mut current = (u32::MAX, Entry::default());
+        for &(k, t) in &listed {
+            if current.0 != t {
+                let b = self.boxes.get(t as usize).copied().unwrap_or_default();
+                current = (t, Entry::new(&b, t));
             }
-            for_each_cell(&range, |c| {
-                if let Some(slot) = next.get_mut(bucket(c, buckets)) {
-                    if let Some(e) = self.entries.get_mut(*slot as usize) {
-                        *e = Entry::new(b, t as u32);
-                    }
-                    *slot += 1;
+            if let Some(slot) = next.get_mut(k as usize) {
+                if let Some(e) = self.entries.get_mut(*slot as usize) {
+                    *e = current.1;
                 }
-            });
+                *slot += 1;
+            }
         }
+        self.listed = listed;
         self.start = count;
     }
 

@@ -2,12 +2,13 @@
 //!
 //! Each face is cut into `n²` similar sub-triangles (`n` from the face's longest edge and a spacing
 //! relative to the bounding-box diagonal, see [`sample_spacing`]); each sub-triangle is integrated
-//! with the classic 7-point rule (corners 1/20, edge midpoints 2/15, centroid 9/20 of its area),
-//! exact for cubics. A squared distance to a nearby surface is close to a low-degree polynomial
-//! across a small triangle, so the RMS converges far faster than with random samples, and no seed
-//! is needed. Points shared by neighbouring faces (mesh vertices, points on shared edges) are one
-//! sample carrying all their weights; the vertices, where a displaced surface's distance often
-//! peaks, are thereby always sampled for the maximum.
+//! with the 3-point edge-midpoint rule (a third of its area at each edge midpoint), exact for
+//! quadratics. The squared distance from a face to the plane of a nearby face is exactly quadratic
+//! across it, so the RMS converges far faster than with random samples, and no seed is needed.
+//! Points shared by neighbouring faces (points on shared edges) are one sample carrying all their
+//! weights. The sub-triangles' corners, the mesh vertices among them, where a displaced surface's
+//! distance often peaks, are samples of no weight: they count for the maximum only, and come after
+//! the weighted samples, so that most of them are settled by the maximum already found.
 
 use super::triangle::{triangle_area, Vec3};
 use crate::mesh::{Point, Triangle};
@@ -90,10 +91,10 @@ pub struct SamplingPlan {
     shares: Vec<(u32, f64)>,
 }
 
-/// 7-point rule weights, as fractions of a sub-triangle's area.
-const CORNER: f64 = 1.0 / 20.0;
-const MIDPOINT: f64 = 2.0 / 15.0;
-const CENTROID: f64 = 9.0 / 20.0;
+/// The edge-midpoint rule's weight, as a fraction of a sub-triangle's area. (The 7-point rule,
+/// exact for cubics, took twice the full queries on pdance for RMS values within 0.03 %:
+/// docs/design.md, "Surface RMSE: 50 samples per diagonal".)
+const MIDPOINT: f64 = 1.0 / 3.0;
 
 impl SamplingPlan {
     /// Plans the samples of `triangles`, choosing each face's subdivision from its size at
@@ -117,7 +118,6 @@ impl SamplingPlan {
             let sub = 1.0 / (n * n) as f64;
             let face = f as u32;
             planner.add_lattice(face, t, n, sub);
-            planner.add_centroids(face, n, sub);
         }
         planner.finish()
     }
@@ -225,41 +225,30 @@ impl Planner {
         }
     }
 
-    /// Centroids of the upward (corner sum n − 1) and downward (n − 2) sub-triangles.
-    fn add_centroids(&mut self, face: u32, n: usize, sub: f64) {
-        let nf = n as f64;
-        let upward = (n - 1, 1.0 / 3.0);
-        let downward = n.checked_sub(2).map(|sum| (sum, 2.0 / 3.0));
-        for (sum, shift) in std::iter::once(upward).chain(downward) {
-            for i in 0..=sum {
-                for j in 0..=(sum - i) {
-                    let k = sum - i - j;
-                    self.samples.push(Planned {
-                        face,
-                        bary: [i, j, k].map(|x| (x as f64 + shift) / nf),
-                        shares: (0, 0),
-                    });
-                    self.shares.push(vec![(face, CENTROID * sub)]);
-                }
-            }
-        }
-    }
-
-    /// Flattens the shares into one list the samples index.
+    /// Flattens the shares into one list the samples index, the weighted samples first (in the
+    /// order planned, so neighbours stay neighbours), then those of no weight.
     fn finish(self) -> SamplingPlan {
         let Self {
-            mut samples,
-            shares,
-            ..
+            samples, shares, ..
         } = self;
+        let weighted = |list: &Vec<(u32, f64)>| list.iter().any(|&(_, f)| f > 0.0);
         let mut flat = Vec::with_capacity(shares.iter().map(Vec::len).sum());
-        for (s, list) in samples.iter_mut().zip(&shares) {
-            let start = flat.len() as u32;
-            flat.extend_from_slice(list);
-            s.shares = (start, flat.len() as u32);
+        let mut ordered = Vec::with_capacity(samples.len());
+        for want in [true, false] {
+            for (s, list) in samples.iter().zip(&shares) {
+                if weighted(list) != want {
+                    continue;
+                }
+                let start = flat.len() as u32;
+                flat.extend(list.iter().filter(|&&(_, f)| f > 0.0));
+                ordered.push(Planned {
+                    shares: (start, flat.len() as u32),
+                    ..*s
+                });
+            }
         }
         SamplingPlan {
-            samples,
+            samples: ordered,
             shares: flat,
         }
     }
@@ -269,12 +258,9 @@ impl Planner {
 fn lattice_fraction(i: usize, j: usize, k: usize) -> f64 {
     let zeros = [i, j, k].iter().filter(|&&x| x == 0).count();
     let corner = i % 2 == 0 && j % 2 == 0 && k % 2 == 0;
-    // Sub-triangles meeting at a corner: 1 at a face corner, 3 on a face edge,
-    // 6 inside; sharing a midpoint: 1 on a face edge, 2 inside.
+    // A corner has no weight; a midpoint belongs to 1 sub-triangle on a face edge, 2 inside.
     match (corner, zeros) {
-        (true, 2) => CORNER,
-        (true, 1) => 3.0 * CORNER,
-        (true, _) => 6.0 * CORNER,
+        (true, _) => 0.0,
         (false, 1) => MIDPOINT,
         (false, _) => 2.0 * MIDPOINT,
     }
@@ -313,26 +299,49 @@ mod tests {
             let s = sample_surface(&[[0, 1, 2]], &positions, spacing);
             let total: f64 = s.iter().map(|s| s.weight).sum();
             assert!((total - 6.0).abs() < 1e-12, "spacing {spacing}: {total}");
-            assert!(s.iter().all(|s| s.weight > 0.0));
+            assert!(s.iter().all(|s| s.weight >= 0.0));
+            assert!(s.iter().filter(|s| s.weight > 0.0).count() >= 3);
         }
     }
 
     #[test]
-    fn integrates_a_cubic_exactly() {
-        // Over the triangle (0,0),(1,0),(0,1): ∫ x² = 1/12, ∫ x³ = 1/20, ∫ x²y = 1/60.
+    fn integrates_a_quadratic_exactly_and_a_cubic_ever_better() {
+        // Over the triangle (0,0),(1,0),(0,1): ∫ x = 1/6, ∫ x² = 1/12, ∫ xy = 1/24, ∫ x³ = 1/20.
         let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         type Integrand = fn(Vec3) -> f64;
         let cases: [(Integrand, f64); 3] = [
+            (|p| p[0], 1.0 / 6.0),
             (|p| p[0].powi(2), 1.0 / 12.0),
-            (|p| p[0].powi(3), 1.0 / 20.0),
-            (|p| p[0].powi(2) * p[1], 1.0 / 60.0),
+            (|p| p[0] * p[1], 1.0 / 24.0),
         ];
+        let integral = |s: &[Sample], f: Integrand| -> f64 { s.iter().map(|s| s.weight * f(s.point)).sum() };
+        let mut cubic_error = f64::INFINITY;
         for spacing in [2.0, 0.4, 0.1] {
             let s = sample_surface(&[[0, 1, 2]], &positions, spacing);
             for (f, want) in cases {
-                let integral: f64 = s.iter().map(|s| s.weight * f(s.point)).sum();
-                assert!((integral - want).abs() < 1e-12, "{integral} vs {want}");
+                let got = integral(&s, f);
+                assert!((got - want).abs() < 1e-12, "{got} vs {want}");
             }
+            // Not exact for a cubic, but converging as the sub-triangles shrink.
+            let error = (integral(&s, |p| p[0].powi(3)) - 1.0 / 20.0).abs();
+            assert!(error > 0.0 && error < cubic_error, "spacing {spacing}: {error}");
+            cubic_error = error;
+        }
+        assert!(cubic_error < 1e-4, "{cubic_error}");
+    }
+
+    #[test]
+    fn corners_come_last_with_no_weight() {
+        let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let s = sample_surface(&[[0, 1, 2]], &positions, 0.5);
+        let weighted = s.iter().take_while(|s| s.weight > 0.0).count();
+        assert!(s[weighted..].iter().all(|s| s.weight == 0.0));
+        // Level 3: 3² sub-triangles with 18 distinct edge midpoints, and 10 corners.
+        assert_eq!((weighted, s.len() - weighted), (18, 10));
+        // The mesh vertices are among the corners, for the maximum.
+        for corner in positions {
+            let c = corner.map(f64::from);
+            assert!(s[weighted..].iter().any(|s| s.point == c), "{c:?}");
         }
     }
 
@@ -348,9 +357,8 @@ mod tests {
         let tris = [[0, 1, 2], [3, 2, 1]];
         for (spacing, level) in [(2.0, 1usize), (0.5, 3)] {
             let s = sample_surface(&tris, &positions, spacing);
-            // Per face: the (2L+1)(2L+2)/2 lattice points and L² centroids; the shared edge
-            // holds 2L+1 of them.
-            let per_face = (level + 1) * (2 * level + 1) + level * level;
+            // Per face: the (2L+1)(2L+2)/2 lattice points; the shared edge holds 2L+1 of them.
+            let per_face = (level + 1) * (2 * level + 1);
             assert_eq!(s.len(), 2 * per_face - (2 * level + 1), "level {level}");
             let total: f64 = s.iter().map(|s| s.weight).sum();
             assert!((total - 1.0).abs() < 1e-12);
@@ -362,7 +370,7 @@ mod tests {
         let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let coarse = sample_surface(&[[0, 1, 2]], &positions, 2.0).len();
         let fine = sample_surface(&[[0, 1, 2]], &positions, 0.1).len();
-        assert_eq!(coarse, 3 + 3 + 1);
+        assert_eq!(coarse, 3 + 3);
         assert!(fine > 10 * coarse);
     }
 }

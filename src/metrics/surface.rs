@@ -65,17 +65,18 @@ pub fn one_sided(
     same_triangles: bool,
     twins: Option<&[u32]>,
 ) -> Result<OneSided> {
-    let (mut area, mut sum, mut sum_sq, mut max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut area, mut sum, mut sum_sq, mut max_sq) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut last = None;
     let mut stack = Vec::new();
     for s in samples {
-        // The same-numbered face is right when the surfaces barely differ; the previous sample's
-        // answer when they differ a lot (a neighbouring sample has a neighbouring answer).
+        // The same-numbered face is right when the surfaces barely differ; without one, the
+        // previous sample's answer (a neighbouring sample has a neighbouring answer). Both at
+        // once cost an exact distance per query for a bound seldom tighter.
         let same_face = match twins {
             Some(t) => t.get(s.face as usize).copied().filter(|&f| f != NO_TWIN),
             None => same_triangles.then_some(s.face),
         };
-        let hints = same_face.into_iter().chain(last.filter(|&l| Some(l) != same_face));
+        let hints = same_face.or(last);
         // A face that did not move holds its samples exactly (a query would add rounding noise).
         let unmoved = same_triangles && b.corners(s.face) == Some(&corners(a, s.face));
         let nearest = if unmoved {
@@ -84,14 +85,20 @@ pub fn one_sided(
                 distance_squared: 0.0,
             }
         } else {
-            b.nearest_with(s.point, hints, &mut stack)
+            let hinted = b.nearest_hint(s.point, hints);
+            // A sample of no weight counts only for the maximum: when its hint is no farther
+            // than the maximum so far, the exact distance (no farther still) cannot change it.
+            if s.weight == 0.0 && hinted.distance_squared <= max_sq {
+                last = Some(hinted.triangle);
+                continue;
+            }
+            b.nearest_from(s.point, hinted, &mut stack)
         };
         last = Some(nearest.triangle);
-        let d = nearest.distance_squared.sqrt();
         area += s.weight;
-        sum += s.weight * d;
+        sum += s.weight * nearest.distance_squared.sqrt();
         sum_sq += s.weight * nearest.distance_squared;
-        max = max.max(d);
+        max_sq = max_sq.max(nearest.distance_squared);
     }
     if area <= 0.0 || !area.is_finite() {
         return Err(Error::Mesh(
@@ -101,7 +108,7 @@ pub fn one_sided(
     Ok(OneSided {
         rms: (sum_sq / area).sqrt(),
         mean: sum / area,
-        max,
+        max: max_sq.sqrt(),
         samples: samples.len(),
         area,
     })
