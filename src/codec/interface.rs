@@ -48,6 +48,9 @@ pub(crate) struct CodedResiduals {
     pub setup: Vec<u8>,
     /// The atlas's figures, for codecs with an atlas.
     pub atlas: Option<atlas::AtlasStats>,
+    /// The atlas itself and its lattice (codecs with an atlas), for later encodings on the same
+    /// first frame and partition.
+    pub built_atlas: Option<((u16, u16), atlas::Atlas)>,
     /// Whole-stream parts written after the set-up, before the predictor's (geometry video: the
     /// lattice coordinates).
     pub before_predictor: Vec<Part>,

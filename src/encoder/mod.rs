@@ -100,6 +100,9 @@ pub struct Encoded {
     /// The motion model and clusters it was coded with, for trials that keep them.
     pub(crate) model: MotionModel,
     pub(crate) partition: Partition,
+    /// The atlas the pictures were laid on (picture codecs), which a segmented encoding's
+    /// segments reuse instead of building it again.
+    pub(crate) atlas: Option<((u16, u16), atlas::Atlas)>,
 }
 
 impl Encoded {
@@ -377,10 +380,12 @@ fn code(
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
     let (partition, prediction) = (analysed.partition, analysed.prediction);
-    let coded = (settings.plan.encoder()?).encode(&residual_input(mesh, ff, analysed, progress))?;
+    let mut coded =
+        (settings.plan.encoder()?).encode(&residual_input(mesh, ff, analysed, progress))?;
     clock.stages.extend(coded.stage_seconds.iter().cloned());
     clock.restart();
     let atlas = coded.atlas.clone();
+    let built_atlas = coded.built_atlas.take();
     let model = analysed.model;
     let header = header(mesh, settings, model, partition);
     let parts = coded.into_parts();
@@ -409,6 +414,7 @@ fn code(
         report,
         model,
         partition: partition.clone(),
+        atlas: built_atlas,
     })
 }
 

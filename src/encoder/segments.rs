@@ -245,7 +245,10 @@ impl SegmentedEncoder {
             segment_frames: None,
             ..opts.clone()
         };
-        let encoded = super::encode_with_progress(analysis, &whole, &NoTotal(progress))?;
+        let mut encoded = super::encode_with_progress(analysis, &whole, &NoTotal(progress))?;
+        // The segments' atlas is the analysis clip's (same first frame, partition and lattice
+        // option; `check_shared` holds them to its lattice part): built once, not twice.
+        let atlas = encoded.atlas.take().map_or_else(AtlasCache::default, AtlasCache::holding);
         let shared = Analysis {
             stream: encoded.to_bytes(),
             length,
@@ -255,7 +258,7 @@ impl SegmentedEncoder {
             model: encoded.model,
             options: options_checksum(opts),
         };
-        Self::from_analysis(shared, opts, Some(encoded.report), clock)
+        Self::from_analysis(shared, opts, (Some(encoded.report), atlas), clock)
     }
 
     /// The analysis [`SegmentedEncoder::start`] made, as bytes (the analysis clip's stream and
@@ -278,16 +281,17 @@ impl SegmentedEncoder {
                 "the analysis was made with other encoding options: resume with the same".into(),
             ));
         }
-        Self::from_analysis(analysis, opts, None, Instant::now())
+        let fresh = (None, AtlasCache::default());
+        Self::from_analysis(analysis, opts, fresh, Instant::now())
     }
 
     /// The encoder of an analysis: everything but the analysis' own figures (`report`, when it
-    /// was just made) is read from the analysis clip's stream as the decoder reads it, so a
-    /// started and a resumed encoder agree.
+    /// was just made) and its atlas (`atlas`, when one was built) is read from the analysis
+    /// clip's stream as the decoder reads it, so a started and a resumed encoder agree.
     fn from_analysis(
         analysis: Analysis,
         opts: &EncodeOptions,
-        report: Option<EncodeReport>,
+        (report, atlas): (Option<EncodeReport>, AtlasCache),
         clock: Instant,
     ) -> Result<Self> {
         let decoder = Decoder::new(&analysis.stream)?;
@@ -338,7 +342,7 @@ impl SegmentedEncoder {
             partition,
             weights,
             plan,
-            atlas: AtlasCache::default(),
+            atlas,
             header,
             shared,
             segments: Vec::new(),
@@ -437,6 +441,7 @@ impl SegmentedEncoder {
             report,
             model: self.analysis.model,
             partition: self.partition,
+            atlas: None,
         })
     }
 

@@ -57,6 +57,12 @@ pub struct AtlasCache(std::sync::OnceLock<((u16, u16), atlas::Atlas)>);
 
 #[cfg(feature = "encode")]
 impl AtlasCache {
+    /// A cache that already holds `built` (an encoding's atlas, handed on to later encodings on
+    /// the same first frame, partition and lattice option).
+    pub fn holding(built: ((u16, u16), atlas::Atlas)) -> Self {
+        Self(std::sync::OnceLock::from(built))
+    }
+
     /// The cached atlas, or `build`'s result (kept for the next call).
     pub fn get_or_build(
         &self,

@@ -105,6 +105,7 @@ impl ResidualEncoder for Encoder {
             input.mesh.triangles(),
         )?;
         let stats = images.atlas.stats().clone();
+        let built_atlas = Some((images.lattice, images.atlas));
         let setup = PictureSetup {
             lattice: images.lattice,
             quantiser: self.plan.quantiser,
@@ -118,6 +119,7 @@ impl ResidualEncoder for Encoder {
         Ok(CodedResiduals {
             setup: setup.to_bytes(),
             atlas: Some(stats),
+            built_atlas,
             before_predictor: vec![Part::whole(Tag::LATTICE, lattice_part)],
             after_predictor: vec![
                 Part::whole(Tag::RANGES, ranges),
