@@ -46,11 +46,9 @@ pub(crate) struct CodedResiduals {
     /// The payload of the codec's set-up part (whole stream, first of the codec's parts): its
     /// own version and settings.
     pub setup: Vec<u8>,
-    /// The atlas's figures, for codecs with an atlas.
-    pub atlas: Option<atlas::AtlasStats>,
-    /// The atlas itself and its lattice (codecs with an atlas), for later encodings on the same
-    /// first frame and partition.
-    pub built_atlas: Option<((u16, u16), atlas::Atlas)>,
+    /// The atlas and its lattice (codecs with an atlas): its figures for the report, and the
+    /// atlas itself for later encodings on the same first frame and partition.
+    pub atlas: Option<((u16, u16), atlas::Atlas)>,
     /// Whole-stream parts written after the set-up, before the predictor's (geometry video: the
     /// lattice coordinates).
     pub before_predictor: Vec<Part>,

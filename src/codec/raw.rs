@@ -60,7 +60,6 @@ impl ResidualEncoder for Encoder {
         Ok(CodedResiduals {
             setup: setup.into_bytes(),
             atlas: None,
-            built_atlas: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
                 Part::whole(Tag::FRAME_INDEX, index.to_bytes()),

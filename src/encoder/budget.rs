@@ -252,8 +252,6 @@ struct Search<'a> {
     budget: Budget,
     codec: Codec,
     limit: f64,
-    /// (log scale, measure) of each encode.
-    points: Vec<(f64, f64)>,
     /// A size budget's bytes outside the temporal segments' parts in the latest encode (first
     /// frame, partition, atlas, skinning weights…), which the model leaves out; 0 for an error
     /// budget.
@@ -272,7 +270,6 @@ impl<'a> Search<'a> {
             budget,
             codec: opts.codec.codec(),
             limit: budget.limit(mesh),
-            points: Vec::new(),
             fixed: 0.0,
             unchanging: 0.0,
             trials: Vec::new(),
@@ -310,7 +307,6 @@ impl<'a> Search<'a> {
             self.fixed = measure - segments;
             self.unchanging = self.fixed - weights;
         }
-        self.points.push((log_scale(quality), measure));
         self.trials.push(trial);
         let better = match &self.best {
             Some((_, i)) => measure > self.budget.measure(&self.trials[*i]),
@@ -361,8 +357,8 @@ impl<'a> Search<'a> {
 
     /// (log scale, modelled measure) of each encode.
     fn modelled_points(&self) -> Vec<(f64, f64)> {
-        (self.points.iter())
-            .map(|&(u, measure)| (u, self.modelled(measure)))
+        (self.trials.iter())
+            .map(|t| (log_scale(t.quality), self.modelled(self.budget.measure(t))))
             .collect()
     }
 

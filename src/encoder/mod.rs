@@ -384,8 +384,8 @@ fn code(
         (settings.plan.encoder()?).encode(&residual_input(mesh, ff, analysed, progress))?;
     clock.stages.extend(coded.stage_seconds.iter().cloned());
     clock.restart();
-    let atlas = coded.atlas.clone();
-    let built_atlas = coded.built_atlas.take();
+    let atlas = coded.atlas.take();
+    let stats = atlas.as_ref().map(|(_, a)| a.stats());
     let model = analysed.model;
     let header = header(mesh, settings, model, partition);
     let parts = coded.into_parts();
@@ -398,10 +398,10 @@ fn code(
         bpvf: container.len() as f64 * 8.0 / (mesh.vertex_count() * mesh.frame_count()) as f64,
         header,
         codec: settings.opts.codec.codec(),
-        charts: atlas.as_ref().map_or(0, |s| s.charts),
-        packing_efficiency: atlas.as_ref().map_or(0.0, |s| s.packing_efficiency),
-        moved_vertices: atlas.as_ref().map_or(0, |s| s.moved_vertices),
-        l2_stretch: atlas.as_ref().map_or(0.0, |s| s.l2_stretch),
+        charts: stats.map_or(0, |s| s.charts),
+        packing_efficiency: stats.map_or(0.0, |s| s.packing_efficiency),
+        moved_vertices: stats.map_or(0, |s| s.moved_vertices),
+        l2_stretch: stats.map_or(0.0, |s| s.l2_stretch),
         stage_seconds: clock.stages,
         segmentation: analysed.segmentation.clone(),
         choice: None,
@@ -414,7 +414,7 @@ fn code(
         report,
         model,
         partition: partition.clone(),
-        atlas: built_atlas,
+        atlas,
     })
 }
 

@@ -176,12 +176,7 @@ impl ContainerWriter {
 
     /// The file's length in bytes, without serialising it.
     pub fn len(&self) -> u64 {
-        let parts: usize = self
-            .parts
-            .iter()
-            .map(|(_, p, _)| PART_HEADER_LEN + p.len())
-            .sum();
-        (FILE_HEADER_LEN + parts) as u64
+        FILE_HEADER_LEN as u64 + self.bytes_of(|_| true)
     }
 
     /// Whether the container holds no part.

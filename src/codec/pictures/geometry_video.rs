@@ -104,8 +104,7 @@ impl ResidualEncoder for Encoder {
             images.lattice,
             input.mesh.triangles(),
         )?;
-        let stats = images.atlas.stats().clone();
-        let built_atlas = Some((images.lattice, images.atlas));
+        let stats = images.atlas.stats();
         let setup = PictureSetup {
             lattice: images.lattice,
             quantiser: self.plan.quantiser,
@@ -118,8 +117,7 @@ impl ResidualEncoder for Encoder {
         };
         Ok(CodedResiduals {
             setup: setup.to_bytes(),
-            atlas: Some(stats),
-            built_atlas,
+            atlas: Some((images.lattice, images.atlas)),
             before_predictor: vec![Part::whole(Tag::LATTICE, lattice_part)],
             after_predictor: vec![
                 Part::whole(Tag::RANGES, ranges),

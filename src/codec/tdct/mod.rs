@@ -94,7 +94,6 @@ impl ResidualEncoder for Encoder {
         Ok(CodedResiduals {
             setup: vec![SETUP_VERSION],
             atlas: None,
-            built_atlas: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
                 Part::whole(Tag::TDCT_INDEX, index.to_bytes()?),
