@@ -189,7 +189,7 @@ pub fn encode_to_budget_with_progress(
     let start = opts.fine_quality.unwrap_or(f64::from(opts.quality));
     let first = encode_with_progress(mesh, &at_quality(opts, start), progress)?;
     let pinned = pin_choices(opts, &first);
-    search.model = model_name(&pinned);
+    search.model = model_name(&pinned, first.report.segmentation.clusters);
     search.record(first, start)?;
     while let Some(quality) = search.next_quality()? {
         let encoded = encode_with_progress(mesh, &at_quality(&pinned, quality), progress)?;
@@ -220,12 +220,13 @@ fn pin_choices(opts: &EncodeOptions, first: &Encoded) -> EncodeOptions {
     }
 }
 
-fn model_name(pinned: &EncodeOptions) -> String {
+/// The pinned model as the report names it; `clusters` is the count the first encode's
+/// segmentation found (decimation's own, not the `clusters` option it does not use).
+fn model_name(pinned: &EncodeOptions, clusters: usize) -> String {
     let models = pinned.motion_models();
     let name = models.first().map_or_else(String::new, |m| m.name());
     format!(
-        "{name}, K {}, first frame {} bits",
-        pinned.clusters,
+        "{name}, K {clusters}, first frame {} bits",
         pinned.first_frame_bits_or_default()
     )
 }
