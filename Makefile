@@ -101,13 +101,15 @@ demo: deps
 
 # The second clippy builds the library and the binary alone, as a user does: without the
 # `internals` feature the tests turn on, so an internal item used only by tests is dead code there,
-# and the CLI cannot reach past the library's public API. The docs must build without a warning.
+# and the CLI cannot reach past the library's public API. The docs must build without a warning,
+# the internal modules' too (`internals`), so that their links do not rot.
 test: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets --quiet -- -D warnings
 	$(CARGO) clippy --workspace --lib --bins --quiet -- -D warnings
 	$(CARGO) clippy -p mcgv-video-cli --no-default-features --quiet -- -D warnings
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps -p mcgv-video --quiet
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps -p mcgv-video --features internals --quiet
 	MCGV_PYTHON=$(abspath $(PY)) $(CARGO) test --workspace --quiet
 	$(PY) scripts/test_peers.py
 	$(MAKE) --no-print-directory web-build

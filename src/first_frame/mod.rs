@@ -5,13 +5,13 @@
 //! degenerate triangles u32, welded vertices u32, bbox lo 3×f32, bbox hi 3×f32,
 //! connectivity length u32, geometry length u32, order length u32, crc32 u32` then the three
 //! range-coded streams, all over the *welded* mesh, whose vertices are the distinct positions (see
-//! [`weld`]: seam copies and triangle soups become one connected surface):
-//! - connectivity: the [`traversal`] symbols of the triangles whose corners are three welded
+//! `weld`: seam copies and triangle soups become one connected surface):
+//! - connectivity: the `traversal` symbols of the triangles whose corners are three welded
 //!   vertices, then the copies of each welded vertex and which one each corner uses, then the
 //!   degenerate triangles (a repeated welded vertex), which no traversal can reach, as plain
 //!   adaptive-coded indices;
 //! - geometry: the quantised welded positions in traversal order (those in no triangle appended
-//!   in input order), coded after the connectivity by [`geometry`]: multi-parallelogram
+//!   in input order), coded after the connectivity by `geometry`: multi-parallelogram
 //!   prediction, else the mean of coded neighbours, else the previous vertex;
 //! - order: the output → input vertex permutation, absent with `reorder`.
 //!

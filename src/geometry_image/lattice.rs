@@ -23,7 +23,7 @@ pub enum Lattice {
 const AUTO_PIXELS_PER_VERTEX: f64 = 1.9;
 
 /// The first lattice side `Lattice::Auto` tries for `vertices`: about
-/// [`AUTO_PIXELS_PER_VERTEX`] pixels per vertex, at least 32, in multiples of 16.
+/// `AUTO_PIXELS_PER_VERTEX` pixels per vertex, at least 32, in multiples of 16.
 pub fn auto_side(vertices: usize) -> u16 {
     round_up_16((vertices as f64 * AUTO_PIXELS_PER_VERTEX).sqrt()).max(32)
 }

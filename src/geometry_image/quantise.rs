@@ -4,7 +4,7 @@
 //! A residual `r` of one coordinate becomes the level `r / step − offset + mid`, mid-grey being
 //! 2^(depth − 1) at the picture codec's sample depth (128 for the 8-bit JPEG and MPEG-4, 512 or 2048
 //! for HEVC at 10 or 12 bits): mid-grey is the offset, one grey level one step. The step is the encoding's pixel step (a fraction of the first
-//! frame's bounding-box diagonal that `quality` sets, [`crate::codec::quality`]), so a frame whose
+//! frame's bounding-box diagonal that `quality` sets, `crate::codec::quality`), so a frame whose
 //! residuals are small makes a near-flat picture that costs almost nothing, and a better predictor
 //! buys fewer bits rather than finer levels. The offset (an integer number of steps) centres the
 //! 2^depth levels on the frame's residuals.

@@ -1,6 +1,6 @@
 //! Reading and writing animations in every form the tool takes: OBJ sequences, PC2 + base OBJ, glTF.
 //!
-//! The formats themselves live in [`super::obj`], [`super::pc2`] and [`super::gltf`]; this
+//! The formats themselves live in `super::obj`, `super::pc2` and `super::gltf`; this
 //! module picks one from the input's name and writes files so that a failure never leaves half of one.
 
 use super::{gltf, obj, pc2, AnimatedMesh};

@@ -66,7 +66,7 @@ impl Default for SegmentOptions {
 ///    trajectory best instead.
 /// 3. `opts.refine_passes` passes move cluster borders to lower the prediction error (see
 ///    [`SegmentOptions::refine_passes`]).
-/// 4. Clusters with fewer than [`MIN_CLUSTER_SIZE`] vertices are dissolved, smallest first, into the
+/// 4. Clusters with fewer than `MIN_CLUSTER_SIZE` vertices are dissolved, smallest first, into the
 ///    nearest remaining k-means centroid; empty ones vanish; labels are renumbered in order of first vertex.
 pub fn segment(mesh: &AnimatedMesh, opts: &SegmentOptions) -> Result<Partition> {
     check(opts)?;

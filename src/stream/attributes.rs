@@ -2,7 +2,7 @@
 //! coded once for the whole animation, in the decoder's vertex and triangle order.
 //!
 //! Each texture-coordinate set is quantised to `bits` bits over its own bounding box and coded by
-//! [`super::texcoords`] (reuse of a welded copy's coordinate, else the 3D triangle projected into
+//! `super::texcoords` (reuse of a welded copy's coordinate, else the 3D triangle projected into
 //! UV) through the stream's adaptive entropy coder. Materials are one
 //! "same as the previous triangle" bit per triangle, and the index when not.
 //! The coding routine is written once for both directions ([`SymbolCoder`]).

@@ -5,11 +5,11 @@
 //! profile 2 at 12 (libaom picks the profile from the pixel format). The quantiser is libaom's
 //! constant-quality level (`crf` 0..63, end usage `q`: no rate control), `tune=psnr`. A key frame
 //! every `gop` frames (every frame with `gop` 1: all-intra), P-frames between, which look ahead
-//! [`LAG_IN_FRAMES`] frames for hidden alternate-reference frames; one packet per frame (a hidden
+//! `LAG_IN_FRAMES` frames for hidden alternate-reference frames; one packet per frame (a hidden
 //! frame rides in the packet of a shown one), in order, the sequence header in-band on every key
 //! frame. One thread and no row multi-threading, so the output does not depend on scheduling.
 //!
-//! `cpu-used` [`CPU_USED`] trades compression for speed (docs/design.md, "AV1 settings").
+//! `cpu-used` `CPU_USED` trades compression for speed (docs/design.md, "AV1 settings").
 
 use super::deep::DeepConfig;
 use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};

@@ -1,8 +1,8 @@
 //! What the FFmpeg picture codecs at 10 or 12 bits a sample ([`super::hevc`], [`super::av1`])
 //! share: the x | y | z picture layout ([`Planes`]), a fixed-quantiser encoder and a one-thread
 //! decoder of 16-bit little-endian planes, the codec set-up part (sample depth and planes) and the
-//! geometry-video glue ([`Pictures`]). What tells the codecs apart, the FFmpeg encoder and its
-//! settings, the decoder and the quality law, is a [`Flavour`].
+//! geometry-video glue (`Pictures`). What tells the codecs apart, the FFmpeg encoder and its
+//! settings, the decoder and the quality law, is a `Flavour`.
 //!
 //! Each group of pictures has its own encoder (the geometry-video coder runs groups on several
 //! threads), which makes one key frame, then P-frames, one packet per frame in order; headers are

@@ -2,7 +2,7 @@
 //!
 //! Encoding builds the atlas on the decoded first frame, splats each frame's quantised residuals
 //! onto it, pads the free pixels, tiles x | y | z into one picture and hands the pictures to a
-//! [`PictureCodec`]. Its parts, in file order: the set-up ([`PictureSetup`]) and the lattice
+//! `PictureCodec`. Its parts, in file order: the set-up (`PictureSetup`) and the lattice
 //! coordinates (the whole stream's, before the predictor's), then a segment's residual ranges
 //! (pixel step, per-frame shifts and offsets, the correction list), frame index and coded frames.
 //! Decoding reads the frames from the last key frame before the one asked for.

@@ -5,7 +5,7 @@
 //! The x | y | z picture is coded as the three planes of a 4:4:4 picture (`yuv444p10le`,
 //! `yuv444p12le`), which shares block modes and motion vectors between the coordinates: fewer bits
 //! at equal error than the three side by side in one monochrome (4:0:0) picture (`gray10le`,
-//! `gray12le`; [`Planes::Mono`], which the decoder also reads; docs/design.md, "HEVC settings").
+//! `gray12le`; `Planes::Mono`, which the decoder also reads; docs/design.md, "HEVC settings").
 //! The quantiser is a fixed QP (`qp=`, no rate control, `tune=psnr`: no psycho-visual tricks, which
 //! spend bits on what looks sharp rather than on the error). No B-frames, no scene cuts, no open
 //! GOPs: an IDR every `gop` frames (every frame with `gop` 1: all-intra), P-frames between, so each

@@ -1,11 +1,11 @@
 //! The picture path: residuals as geometry images coded by a picture codec.
 //!
 //! [`geometry_video`] splats each frame's residuals onto a multi-chart atlas, pads and tiles them
-//! into one picture per frame and hands the pictures to a [`PictureCodec`]: JPEG ([`jpeg`], every
+//! into one picture per frame and hands the pictures to a `PictureCodec`: JPEG ([`jpeg`], every
 //! frame alone), or through FFmpeg (cargo feature `ffmpeg`) MPEG-4 Part 2 ([`mpeg4`]) and HEVC and
 //! AV1 at 10 or 12 bits a sample ([`hevc`], [`av1`], sharing [`deep`]). Each codec's file holds its
 //! configuration, its quality law and its coder; what they share — the lattice and padding options
-//! and the resolved [`PicturePlan`] — is here.
+//! and the resolved `PicturePlan` — is here.
 
 pub mod abbreviated;
 pub mod av1;

@@ -83,8 +83,8 @@ fn magnitude_class(magnitude: u64) -> usize {
 
 /// The adaptive models of the coefficient coder, carried from band to band.
 ///
-/// A level (minus its spatial prediction) is coded as a magnitude with one of [`CONTEXTS`] models
-/// per frequency class and, when non-zero, a sign with one of [`SIGNS`], chosen by what the decoder
+/// A level (minus its spatial prediction) is coded as a magnitude with one of `CONTEXTS` models
+/// per frequency class and, when non-zero, a sign with one of `SIGNS`, chosen by what the decoder
 /// already has: the same vertex/axis's level in the previous band, whether an earlier axis of the
 /// same vertex is non-zero in this band, and the neighbours' magnitude (six classes each), and for
 /// the sign, the signs the neighbours coded. The frequency class costs nothing and separates the DC

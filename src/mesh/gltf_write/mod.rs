@@ -1,7 +1,7 @@
 //! glTF 2.0 output: a decoded animation as one mesh with morph targets, ready for three.js, Blender
 //! or any glTF viewer.
 //!
-//! Frame 0 is the base mesh (positions, recomputed [`normals`], every texture-coordinate set); each
+//! Frame 0 is the base mesh (positions, recomputed `normals`, every texture-coordinate set); each
 //! later frame is one morph target holding its position and normal differences from frame 0. One
 //! animation, "frames", sets the weights with STEP interpolation: at time `f / fps` target `f` has
 //! weight 1 and every other 0, so a viewer shows exactly the decoded frames. One primitive per
