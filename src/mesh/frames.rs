@@ -2,7 +2,8 @@
 //! caches sample by sample, so that a long clip is never held whole. glTF clips are baked whole
 //! (the baker poses every frame from the clip's channels) and served from memory.
 
-use super::obj::{frame_files, read_frames, read_obj};
+use super::obj::{read_frames, read_obj};
+use super::obj_files::frame_files;
 use super::obj_skeleton::FirstObj;
 use super::{gltf, pc2, AnimatedMesh, Point, ReadOptions};
 use crate::error::{Error, Result};

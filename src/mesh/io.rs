@@ -3,7 +3,7 @@
 //! The formats themselves live in `super::obj`, `super::pc2` and `super::gltf`; this
 //! module picks one from the input's name and writes files so that a failure never leaves half of one.
 
-use super::{gltf, obj, pc2, AnimatedMesh};
+use super::{gltf, obj, obj_files, pc2, AnimatedMesh};
 use crate::error::{Error, Result};
 use crate::limits::DEFAULT_MAX_POSITIONS;
 use crate::output::write_atomic;
@@ -60,7 +60,7 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
         Some("gltf") | Some("glb") => {
             gltf::read_gltf(path, opts.fps, opts.clip.as_deref(), opts.max_positions)
         }
-        _ => obj::read_sequence(&obj::frame_files(input)?),
+        _ => obj::read_sequence(&obj_files::frame_files(input)?),
     }
 }
 
@@ -79,7 +79,7 @@ pub fn input_files(input: &str, opts: &ReadOptions) -> Result<Vec<PathBuf>> {
                 .unwrap_or_else(|| path.with_extension("obj")),
         ]),
         Some("gltf") | Some("glb") => Ok(gltf::files(path)),
-        _ => obj::frame_files(input),
+        _ => obj_files::frame_files(input),
     }
 }
 

@@ -24,6 +24,8 @@ mod gltf;
 #[cfg(feature = "encode")]
 mod obj;
 #[cfg(feature = "encode")]
+mod obj_files;
+#[cfg(feature = "encode")]
 mod obj_skeleton;
 #[cfg(feature = "encode")]
 mod pc2;
