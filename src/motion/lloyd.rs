@@ -190,8 +190,8 @@ impl<'a> Centred<'a> {
             centroids.rows().into_iter().map(|r| r.to_vec()).collect();
         let dim = self.x.ncols().max(1) as f32;
         // Whether every exact distance is finite: each squared difference is at most
-        // (|row| + |centroid|)², the centroids being means of rows bounded by the same largest
-        // magnitude; the factor 2 covers the summation's rounding.
+        // (2 × the largest magnitude among the rows and centroids)², and the factor 2 covers the
+        // summation's rounding.
         let largest = self.largest.max(largest_magnitude(centroids));
         let distances_finite = largest.is_finite()
             && f64::from(dim) * (2.0 * f64::from(largest)).powi(2) * 2.0 < f64::from(f32::MAX);
