@@ -63,18 +63,14 @@ pub(crate) fn nearest(x: &Array2<f32>, centroids: &Array2<f32>) -> Vec<usize> {
 /// The squared distance of two equally long vectors, summed in f32 from the first element on:
 /// the value linfa's (ndarray-stats') `sq_l2_dist` gives, on which its choices depend.
 fn exact_sq_distance(a: &[f32], b: &[f32]) -> f32 {
-    let mut sum = 0f32;
-    for (&p, &q) in a.iter().zip(b) {
-        let d = p - q;
-        sum += d * d;
-    }
-    sum
+    exact_sq_distances([a], [b])[0]
 }
 
-/// [`exact_sq_distance`] of `L` pairs at once, each summed in the same order, so each lane gives
-/// that function's value to the bit. One pair's sum is a chain of dependent additions that waits
-/// on each add's latency; `L` independent chains keep the processor's adders busy (k-means++
-/// seeding and the exact checks of `nearest` were a tenth of a default tdct encode).
+/// [`exact_sq_distance`] of `L` pairs at once (over the shorter of each pair), each lane summed
+/// in f32 from the first element on, as that function's value is defined. One pair's sum is a
+/// chain of dependent additions that waits on each add's latency; `L` independent chains keep
+/// the processor's adders busy (k-means++ seeding and the exact checks of `nearest` were a tenth
+/// of a default tdct encode).
 fn exact_sq_distances<const L: usize>(a: [&[f32]; L], b: [&[f32]; L]) -> [f32; L] {
     let len = (0..L).map(|l| a[l].len().min(b[l].len())).min().unwrap_or(0);
     let (a, b) = (a.map(|r| &r[..len]), b.map(|r| &r[..len]));

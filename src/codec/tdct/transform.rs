@@ -35,9 +35,10 @@ pub fn forward(residuals: &[Vec<[f32; 3]>]) -> Result<Vec<Vec<f64>>> {
     let mut tile = vec![0.0f64; frames * 3 * BLOCK];
     let mut buf = vec![0.0f64; frames];
     for first in (0..vertices).step_by(BLOCK) {
-        let width = 3 * (vertices - first).min(BLOCK);
+        let count = (vertices - first).min(BLOCK);
+        let width = 3 * count;
         for (row, r) in tile.chunks_exact_mut(3 * BLOCK).zip(residuals) {
-            for (t, p) in row.chunks_exact_mut(3).zip(&r[first..first + width / 3]) {
+            for (t, p) in row.chunks_exact_mut(3).zip(&r[first..first + count]) {
                 for (t, &x) in t.iter_mut().zip(p) {
                     *t = f64::from(x);
                 }

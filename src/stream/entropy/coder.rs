@@ -347,13 +347,17 @@ mod tests {
     #[test]
     fn mixed_symbols_round_trip() {
         let values: Vec<i64> = vec![0, 1, -1, 5, -300, i64::MAX, i64::MIN + 1, 42, 0, 0, 7];
+        // Each side starts from the same fresh models.
+        let models = || {
+            (
+                BitModel::default(),
+                SymbolModel::new(5),
+                UIntModel::default(),
+                IntModel::default(),
+            )
+        };
         let mut enc = Encoder::new();
-        let (mut b, mut s, mut u, mut i) = (
-            BitModel::default(),
-            SymbolModel::new(5),
-            UIntModel::default(),
-            IntModel::default(),
-        );
+        let (mut b, mut s, mut u, mut i) = models();
         for (k, &v) in values.iter().enumerate() {
             enc.bit(k % 3 == 0, &mut b);
             enc.symbol(k % 5, &mut s);
@@ -364,12 +368,7 @@ mod tests {
         enc.unsigned(u64::MAX, &mut u);
         let bytes = enc.finish().unwrap();
         let mut dec = Decoder::new(&bytes).unwrap();
-        let (mut b, mut s, mut u, mut i) = (
-            BitModel::default(),
-            SymbolModel::new(5),
-            UIntModel::default(),
-            IntModel::default(),
-        );
+        let (mut b, mut s, mut u, mut i) = models();
         for (k, &v) in values.iter().enumerate() {
             assert_eq!(dec.bit(&mut b).unwrap(), k % 3 == 0);
             assert_eq!(dec.symbol(&mut s).unwrap(), k % 5);
