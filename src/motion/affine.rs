@@ -4,18 +4,22 @@
 //! Quantisation follows the residuals' quality law instead of a fixed bit count: the encoder
 //! predicts from the *dequantised* maps (closed loop), so a map's error only has to be small
 //! against the residual quantiser step Δ, not against the map itself. Each map `x ↦ A x + b` is
-//! stored as its linear part `A` and the image `t = A c + b` of its cluster's centroid `c`: an
-//! error `e` in an entry of `A` then moves a vertex at distance `r` from the centroid by about
-//! `e·r`, and an error in `t` moves every vertex of the cluster alike, with no share of `A`'s
-//! error. `t` is quantised with the track's step `s` and `A` with `s / r̄`, `r̄` the cluster's
-//! RMS distance from its centroid ([`ClusterGeometry`]), so both move the cluster's vertices by
-//! about `s`. The decoder derives centroids and spreads from the decoded frame 0 and the
-//! partition, which it has before the maps.
+//! stored as its linear part `A` (nine numbers in the cluster's [`LinearForm`]: entries, or a
+//! rotation and a symmetric stretch) and the image `t = A c + b` of its cluster's centroid `c`:
+//! an error in `t` moves every vertex of the cluster alike, with no share of `A`'s error, and an
+//! error `e` in one of `A`'s numbers moves a vertex by about `e` times its offset from the
+//! centroid. `t` is quantised with the track's step `s` and each of `A`'s numbers with `s` over
+//! √3 times the cluster's RMS lever for it ([`ClusterGeometry::steps`]), so that together they
+//! move the cluster's vertices by about as much as `t` does. The decoder derives centroids and spreads
+//! from the decoded frame 0 and the partition, which it has before the maps.
 
 use super::fit::{apply, AffineCoefficients, UnitFrame};
 #[cfg(feature = "encode")]
 use super::fit::AffineSolver;
 use super::partition::Partition;
+use super::linear_form::LinearForm;
+#[cfg(feature = "encode")]
+use super::trajectory::best_order;
 use crate::error::{Error, Result};
 use crate::mesh::Point;
 #[cfg(feature = "encode")]
@@ -105,17 +109,21 @@ impl ClusterGeometry {
         }
     }
 
-    /// The 12 quantiser steps of `cluster`'s map for base step `step`, in coefficient order
-    /// (`[a00 a01 a02 t0 a10 …]`): `step` for the translations, `step / (√3 σ_j)` for column `j`
-    /// of the linear part, `σ_j` the cluster's RMS offset along axis `j`. An error `e` in such an
-    /// entry moves the vertices by `e σ_j` RMS, so the three columns of a row together move them
-    /// as much as the translation does (as `step / r̄` did for every column, `r̄² = Σ σ_j²`), with
-    /// fewer levels where the cluster is thin.
-    pub fn steps(&self, cluster: usize, step: f64) -> [f64; 12] {
+    /// The 12 quantiser steps of `cluster`'s map in `form` for base step `step`, in stored
+    /// order (`[x0 x1 x2 t0, x3 x4 x5 t1, x6 x7 x8 t2]`, `x` the linear part's nine numbers,
+    /// [`LinearForm::values`], and `t` the centroid's image): `step` for `t`, and for `x_i`
+    /// `step` over √3 times its lever ([`LinearForm::levers`]). Three numbers of the nine then
+    /// move the vertices by as much as the translation does, with fewer levels across thin
+    /// clusters (per-axis levers since stream version 6).
+    pub fn steps(&self, cluster: usize, step: f64, form: LinearForm) -> [f64; 12] {
         let spreads = self.axis_spreads.get(cluster).copied().unwrap_or([0.0; 3]);
-        let linear = spreads
-            .map(|s| (step / (3f64.sqrt() * s).max(MIN_SPREAD)).min(MAX_LINEAR_STEP));
-        std::array::from_fn(|c| if c % 4 == 3 { step } else { linear[c % 4] })
+        let linear = form
+            .levers(spreads)
+            .map(|l| (step / (3f64.sqrt() * l).max(MIN_SPREAD)).min(MAX_LINEAR_STEP));
+        std::array::from_fn(|c| match c % 4 {
+            3 => step,
+            col => linear[3 * (c / 4) + col],
+        })
     }
 
     /// `cluster`'s centroid (the origin for a cluster out of range).
@@ -124,16 +132,18 @@ impl ClusterGeometry {
     }
 }
 
-/// The identity map in stored form for `cluster`: `A = I`, `t = c`, in levels of `steps`.
-pub fn identity_levels(centroid: [f64; 3], steps: &[f64; 12]) -> [i64; 12] {
-    std::array::from_fn(|c| {
-        let (row, col) = (c / 4, c % 4);
-        let x = match col {
-            3 => centroid[row],
-            _ if col == row => 1.0,
-            _ => 0.0,
-        };
-        level(x / steps[c])
+/// The identity map in stored form for a cluster: `A = I` in `form`, `t = c`, in levels of
+/// `steps`.
+pub fn identity_levels(centroid: [f64; 3], steps: &[f64; 12], form: LinearForm) -> [i64; 12] {
+    let values = stored_values(&form.identity(), centroid);
+    std::array::from_fn(|c| level(values[c] / steps[c]))
+}
+
+/// The 12 stored numbers of a map: linear part `x` and centroid image `t` interleaved as rows.
+fn stored_values(x: &[f64; 9], t: [f64; 3]) -> [f64; 12] {
+    std::array::from_fn(|c| match c % 4 {
+        3 => t[c / 4],
+        col => x[3 * (c / 4) + col],
     })
 }
 
@@ -147,7 +157,8 @@ fn level(x: f64) -> i64 {
     }
 }
 
-/// The affine maps as they are stored: integer levels of `A` and `t` (see the module notes).
+/// The affine maps as they are stored: integer levels of `A` (in each cluster's form) and `t`
+/// (see the module notes).
 #[derive(Debug, Clone, PartialEq)]
 pub struct QuantisedAffine {
     /// Base step in the unit frame (a fraction of the decoded frame 0's diagonal): the step of
@@ -157,7 +168,9 @@ pub struct QuantisedAffine {
     pub frames: usize,
     /// Number of clusters.
     pub clusters: usize,
-    /// Levels, frame by frame, cluster by cluster, 12 each (row-major `[A | t]`).
+    /// How each cluster stores its linear part.
+    pub forms: Vec<LinearForm>,
+    /// Levels, frame by frame, cluster by cluster, 12 each (see [`ClusterGeometry::steps`]).
     pub values: Vec<i64>,
 }
 
@@ -179,6 +192,13 @@ impl QuantisedAffine {
             return Err(Error::Stream(
                 "affine coefficients: no frames or no clusters".into(),
             ));
+        }
+        if self.forms.len() != self.clusters {
+            return Err(Error::Stream(format!(
+                "affine coefficients: {} linear forms for {} clusters",
+                self.forms.len(),
+                self.clusters
+            )));
         }
         let expected = self
             .frames
@@ -204,26 +224,39 @@ impl QuantisedAffine {
         Ok(())
     }
 
-    /// The map `[A | b]` of levels `q` of a cluster with `steps` and `centroid`: `b = t − A c`.
-    fn dequantise(q: &[i64], steps: &[f64; 12], centroid: [f64; 3]) -> AffineCoefficients {
-        let mut h: AffineCoefficients = std::array::from_fn(|c| q[c] as f64 * steps[c]);
+    /// The map `[A | b]` of levels `q` of a cluster in `form` with `steps` and `centroid`:
+    /// `b = t − A c`.
+    fn dequantise(
+        q: &[i64],
+        steps: &[f64; 12],
+        centroid: [f64; 3],
+        form: LinearForm,
+    ) -> AffineCoefficients {
+        let x: [f64; 12] = std::array::from_fn(|c| q[c] as f64 * steps[c]);
+        let a = form.linear(&std::array::from_fn(|i| x[4 * (i / 3) + i % 3]));
+        let mut h = [0.0; 12];
         for row in 0..3 {
-            let ac: f64 = (0..3).map(|col| h[4 * row + col] * centroid[col]).sum();
-            h[4 * row + 3] -= ac;
+            h[4 * row..4 * row + 3].copy_from_slice(&a[row]);
+            let ac: f64 = (0..3).map(|col| a[row][col] * centroid[col]).sum();
+            h[4 * row + 3] = x[4 * row + 3] - ac;
         }
         h
     }
 
-    /// Levels of the exact map `h`: `A` as it is, `t = A c + b`.
-    fn quantise(h: &AffineCoefficients, steps: &[f64; 12], centroid: [f64; 3]) -> [i64; 12] {
-        std::array::from_fn(|c| {
-            let (row, col) = (c / 4, c % 4);
-            let x = match col {
-                3 => h[c] + (0..3).map(|j| h[4 * row + j] * centroid[j]).sum::<f64>(),
-                _ => h[c],
-            };
-            level(x / steps[c])
-        })
+    /// Levels of the exact map `h` in `form`: `A`'s nine numbers, `t = A c + b`.
+    #[cfg(feature = "encode")]
+    fn quantise(
+        h: &AffineCoefficients,
+        steps: &[f64; 12],
+        centroid: [f64; 3],
+        form: LinearForm,
+    ) -> [i64; 12] {
+        let a: [[f64; 3]; 3] = std::array::from_fn(|r| [h[4 * r], h[4 * r + 1], h[4 * r + 2]]);
+        let t = std::array::from_fn(|r| {
+            h[4 * r + 3] + (0..3).map(|j| h[4 * r + j] * centroid[j]).sum::<f64>()
+        });
+        let values = stored_values(&form.values(&a), t);
+        std::array::from_fn(|c| level(values[c] / steps[c]))
     }
 }
 
@@ -298,24 +331,7 @@ impl AffineTrack {
         }
         let geometry = ClusterGeometry::of(reference, partition);
         let stored = step as f32;
-        let clusters = partition.clusters();
-        let steps: Vec<[f64; 12]> = (0..clusters)
-            .map(|k| geometry.steps(k, f64::from(stored)))
-            .collect();
-        let values = exact
-            .iter()
-            .enumerate()
-            .flat_map(|(i, h)| {
-                let k = i % clusters;
-                QuantisedAffine::quantise(h, &steps[k], geometry.centroid(k))
-            })
-            .collect();
-        let quantised = QuantisedAffine {
-            step: stored,
-            frames: frames.len(),
-            clusters,
-            values,
-        };
+        let quantised = quantise_track(&exact, frames.len(), &geometry, stored);
         Self::from_quantised(quantised, geometry)
     }
 
@@ -335,7 +351,7 @@ impl AffineTrack {
         }
         let step = f64::from(quantised.step);
         let steps: Vec<[f64; 12]> = (0..quantised.clusters)
-            .map(|k| geometry.steps(k, step))
+            .map(|k| geometry.steps(k, step, quantised.forms[k]))
             .collect();
         Ok(Self {
             quantised,
@@ -380,10 +396,12 @@ impl AffineTrack {
             .get(cluster.checked_mul(12)?..)?
             .get(..12)?;
         let steps = self.steps.get(cluster)?;
+        let form = *self.quantised.forms.get(cluster)?;
         Some(QuantisedAffine::dequantise(
             levels,
             steps,
             self.geometry.centroid(cluster),
+            form,
         ))
     }
 
@@ -401,6 +419,7 @@ impl AffineTrack {
             step: q.step,
             frames: frames.len(),
             clusters: q.clusters,
+            forms: q.forms.clone(),
             values,
         };
         Self::from_quantised(selected, self.geometry.clone())
@@ -470,5 +489,47 @@ impl AffineTrack {
                 None => *p,
             })
             .collect()
+    }
+}
+
+/// Quantises `exact` (frame by frame, cluster by cluster) at base step `step`, each cluster in
+/// the [`LinearForm`] whose nine linear trajectories the affine coder's estimate finds smaller
+/// (the translations are the same either way; a tie keeps the entries).
+#[cfg(feature = "encode")]
+fn quantise_track(
+    exact: &[AffineCoefficients],
+    frames: usize,
+    geometry: &ClusterGeometry,
+    step: f32,
+) -> QuantisedAffine {
+    let clusters = geometry.centroids.len();
+    let mut values = vec![0i64; frames * clusters * 12];
+    let mut forms = Vec::with_capacity(clusters);
+    for k in 0..clusters {
+        let centroid = geometry.centroid(k);
+        let candidates = LinearForm::ALL.map(|form| {
+            let steps = geometry.steps(k, f64::from(step), form);
+            let levels: Vec<[i64; 12]> = (0..frames)
+                .map(|f| QuantisedAffine::quantise(&exact[f * clusters + k], &steps, centroid, form))
+                .collect();
+            let bits: f64 = (0..12)
+                .filter(|c| c % 4 != 3)
+                .map(|c| best_order(&levels.iter().map(|l| l[c]).collect::<Vec<_>>()).1)
+                .sum();
+            (form, levels, bits)
+        });
+        let [entries, rotation] = candidates;
+        let (form, levels, _) = if rotation.2 < entries.2 { rotation } else { entries };
+        forms.push(form);
+        for (f, l) in levels.iter().enumerate() {
+            values[(f * clusters + k) * 12..][..12].copy_from_slice(l);
+        }
+    }
+    QuantisedAffine {
+        step,
+        frames,
+        clusters,
+        forms,
+        values,
     }
 }

@@ -14,6 +14,8 @@
 //! - `partition`: the cluster id per vertex that segmentation yields
 //! - `fit`: regularised least-squares affine fits and the unit frame
 //! - `affine`: the piecewise affine predictor, fitted and quantised (MCGV §3.2)
+//! - `linear_form`: how a map's linear part is stored: its entries, or a rotation and a stretch
+//! - `trajectory`: temporal prediction of a coefficient's levels, and the estimate of their bits
 //! - `skinning`: the skinning predictor's per-vertex weights (follow-up paper §3.2)
 //! - `predictor`: which predictor a stream uses, and the one prediction both codec sides call
 //! - `residual`: prediction residuals and their energy
@@ -32,10 +34,13 @@ mod predictor;
 mod refine;
 #[cfg(feature = "encode")]
 mod residual;
+mod linear_form;
 #[cfg(feature = "encode")]
 mod sampled_motion;
 mod skinning;
+pub(crate) mod trajectory;
 
+pub use linear_form::LinearForm;
 pub use affine::{
     identity_levels, AffineTrack, ClusterGeometry, QuantisedAffine, DEFAULT_AFFINE_PRECISION,
     MAX_AFFINE_LEVEL, MAX_AFFINE_STEP, MIN_AFFINE_STEP,

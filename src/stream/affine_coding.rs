@@ -2,11 +2,13 @@
 //! [`crate::motion::AffineTrack`]) is a trajectory of integer levels over the frames, coded as the
 //! residual of a temporal predictor.
 //!
-//! Per trajectory the encoder picks the predictor order that codes smallest (1: the previous
-//! level, 2: linear extrapolation, 3: quadratic), one adaptive symbol; the first frame is
+//! Each cluster starts with its [`LinearForm`] (entries, or rotation and stretch), one adaptive
+//! symbol. Per trajectory the encoder picks the predictor order that codes smallest (1: the
+//! previous level, 2: linear extrapolation, 3: quadratic), one adaptive symbol; the first frame is
 //! predicted by the identity map (frame 0 is fitted from the decoded frame 0 itself). Residuals go
-//! through adaptive integer models chosen by the coefficient's kind (linear part or translation)
-//! and the size of the trajectory's previous residual, which tracks how busy the motion is.
+//! through adaptive integer models chosen by the coefficient's kind (entry, rotation, stretch
+//! or translation) and the size of the trajectory's previous residual, which tracks how busy the
+//! motion is.
 //!
 //! The extrapolation codes smaller than a temporal DCT of each trajectory
 //! (docs/design.md, "Affine precision per codec"); the levels are uniform scalar quantisation of
@@ -14,14 +16,13 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::Point;
+use crate::motion::trajectory::{best_order, extrapolate, ORDERS};
 use crate::motion::{
-    identity_levels, AffineTrack, ClusterGeometry, Partition, QuantisedAffine, MAX_AFFINE_LEVEL,
+    identity_levels, AffineTrack, ClusterGeometry, LinearForm, Partition, QuantisedAffine,
+    MAX_AFFINE_LEVEL,
 };
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::entropy::{self, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel};
-
-/// Predictor orders a trajectory may use (1..=ORDERS).
-const ORDERS: usize = 3;
 
 /// Classes of the previous residual's magnitude: 0, 1, 2–3, 4–15, 16+.
 const MAGNITUDES: usize = 5;
@@ -40,108 +41,84 @@ fn magnitude_class(r: i64) -> usize {
     }
 }
 
-/// The level `order` predicts from `history` (most recent last; shorter histories lower the order).
-fn extrapolate(order: usize, history: &[i64]) -> i64 {
-    let n = history.len();
-    let at = |back: usize| history[n - back];
-    match order.min(n) {
-        0 => 0,
-        1 => at(1),
-        2 => 2 * at(1) - at(2),
-        _ => 3 * at(1) - 3 * at(2) + at(3),
+/// What a stored coefficient is (see [`ClusterGeometry::steps`]): each kind has its own models,
+/// since a turning part's rotation moves while its stretch barely does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Entry = 0,
+    Rotation = 1,
+    Stretch = 2,
+    Translation = 3,
+}
+
+const KINDS: usize = 4;
+
+impl Kind {
+    /// The kind of stored coefficient `coeff` (0..12) of a cluster in `form`.
+    fn of(coeff: usize, form: LinearForm) -> Self {
+        match (coeff, form) {
+            (3 | 7 | 11, _) => Kind::Translation,
+            (_, LinearForm::Entries) => Kind::Entry,
+            (0..=2, LinearForm::RotationStretch) => Kind::Rotation,
+            (_, LinearForm::RotationStretch) => Kind::Stretch,
+        }
     }
 }
 
-/// Rough cost in bits of coding `residual` (the encoder's choice of order only).
-fn cost(residual: i64) -> f64 {
-    2.0 * (1.0 + residual.unsigned_abs() as f64).log2() + 1.0
-}
-
-/// The order (1..=ORDERS) that codes `trajectory` smallest, by [`cost`].
-fn best_order(trajectory: &[i64]) -> usize {
-    (1..=ORDERS)
-        .map(|order| {
-            let bits: f64 = (1..trajectory.len())
-                .map(|f| cost(trajectory[f] - extrapolate(order, &trajectory[..f])))
-                .sum();
-            (order, bits)
-        })
-        .fold(
-            (1, f64::INFINITY),
-            |best, c| if c.1 < best.1 { c } else { best },
-        )
-        .0
-}
-
-/// The adaptive models of the traversal: per coefficient kind (linear, translation).
+/// The adaptive models of the traversal: the clusters' forms, and per coefficient [`Kind`].
 struct Models {
-    order: [SymbolModel; 2],
-    first: [IntModel; 2],
-    residual: [[IntModel; MAGNITUDES]; 2],
+    form: SymbolModel,
+    order: [SymbolModel; KINDS],
+    first: [IntModel; KINDS],
+    residual: [[IntModel; MAGNITUDES]; KINDS],
 }
 
 impl Models {
     fn new() -> Self {
         Self {
-            order: [SymbolModel::new(ORDERS), SymbolModel::new(ORDERS)],
+            form: SymbolModel::new(LinearForm::ALL.len()),
+            order: std::array::from_fn(|_| SymbolModel::new(ORDERS)),
             first: Default::default(),
             residual: Default::default(),
         }
     }
 }
 
-/// Codes the levels cluster by cluster, coefficient by coefficient, each trajectory over all
-/// frames; `orders[k * 12 + c]` is trajectory (k, c)'s predictor order (filled when decoding).
-/// With `q.values` empty, a decoder reads every level and keeps none: a dry run that checks the
-/// part (its end word included) in constant memory before its levels are given room.
+/// Codes the levels cluster by cluster (its [`LinearForm`] first), coefficient by coefficient,
+/// each trajectory over all frames; `orders[k * 12 + c]` is trajectory (k, c)'s predictor order
+/// and `q.forms[k]` cluster k's form (both filled when decoding). With `q.values` empty, a
+/// decoder reads every level and keeps none: a dry run that checks the part (its end word
+/// included) in constant memory before its levels are given room.
 fn code_trajectories<C: SymbolCoder>(
     c: &mut C,
     q: &mut QuantisedAffine,
     orders: &mut [usize],
-    identity: &[[i64; 12]],
+    geometry: &ClusterGeometry,
 ) -> Result<()> {
     let mut models = Models::new();
     let (frames, clusters) = (q.frames, q.clusters);
-    if identity.len() != clusters || orders.len() != clusters * 12 {
+    if geometry.centroids.len() != clusters
+        || q.forms.len() != clusters
+        || orders.len() != clusters * 12
+    {
         return Err(Error::Stream(format!(
             "affine coefficients: {clusters} clusters, the partition has {}",
-            identity.len()
+            geometry.centroids.len()
         )));
     }
-    for (k, start) in identity.iter().enumerate() {
-        for (coeff, &first) in start.iter().enumerate() {
-            let kind = usize::from(coeff % 4 == 3);
-            let slot = k * 12 + coeff;
-            let order = 1 + c.symbol(orders[slot] - 1, &mut models.order[kind])?;
-            orders[slot] = order;
-            // The last ORDERS levels, oldest first: all that `extrapolate` looks back at.
-            let mut history = [0i64; ORDERS];
-            let mut class = 0;
-            for f in 0..frames {
-                let i = (f * clusters + k) * 12 + coeff;
-                let (guess, model) = match f {
-                    0 => (first, &mut models.first[kind]),
-                    _ => (
-                        extrapolate(order, &history[ORDERS - f.min(ORDERS)..]),
-                        &mut models.residual[kind][class],
-                    ),
-                };
-                let target = q.values.get(i).copied().unwrap_or(guess);
-                let r = c.signed(target.wrapping_sub(guess), model)?;
-                let value = guess.checked_add(r).filter(|v| v.abs() <= MAX_AFFINE_LEVEL);
-                let Some(value) = value else {
-                    return Err(Error::Stream(format!(
-                        "affine coefficients: level of cluster {k}, coefficient {coeff}, frame \
-                         {f} is beyond ±2^40"
-                    )));
-                };
-                if let Some(slot) = q.values.get_mut(i) {
-                    *slot = value;
-                }
-                history.rotate_left(1);
-                history[ORDERS - 1] = value;
-                class = magnitude_class(r);
-            }
+    for k in 0..clusters {
+        let form = LinearForm::ALL[c.symbol(q.forms[k] as usize, &mut models.form)?];
+        q.forms[k] = form;
+        let steps = geometry.steps(k, f64::from(q.step), form);
+        let identity = identity_levels(geometry.centroid(k), &steps, form);
+        for (coeff, &first) in identity.iter().enumerate() {
+            let trajectory = Trajectory {
+                cluster: k,
+                coeff,
+                first,
+                kind: Kind::of(coeff, form),
+            };
+            code_trajectory(c, q, &mut orders[k * 12 + coeff], &trajectory, &mut models)?;
         }
     }
     if c.raw_bits(u64::from(AFFINE_END), 32)? != u64::from(AFFINE_END) {
@@ -153,11 +130,54 @@ fn code_trajectories<C: SymbolCoder>(
     Ok(())
 }
 
-/// The identity map's levels of every cluster: the first frame's prediction.
-fn identity_of(geometry: &ClusterGeometry, step: f32) -> Vec<[i64; 12]> {
-    (0..geometry.centroids.len())
-        .map(|k| identity_levels(geometry.centroid(k), &geometry.steps(k, f64::from(step))))
-        .collect()
+/// One coefficient's trajectory: where it is, and its identity level (frame 0's prediction).
+struct Trajectory {
+    cluster: usize,
+    coeff: usize,
+    first: i64,
+    kind: Kind,
+}
+
+/// Codes `t`'s predictor order, then its level at every frame as the residual of the prediction.
+fn code_trajectory<C: SymbolCoder>(
+    c: &mut C,
+    q: &mut QuantisedAffine,
+    order: &mut usize,
+    t: &Trajectory,
+    models: &mut Models,
+) -> Result<()> {
+    let (frames, clusters, kind) = (q.frames, q.clusters, t.kind as usize);
+    *order = 1 + c.symbol(*order - 1, &mut models.order[kind])?;
+    // The last ORDERS levels, oldest first: all that `extrapolate` looks back at.
+    let mut history = [0i64; ORDERS];
+    let mut class = 0;
+    for f in 0..frames {
+        let i = (f * clusters + t.cluster) * 12 + t.coeff;
+        let (guess, model) = match f {
+            0 => (t.first, &mut models.first[kind]),
+            _ => (
+                extrapolate(*order, &history[ORDERS - f.min(ORDERS)..]),
+                &mut models.residual[kind][class],
+            ),
+        };
+        let target = q.values.get(i).copied().unwrap_or(guess);
+        let r = c.signed(target.wrapping_sub(guess), model)?;
+        let value = guess.checked_add(r).filter(|v| v.abs() <= MAX_AFFINE_LEVEL);
+        let Some(value) = value else {
+            return Err(Error::Stream(format!(
+                "affine coefficients: level of cluster {}, coefficient {}, frame {f} is beyond \
+                 ±2^40",
+                t.cluster, t.coeff
+            )));
+        };
+        if let Some(slot) = q.values.get_mut(i) {
+            *slot = value;
+        }
+        history.rotate_left(1);
+        history[ORDERS - 1] = value;
+        class = magnitude_class(r);
+    }
+    Ok(())
 }
 
 /// Codes the affine track: its base step, then the level trajectories.
@@ -170,14 +190,13 @@ pub fn encode_affine(track: &AffineTrack) -> Result<Vec<u8>> {
             let trajectory: Vec<i64> = (0..frames)
                 .map(|f| q.values[(f * clusters + k) * 12 + coeff])
                 .collect();
-            best_order(&trajectory)
+            best_order(&trajectory).0
         })
         .collect();
-    let identity = identity_of(track.geometry(), q.step);
     let mut w = ByteWriter::new();
     w.f32(q.step);
     let mut enc = Encoder::new();
-    code_trajectories(&mut enc, &mut q, &mut orders, &identity)?;
+    code_trajectories(&mut enc, &mut q, &mut orders, track.geometry())?;
     w.raw(&enc.finish()?);
     Ok(w.into_bytes())
 }
@@ -227,8 +246,6 @@ struct AffinePart<'a> {
     /// The track read so far: no levels until they are given room.
     q: QuantisedAffine,
     geometry: ClusterGeometry,
-    /// The identity's levels of every cluster, which predict frame 0.
-    identity: Vec<[i64; 12]>,
     coded: &'a [u8],
 }
 
@@ -255,17 +272,16 @@ impl<'a> AffinePart<'a> {
         // The step sets the identity's levels below: refuse a forged one first.
         QuantisedAffine::check_step(step)?;
         let geometry = ClusterGeometry::of(reference, partition);
-        let identity = identity_of(&geometry, step);
         let q = QuantisedAffine {
             step,
             frames,
             clusters,
+            forms: vec![LinearForm::Entries; clusters],
             values: Vec::new(),
         };
         Ok(Self {
             q,
             geometry,
-            identity,
             coded,
         })
     }
@@ -274,25 +290,6 @@ impl<'a> AffinePart<'a> {
     fn read(&mut self) -> Result<()> {
         let mut orders = vec![1usize; self.q.clusters * 12];
         let mut dec = Decoder::new(self.coded)?;
-        code_trajectories(&mut dec, &mut self.q, &mut orders, &self.identity)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn extrapolation_follows_polynomials() {
-        let line = [3, 5, 7, 9];
-        assert_eq!(extrapolate(2, &line), 11);
-        assert_eq!(extrapolate(1, &line), 9);
-        let square = [0, 1, 4, 9];
-        assert_eq!(extrapolate(3, &square), 16);
-        // What the coder passes: the last three levels at most.
-        assert_eq!(extrapolate(3, &square[1..]), 16);
-        assert_eq!(extrapolate(3, &square[..1]), 0);
-        assert_eq!(best_order(&[0, 1, 4, 9, 16, 25, 36]), 3);
-        assert_eq!(best_order(&[4, 4, 4, 4]), 1);
+        code_trajectories(&mut dec, &mut self.q, &mut orders, &self.geometry)
     }
 }

@@ -2,7 +2,9 @@
 //! trajectories. Round trip within the steps, and damaged parts refused.
 
 use crate::cloth::cloth;
-use mcgv_video::motion::{segment, AffineTrack, Partition, SegmentOptions, MIN_AFFINE_STEP};
+use mcgv_video::motion::{
+    segment, AffineTrack, LinearForm, Partition, SegmentOptions, MIN_AFFINE_STEP,
+};
 use mcgv_video::stream::side_info::{decode_affine, encode_affine};
 use mcgv_video::AnimatedMesh;
 
@@ -17,12 +19,16 @@ fn cloth_and_partition() -> (AnimatedMesh, Partition) {
     (mesh, partition)
 }
 
-/// Coefficient `c` of a map `[A | b]` in stored form: `A` as it is, `t = A·centroid + b`.
-fn stored(h: &[f64; 12], centroid: [f64; 3], c: usize) -> f64 {
+/// Coefficient `c` of a map `[A | b]` in stored form: `A`'s nine numbers in `form`,
+/// `t = A·centroid + b`.
+fn stored(h: &[f64; 12], centroid: [f64; 3], c: usize, form: LinearForm) -> f64 {
     let row = c / 4;
     match c % 4 {
         3 => h[c] + (0..3).map(|j| h[4 * row + j] * centroid[j]).sum::<f64>(),
-        _ => h[c],
+        col => {
+            let a: [[f64; 3]; 3] = std::array::from_fn(|r| [h[4 * r], h[4 * r + 1], h[4 * r + 2]]);
+            form.values(&a)[3 * row + col]
+        }
     }
 }
 
@@ -48,11 +54,13 @@ fn decoded_maps_are_the_encoders_and_within_half_a_step_of_the_fit() {
         let geometry = track.geometry();
         for f in 0..mesh.frame_count() {
             for k in 0..partition.clusters() {
-                let steps = geometry.steps(k, f64::from(track.quantised().step));
+                let form = track.quantised().forms[k];
+                let steps = geometry.steps(k, f64::from(track.quantised().step), form);
                 let (got, want) = (decoded.map(f, k).unwrap(), exact.map(f, k).unwrap());
                 let centroid = geometry.centroid(k);
                 for (c, quantiser) in steps.iter().enumerate() {
-                    let error = (stored(&got, centroid, c) - stored(&want, centroid, c)).abs();
+                    let error =
+                        (stored(&got, centroid, c, form) - stored(&want, centroid, c, form)).abs();
                     assert!(
                         error <= 0.5 * quantiser * (1.0 + 1e-6) + 1e-9,
                         "step {step}, frame {f}, cluster {k}, coefficient {c}: error {error:e}, \
@@ -123,7 +131,7 @@ fn linear_steps_follow_each_axis_extent_and_move_vertices_as_the_translation_doe
     let geometry = track.geometry();
     let base = f64::from(track.quantised().step);
     for k in 0..partition.clusters() {
-        let steps = geometry.steps(k, base);
+        let steps = geometry.steps(k, base, LinearForm::Entries);
         let spread = geometry.axis_spreads[k];
         assert!(spread[1] < spread[0] && spread[1] < spread[2], "{spread:?}");
         assert!(steps[1] >= steps[0] && steps[1] >= steps[2], "{steps:?}");
@@ -171,4 +179,65 @@ fn linear_steps_follow_each_axis_extent_and_move_vertices_as_the_translation_doe
         "rms {rms:e}, step {base:e}"
     );
     assert!(rms > 0.1 * base, "rms {rms:e}: the maps were quantised");
+}
+
+#[test]
+fn a_turning_part_is_stored_as_rotation_and_a_stretching_one_as_entries() {
+    // Two blocks of 4 × 4 × 4 points: block 0 turns about z by up to 2 radians (all four of its
+    // map's x–y entries move; as a rotation one number does), block 1 stretches along x (one
+    // entry moves either way: a tie, which keeps the entries).
+    let block = |x0: f32| -> Vec<[f32; 3]> {
+        (0..64)
+            .map(|i| {
+                [
+                    x0 + 0.1 * (i % 4) as f32,
+                    0.1 * (i / 4 % 4) as f32,
+                    0.1 * (i / 16) as f32,
+                ]
+            })
+            .collect()
+    };
+    let rest: Vec<[f32; 3]> = block(0.0).into_iter().chain(block(1.0)).collect();
+    let labels: Vec<u32> = (0..128).map(|i| u32::from(i >= 64)).collect();
+    let partition = Partition::from_labels(labels, 2).unwrap();
+    let frames: Vec<Vec<[f32; 3]>> = (0..30)
+        .map(|f| {
+            let t = f as f32 / 29.0;
+            let (c, s) = ((2.0 * t).cos(), (2.0 * t).sin());
+            rest.iter()
+                .enumerate()
+                .map(|(i, p)| match i < 64 {
+                    true => {
+                        let (x, y) = (p[0] - 0.15, p[1] - 0.15);
+                        [0.15 + c * x - s * y, 0.15 + s * x + c * y, p[2]]
+                    }
+                    false => [1.0 + (p[0] - 1.0) * (1.0 + t), p[1], p[2]],
+                })
+                .collect()
+        })
+        .collect();
+    let track = AffineTrack::fit(&frames, &rest, &partition, 1e-4).unwrap();
+    assert_eq!(
+        track.quantised().forms,
+        [LinearForm::RotationStretch, LinearForm::Entries]
+    );
+    let bytes = encode_affine(&track).unwrap();
+    let decoded = decode_affine(&bytes, frames.len(), &partition, &rest).unwrap();
+    assert_eq!(decoded, track);
+    // Both are predicted to within a few steps (1e-4 of the rest pose's diagonal).
+    let diagonal = {
+        let (lo, hi) = mcgv_video::mesh::bounding_box(&rest);
+        (0..3)
+            .map(|a| f64::from(hi[a] - lo[a]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    for (f, frame) in frames.iter().enumerate() {
+        for (got, want) in track.predict(f, &rest, &partition).iter().zip(frame) {
+            for a in 0..3 {
+                let error = f64::from(got[a] - want[a]).abs() / diagonal;
+                assert!(error < 4e-4, "frame {f}: {error:e}");
+            }
+        }
+    }
 }
