@@ -188,15 +188,17 @@ pub fn decode_lattice(
 /// Per vertex, the weight toward each neighbouring cluster as a difference from a guess: the same
 /// weight of the vertex's first copy at its first-frame position when that is in the same cluster,
 /// else the rounded mean of the same weight at the vertex's already-coded mesh neighbours of the
-/// same cluster (0 if none). Contexts: which guess, and whether the target cluster touches the
-/// vertex's 1-ring (seam vertices carry the large weights).
+/// same cluster (0 if none). Contexts: which guess, whether the target cluster touches the
+/// vertex's 1-ring (seam vertices carry the large weights), and how far apart those neighbours'
+/// weights are (all zero, all equal, then by powers of two: a smooth stretch of surface leaves
+/// small corrections; stream version 7, −2 … −8 % of the part).
 fn code_weight_values<C: SymbolCoder>(
     c: &mut C,
     w: &mut SkinningWeights,
     labels: &[u32],
     (adj, coincident): (&VertexAdjacency, &[Option<u32>]),
 ) -> Result<()> {
-    let mut models: [[IntModel; 2]; 3] = Default::default();
+    let mut models: [[[IntModel; SPREADS]; 2]; 3] = Default::default();
     let top = SkinningWeights::top(w.bits) as i64;
     let mut offsets = Vec::with_capacity(labels.len());
     let mut next = 0usize;
@@ -219,19 +221,27 @@ fn code_weight_values<C: SymbolCoder>(
         let copy_of = copy_of.filter(|&f| labels[f] == k);
         for (idx, &j) in neighbours.iter().enumerate() {
             let (mut sum, mut n) = (0i64, 0i64);
+            let (mut lo, mut hi) = (i64::MAX, i64::MIN);
             for &u in ring.iter().filter(|&&u| (u as usize) < v) {
                 if labels[u as usize] == k {
-                    sum += w.values[offsets[u as usize] + idx] as i64;
+                    let x = w.values[offsets[u as usize] + idx] as i64;
+                    sum += x;
                     n += 1;
+                    lo = lo.min(x);
+                    hi = hi.max(x);
                 }
             }
+            let spread = match n {
+                0 => 0,
+                _ => spread_class(hi - lo, lo == 0 && hi == 0),
+            };
             let (kind, guess) = match copy_of {
                 Some(f) => (2, w.values[offsets[f] + idx] as i64),
                 None if n > 0 => (1, (sum as f64 / n as f64).round() as i64),
                 None => (0, 0),
             };
             let touches = ring.iter().any(|&u| labels[u as usize] == j);
-            let model = &mut models[kind][touches as usize];
+            let model = &mut models[kind][touches as usize][spread];
             let slot = offsets[v] + idx;
             let value = guess + c.signed(w.values[slot] as i64 - guess, model)?;
             if value.abs() > top {
@@ -251,6 +261,17 @@ fn code_weight_values<C: SymbolCoder>(
         ));
     }
     Ok(())
+}
+
+/// Classes of the spread of a weight's already-coded neighbours: none or all 0, all one other
+/// value, 1, 2–3, 4–7, 8–15, 16+.
+const SPREADS: usize = 7;
+
+fn spread_class(spread: i64, zeros: bool) -> usize {
+    match spread {
+        0 => usize::from(!zeros),
+        _ => (65 - spread.unsigned_abs().leading_zeros() as usize).min(SPREADS - 1),
+    }
 }
 
 /// Coded after the last skinning weight, checked by the decoder.
