@@ -441,7 +441,7 @@ mod tests {
     }
 
     #[test]
-    fn affine_precision_is_fine_only_for_p_frames_that_suffer_from_coarse_maps() {
+    fn affine_precision_is_finest_for_p_frames_and_finer_for_the_temporal_dct() {
         let rate = |affine_precision| Rate {
             quality: 50,
             fine_quality: None,
@@ -457,9 +457,9 @@ mod tests {
             }
             config.plan(&rate(None), 1.0).unwrap().affine_precision
         };
-        // In sixteenths: 4 = 1/4, 1 = 1/16.
+        // In sixteenths: 4 = 1/4, 3 = 3/16, 1 = 1/16.
         for (codec, gop, expected) in [
-            (Codec::Tdct, 50, 4),
+            (Codec::Tdct, 50, 3),
             (Codec::Jpeg, 50, 4),
             (Codec::Hevc, 1, 4),
             (Codec::Hevc, 50, 4),

@@ -31,7 +31,8 @@ const CLUSTER_LAMBDA: f64 = 1e-9;
 
 /// The affine step as a multiple of the residual step Δ (`step_affine = k·Δ` for translations,
 /// `k·Δ / r̄` for the linear part): fine enough against Δ for the closed loop, coarse enough to
-/// cost few bytes (docs/design.md, "Affine precision per codec").
+/// cost few bytes (docs/design.md, "Affine precision per codec"). The picture codecs' default;
+/// the temporal DCT's is finer (`codec::tdct::AFFINE_PRECISION`).
 pub const DEFAULT_AFFINE_PRECISION: f64 = 0.25;
 
 /// Smallest and largest base step accepted (unit coordinates: fractions of the diagonal). Below
