@@ -244,20 +244,21 @@ impl QuantisedAffine {
         h
     }
 
-    /// Levels of the exact map `h` in `form`: `A`'s nine numbers, `t = A c + b`.
+    /// Levels of the exact map `h` in `form`: `A`'s nine numbers, `t = A c + b` (none if `A`
+    /// has no such form, [`LinearForm::values`]).
     #[cfg(feature = "encode")]
     fn quantise(
         h: &AffineCoefficients,
         steps: &[f64; 12],
         centroid: [f64; 3],
         form: LinearForm,
-    ) -> [i64; 12] {
+    ) -> Option<[i64; 12]> {
         let a: [[f64; 3]; 3] = std::array::from_fn(|r| [h[4 * r], h[4 * r + 1], h[4 * r + 2]]);
         let t = std::array::from_fn(|r| {
             h[4 * r + 3] + (0..3).map(|j| h[4 * r + j] * centroid[j]).sum::<f64>()
         });
-        let values = stored_values(&form.values(&a), t);
-        std::array::from_fn(|c| level(values[c] / steps[c]))
+        let values = stored_values(&form.values(&a)?, t);
+        Some(std::array::from_fn(|c| level(values[c] / steps[c])))
     }
 }
 
@@ -508,19 +509,33 @@ fn quantise_track(
     let mut forms = Vec::with_capacity(clusters);
     for k in 0..clusters {
         let centroid = geometry.centroid(k);
+        // Each form's levels over the frames and the estimated bits of its nine linear
+        // trajectories; a form some frame's map does not have is out.
         let candidates = LinearForm::ALL.map(|form| {
             let steps = geometry.steps(k, f64::from(step), form);
-            let levels: Vec<[i64; 12]> = (0..frames)
+            let levels: Option<Vec<[i64; 12]>> = (0..frames)
                 .map(|f| QuantisedAffine::quantise(&exact[f * clusters + k], &steps, centroid, form))
                 .collect();
-            let bits: f64 = (0..12)
-                .filter(|c| c % 4 != 3)
-                .map(|c| best_order(&levels.iter().map(|l| l[c]).collect::<Vec<_>>()).1)
-                .sum();
-            (form, levels, bits)
+            levels.map(|levels| {
+                let bits: f64 = (0..12)
+                    .filter(|c| c % 4 != 3)
+                    .map(|c| best_order(&levels.iter().map(|l| l[c]).collect::<Vec<_>>()).1)
+                    .sum();
+                (form, levels, bits)
+            })
         });
-        let [entries, rotation] = candidates;
-        let (form, levels, _) = if rotation.2 < entries.2 { rotation } else { entries };
+        let best = candidates
+            .into_iter()
+            .flatten()
+            .fold(None::<(LinearForm, Vec<[i64; 12]>, f64)>, |best, c| match best {
+                Some(b) if b.2 <= c.2 => Some(b),
+                _ => Some(c),
+            });
+        // The entries always exist: `LinearForm::values` fails only for the decomposition.
+        let (form, levels) = match best {
+            Some((form, levels, _)) => (form, levels),
+            None => (LinearForm::Entries, vec![[0; 12]; frames]),
+        };
         forms.push(form);
         for (f, l) in levels.iter().enumerate() {
             values[(f * clusters + k) * 12..][..12].copy_from_slice(l);

@@ -31,15 +31,16 @@ impl LinearForm {
     /// Both forms, by their stored id.
     pub const ALL: [LinearForm; 2] = [LinearForm::Entries, LinearForm::RotationStretch];
 
-    /// The nine stored numbers of `a`.
+    /// The nine stored numbers of `a` (none when its decomposition fails: see
+    /// [`RotationStretch::of`]).
     #[cfg(feature = "encode")]
-    pub fn values(self, a: &Linear) -> [f64; 9] {
+    pub fn values(self, a: &Linear) -> Option<[f64; 9]> {
         match self {
-            LinearForm::Entries => std::array::from_fn(|i| a[i / 3][i % 3]),
+            LinearForm::Entries => Some(std::array::from_fn(|i| a[i / 3][i % 3])),
             LinearForm::RotationStretch => {
-                let parts = RotationStretch::of(a);
+                let parts = RotationStretch::of(a)?;
                 let (p, s) = (parts.rotation, parts.stretch);
-                [p[0], p[1], p[2], s[0], s[1], s[2], s[3], s[4], s[5]]
+                Some([p[0], p[1], p[2], s[0], s[1], s[2], s[3], s[4], s[5]])
             }
         }
     }
@@ -60,7 +61,10 @@ impl LinearForm {
     pub fn identity(self) -> [f64; 9] {
         match self {
             LinearForm::Entries => [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-            LinearForm::RotationStretch => [0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0],
+            LinearForm::RotationStretch => {
+                let RotationStretch { rotation, stretch } = RotationStretch::IDENTITY;
+                std::array::from_fn(|i| if i < 3 { rotation[i] } else { stretch[i - 3] })
+            }
         }
     }
 
@@ -106,15 +110,17 @@ impl RotationStretch {
         stretch: [1.0, 1.0, 1.0, 0.0, 0.0, 0.0],
     };
 
-    /// The polar decomposition of `a` (through its singular value decomposition, nalgebra's).
+    /// The polar decomposition of `a` (through its singular value decomposition, nalgebra's);
+    /// none if that does not converge or is not finite (entries near the f64 range), and the
+    /// cluster keeps its entries.
     #[cfg(feature = "encode")]
-    pub fn of(a: &Linear) -> Self {
+    pub fn of(a: &Linear) -> Option<Self> {
         use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
+        /// Far above the handful of sweeps a 3 × 3 matrix takes; bounds a pathological one.
+        const MAX_SWEEPS: usize = 1000;
         let m = Matrix3::from_fn(|r, c| a[r][c]);
-        let svd = m.svd(true, true);
-        let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
-            return Self::IDENTITY;
-        };
+        let svd = m.try_svd(true, true, f64::EPSILON, MAX_SWEEPS)?;
+        let (u, v_t) = (svd.u?, svd.v_t?);
         let mut r = u * v_t;
         if r.determinant() < 0.0 {
             r = -r;
@@ -125,7 +131,7 @@ impl RotationStretch {
         // The shorter way round (w ≥ 0): p = v / (1 + w) stays within the unit ball.
         let sign = if q.w < 0.0 { -1.0 } else { 1.0 };
         let d = 1.0 + sign * q.w;
-        Self {
+        let parts = Self {
             rotation: [sign * q.i / d, sign * q.j / d, sign * q.k / d],
             stretch: [
                 s[(0, 0)],
@@ -135,7 +141,9 @@ impl RotationStretch {
                 0.5 * (s[(0, 2)] + s[(2, 0)]),
                 0.5 * (s[(1, 2)] + s[(2, 1)]),
             ],
-        }
+        };
+        let finite = parts.rotation.iter().chain(&parts.stretch).all(|x| x.is_finite());
+        finite.then_some(parts)
     }
 
     /// The rotation matrix of the stored parameters, through their unit quaternion
@@ -199,22 +207,25 @@ mod tests {
             [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         ];
         for a in cases {
-            let parts = RotationStretch::of(&a);
+            let parts = RotationStretch::of(&a).unwrap();
             assert!(close(&parts.linear(), &a, 1e-12), "{a:?} -> {parts:?}");
             let [x, y, z] = parts.rotation;
             assert!(x * x + y * y + z * z <= 1.0 + 1e-12, "the shorter way round");
         }
         assert_eq!(
             RotationStretch::of(&RotationStretch::IDENTITY.linear()),
-            RotationStretch::IDENTITY
+            Some(RotationStretch::IDENTITY)
         );
+        // Beyond what the decomposition can square: refused, not looped over or made infinite.
+        assert_eq!(RotationStretch::of(&[[1e300, 0.0, 0.0], [0.0, 1e300, 1e300], [0.0, 0.0, 1.0]]), None);
     }
 
     #[test]
     fn both_forms_store_and_rebuild_a_map() {
         let a = [[0.9, -0.4, 0.1], [0.45, 0.85, 0.05], [-0.1, 0.0, 1.1]];
         for form in LinearForm::ALL {
-            assert!(close(&form.linear(&form.values(&a)), &a, 1e-12), "{form:?}");
+            let values = form.values(&a).unwrap();
+            assert!(close(&form.linear(&values), &a, 1e-12), "{form:?}");
             let identity = form.linear(&form.identity());
             assert_eq!(identity, LinearForm::Entries.linear(&LinearForm::Entries.identity()));
         }
@@ -224,7 +235,7 @@ mod tests {
     fn a_rigid_turn_has_the_identity_stretch() {
         let (c, s) = (0.3f64.cos(), 0.3f64.sin());
         let a = [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]];
-        let parts = RotationStretch::of(&a);
+        let parts = RotationStretch::of(&a).unwrap();
         for (got, want) in parts.stretch.iter().zip(RotationStretch::IDENTITY.stretch) {
             assert!((got - want).abs() < 1e-12, "{parts:?}");
         }
