@@ -31,8 +31,8 @@ impl LinearForm {
     /// Both forms, by their stored id.
     pub const ALL: [LinearForm; 2] = [LinearForm::Entries, LinearForm::RotationStretch];
 
-    /// The nine stored numbers of `a` (none when its decomposition fails: see
-    /// [`RotationStretch::of`]).
+    /// The nine stored numbers of `a` (none when its rotation and stretch cannot be found: a
+    /// decomposition that does not converge or overflows, entries near the f64 range).
     #[cfg(feature = "encode")]
     pub fn values(self, a: &Linear) -> Option<[f64; 9]> {
         match self {

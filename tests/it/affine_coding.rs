@@ -27,7 +27,7 @@ fn stored(h: &[f64; 12], centroid: [f64; 3], c: usize, form: LinearForm) -> f64 
         3 => h[c] + (0..3).map(|j| h[4 * row + j] * centroid[j]).sum::<f64>(),
         col => {
             let a: [[f64; 3]; 3] = std::array::from_fn(|r| [h[4 * r], h[4 * r + 1], h[4 * r + 2]]);
-            form.values(&a)[3 * row + col]
+            form.values(&a).expect("a decomposable map")[3 * row + col]
         }
     }
 }
