@@ -219,7 +219,7 @@ impl SkinningWeights {
             .min(MAX_WEIGHT);
         // A stream without any weight (or with all zero) still needs a valid, positive limit.
         let limit = if largest > 0.0 { largest as f32 } else { 1.0 };
-        let bits = bits_by_effect(limit, bits, effect, reference.len(), track);
+        let (bits, limit) = bits_by_effect(limit, bits, effect, reference.len(), track);
         let top = Self::top(bits);
         let step = limit as f64 / top as f64;
         let values = exact
@@ -299,23 +299,35 @@ impl SkinningWeights {
     }
 }
 
-/// The fewest bits (at most `most`) whose weight step moves the vertices no more than the affine
-/// maps' quantisation does: the closed loop hands both errors to the residual coder, so weights
-/// finer than the maps cost bits and buy nothing. `effect` is `Σ_v Σ_j Σ_i ‖p_j^i − p_k^i‖²`
-/// (unit frame), so a weight step `w` moves the vertices by `w² effect / 12` squared in all;
-/// the maps move each vertex by about three translation steps `s`: `3 s² / 12` a vertex and
-/// frame.
+/// The bits (at most `most`) and limit of weights whose largest magnitude is `limit`: the fewest
+/// bits whose step can move the vertices no more than the affine maps' quantisation does (the
+/// closed loop hands both errors to the residual coder, so weights finer than the maps cost bits
+/// and buy nothing), and the limit widened so that the step is exactly that (the stored limit
+/// sets the step: a step that follows the maps' step smoothly, where the bits alone would halve
+/// it at each threshold). `effect` is `Σ_v Σ_j Σ_i ‖p_j^i − p_k^i‖²` (unit frame), so a weight
+/// step `w` moves the vertices by `w² effect / 12` squared in all; the maps move each vertex by
+/// about three translation steps `s`: `3 s² / 12` a vertex and frame.
 #[cfg(feature = "encode")]
-fn bits_by_effect(limit: f32, most: u8, effect: f64, vertices: usize, track: &AffineTrack) -> u8 {
+fn bits_by_effect(
+    limit: f32,
+    most: u8,
+    effect: f64,
+    vertices: usize,
+    track: &AffineTrack,
+) -> (u8, f32) {
     let step = f64::from(track.quantised().step);
     let per_vertex_frame = effect / (vertices.max(1) * track.frame_count().max(1)) as f64;
     if !(per_vertex_frame > 0.0 && per_vertex_frame.is_finite()) {
-        return most;
+        return (most, limit);
     }
     let target = step * (3.0 / per_vertex_frame).sqrt();
-    (2..most)
-        .find(|&b| f64::from(limit) / f64::from(SkinningWeights::top(b)) <= target)
-        .unwrap_or(most)
+    let Some(bits) =
+        (2..most).find(|&b| f64::from(limit) / f64::from(SkinningWeights::top(b)) <= target)
+    else {
+        return (most, limit);
+    };
+    let widened = (target * f64::from(SkinningWeights::top(bits))).min(MAX_WEIGHT) as f32;
+    (bits, widened.max(limit))
 }
 
 /// What every vertex's weight fit shares.
@@ -475,7 +487,7 @@ mod tests {
             "the bend must defeat the affine predictor"
         );
         assert!(
-            skin_seam < 0.2 * affine_seam,
+            skin_seam < 0.3 * affine_seam,
             "seam energy: skinning {skin_seam}, affine {affine_seam}"
         );
         assert!(skin_all < 0.5 * affine_all, "{skin_all} vs {affine_all}");
@@ -494,7 +506,8 @@ mod tests {
         let ((_, fine), (coarse_track, coarse)) = (fit(1e-6), fit(1e-2));
         assert!(fine.bits >= 14, "{} bits at step 1e-6", fine.bits);
         assert!(coarse.bits + 4 <= fine.bits, "{} bits at step 1e-2", coarse.bits);
-        // The coarse weights still remove most of the seam's error of the coarse maps.
+        // The coarse weights still remove most of the seam's error of the coarse maps (0.22 of it
+        // remains with their step exactly at the maps' effect).
         let (mut affine_seam, mut skin_seam) = (0.0, 0.0);
         let seam: Vec<usize> = (0..rest.len())
             .filter(|&v| rest[v][0].abs() < 0.3)
@@ -511,7 +524,7 @@ mod tests {
             skin_seam += energy(&seam.iter().map(|&v| s[v]).collect::<Vec<_>>());
         }
         assert!(
-            skin_seam < 0.2 * affine_seam,
+            skin_seam < 0.3 * affine_seam,
             "seam energy: skinning {skin_seam}, affine {affine_seam}"
         );
     }
