@@ -333,7 +333,7 @@ impl AffineTrack {
         }
         let geometry = ClusterGeometry::of(reference, partition);
         let stored = step as f32;
-        let quantised = quantise_track(&exact, frames.len(), &geometry, stored);
+        let quantised = quantise_track(&exact, frames.len(), &geometry, stored)?;
         Self::from_quantised(quantised, geometry)
     }
 
@@ -503,7 +503,7 @@ fn quantise_track(
     frames: usize,
     geometry: &ClusterGeometry,
     step: f32,
-) -> QuantisedAffine {
+) -> Result<QuantisedAffine> {
     let clusters = geometry.centroids.len();
     let mut values = vec![0i64; frames * clusters * 12];
     let mut forms = Vec::with_capacity(clusters);
@@ -524,28 +524,23 @@ fn quantise_track(
                 (form, levels, bits)
             })
         });
-        let best = candidates
+        // The first of the smallest: a tie keeps the entries, which every map has (only the
+        // decomposition can fail), so a cluster without a form cannot happen.
+        let (form, levels, _) = candidates
             .into_iter()
             .flatten()
-            .fold(None::<(LinearForm, Vec<[i64; 12]>, f64)>, |best, c| match best {
-                Some(b) if b.2 <= c.2 => Some(b),
-                _ => Some(c),
-            });
-        // The entries always exist: `LinearForm::values` fails only for the decomposition.
-        let (form, levels) = match best {
-            Some((form, levels, _)) => (form, levels),
-            None => (LinearForm::Entries, vec![[0; 12]; frames]),
-        };
+            .min_by(|a, b| a.2.total_cmp(&b.2))
+            .ok_or_else(|| Error::Mesh(format!("cluster {k}'s maps have no stored form")))?;
         forms.push(form);
         for (f, l) in levels.iter().enumerate() {
             values[(f * clusters + k) * 12..][..12].copy_from_slice(l);
         }
     }
-    QuantisedAffine {
+    Ok(QuantisedAffine {
         step,
         frames,
         clusters,
         forms,
         values,
-    }
+    })
 }
