@@ -96,10 +96,11 @@ pub struct MotionDescriptors {
     sampled: SampledMotion,
     adjacency: VertexAdjacency,
     features: Array2<f32>,
+    /// The training rows: these (the inliers'), or every row when fewer than K are inliers.
     inliers: Vec<usize>,
-    /// The training rows: the inliers', or every row when fewer than K are inliers.
-    training: Option<Array2<f32>>,
     spread: f32,
+    /// The features ready for k-means' products, made on first use and shared by every K.
+    centred: OnceLock<lloyd::Centred>,
     /// Seeds grown ahead for the largest K of a ladder ([`MotionDescriptors::prepare_seeds`]).
     prepared: OnceLock<Prepared>,
 }
@@ -120,15 +121,18 @@ impl MotionDescriptors {
         let adjacency = welded_adjacency(mesh, &sampled);
         let (features, misfit) = motion_features(&adjacency, &sampled, opts.ring);
         let inliers = affine_rings(&misfit);
-        let training = (!inliers.is_empty()).then(|| features.select(Axis(0), &inliers));
-        let spread = feature_spread(training.as_ref().unwrap_or(&features));
+        let spread = if inliers.is_empty() {
+            feature_spread(&features)
+        } else {
+            feature_spread(&features.select(Axis(0), &inliers))
+        };
         Self {
             sampled,
             adjacency,
             features,
             inliers,
-            training,
             spread,
+            centred: OnceLock::new(),
             prepared: OnceLock::new(),
         }
     }
@@ -145,29 +149,36 @@ impl MotionDescriptors {
         self.prepared.get_or_init(|| Prepared {
             seed,
             inliers,
-            picked: seed_rows(training, clusters.min(training.nrows()), seed),
+            picked: seed_rows(training, clusters.min(training.len()), seed),
         });
     }
 
     /// The rows k-means into `clusters` trains on, and whether they are the inliers', for a K
     /// k-means can make (1 < K); `None` otherwise.
-    fn training_rows(&self, clusters: usize) -> Option<(&Array2<f32>, bool)> {
+    fn training_rows(&self, clusters: usize) -> Option<(lloyd::Rows<'_>, bool)> {
         let k = clusters.min(self.features.nrows());
-        match &self.training {
+        match () {
             _ if k <= 1 => None,
-            Some(t) if self.inliers.len() >= k => Some((t, true)),
-            _ => Some((&self.features, false)),
+            _ if !self.inliers.is_empty() && self.inliers.len() >= k => {
+                Some((lloyd::Rows::picked(&self.features, &self.inliers), true))
+            }
+            _ => Some((lloyd::Rows::all(&self.features), false)),
         }
+    }
+
+    fn centred(&self) -> &lloyd::Centred {
+        self.centred
+            .get_or_init(|| lloyd::Centred::new(&self.features))
     }
 
     /// The first `k` k-means++ seeds of `training` with `seed`: the prepared ones when they
     /// cover them, else seeded now.
-    fn seeds(&self, training: &Array2<f32>, inliers: bool, k: usize, seed: u64) -> Array2<f32> {
+    fn seeds(&self, training: lloyd::Rows<'_>, inliers: bool, k: usize, seed: u64) -> Array2<f32> {
         match self.prepared.get() {
             Some(p) if (p.seed, p.inliers) == (seed, inliers) && p.picked.len() >= k => {
-                training.select(Axis(0), &p.picked[..k])
+                training.select(&p.picked[..k])
             }
-            _ => training.select(Axis(0), &seed_rows(training, k, seed)),
+            _ => training.select(&seed_rows(training, k, seed)),
         }
     }
 
@@ -178,7 +189,7 @@ impl MotionDescriptors {
         let k = opts.clusters.min(v_count);
         let (training, from_inliers) = self
             .training_rows(k)
-            .unwrap_or((&self.features, false));
+            .unwrap_or((lloyd::Rows::all(&self.features), false));
         let spread = if self.inliers.len() >= k {
             self.spread
         } else {
@@ -190,8 +201,10 @@ impl MotionDescriptors {
         }
         let tolerance = (1e-4 * spread).max(f32::MIN_POSITIVE);
         let seeds = self.seeds(training, from_inliers, k, opts.seed);
-        let centroids = lloyd::kmeans_from(training, seeds, opts.max_iterations, tolerance);
-        let mut labels = lloyd::nearest(&self.features, &centroids);
+        let centred = self.centred();
+        let centroids =
+            lloyd::kmeans_from(training, centred, seeds, opts.max_iterations, tolerance);
+        let mut labels = lloyd::nearest(lloyd::Rows::all(&self.features), centred, &centroids);
         if self.inliers.len() >= k && self.inliers.len() < v_count {
             assign_by_trajectory(&mut labels, &self.inliers, &self.sampled, k);
         }
@@ -286,7 +299,7 @@ fn motion_features(
 }
 
 /// The k-means++ seeds of `training` drawn with `seed` ([`lloyd::seed_rows`]).
-fn seed_rows(training: &Array2<f32>, k: usize, seed: u64) -> Vec<usize> {
+fn seed_rows(training: lloyd::Rows<'_>, k: usize, seed: u64) -> Vec<usize> {
     lloyd::seed_rows(training, k, &mut Xoshiro256Plus::seed_from_u64(seed))
 }
 

@@ -14,6 +14,56 @@ use rand::distributions::{Distribution, WeightedIndex};
 use rand::Rng;
 use rayon::prelude::*;
 
+/// Some rows of a matrix, in order: every row, or those listed (the k-means training rows are
+/// most of the descriptors' rows; picking them by index spares a copy of the largest matrix of
+/// an encode, and lets one [`Centred`] of the whole matrix serve every k-means on it).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Rows<'a> {
+    x: &'a Array2<f32>,
+    pick: Option<&'a [usize]>,
+}
+
+impl<'a> Rows<'a> {
+    /// Every row of `x`.
+    pub(crate) fn all(x: &'a Array2<f32>) -> Self {
+        Self { x, pick: None }
+    }
+
+    /// The rows of `x` listed in `pick` (each in range), in that order.
+    pub(crate) fn picked(x: &'a Array2<f32>, pick: &'a [usize]) -> Self {
+        Self { x, pick: Some(pick) }
+    }
+
+    /// Number of rows.
+    pub(crate) fn len(&self) -> usize {
+        self.pick.map_or(self.x.nrows(), <[usize]>::len)
+    }
+
+    /// Row number of the `i`th row in the whole matrix.
+    fn index(&self, i: usize) -> usize {
+        self.pick.map_or(i, |p| p.get(i).copied().unwrap_or(usize::MAX))
+    }
+
+    /// The `i`th row (empty when out of range).
+    fn row(&self, i: usize) -> std::borrow::Cow<'a, [f32]> {
+        let r = self.index(i);
+        if r >= self.x.nrows() {
+            return std::borrow::Cow::Borrowed(&[]);
+        }
+        let row = self.x.row(r);
+        match row.to_slice() {
+            Some(s) => std::borrow::Cow::Borrowed(s),
+            None => std::borrow::Cow::Owned(row.to_vec()),
+        }
+    }
+
+    /// The rows `which` (numbered among these rows) as a matrix.
+    pub(crate) fn select(&self, which: &[usize]) -> Array2<f32> {
+        let whole: Vec<usize> = which.iter().map(|&i| self.index(i)).collect();
+        self.x.select(Axis(0), &whole)
+    }
+}
+
 /// The `k` centroids of the rows of `x` (1 ≤ k ≤ rows): k-means++ seeding from `rng`
 /// ([`seed_rows`]), then [`kmeans_from`] those seeds.
 #[cfg(test)]
@@ -24,24 +74,26 @@ pub(crate) fn kmeans(
     max_rounds: u64,
     tolerance: f32,
 ) -> Array2<f32> {
-    let seeds = x.select(Axis(0), &seed_rows(x, k, rng));
-    kmeans_from(x, seeds, max_rounds, tolerance)
+    let rows = Rows::all(x);
+    let seeds = rows.select(&seed_rows(rows, k, rng));
+    kmeans_from(rows, &Centred::new(x), seeds, max_rounds, tolerance)
 }
 
-/// The centroids Lloyd rounds reach from the seeds `centroids` (rows like `x`'s): rounds until
-/// the centroids (as one vector) move less than `tolerance`, or `max_rounds`. Each update
-/// averages a centroid's rows together with the old centroid (m_k-means), so that an emptied
-/// centroid stays where it was.
+/// The centroids Lloyd rounds reach from the seeds `centroids` on `rows` (rows like theirs):
+/// rounds until the centroids (as one vector) move less than `tolerance`, or `max_rounds`. Each
+/// update averages a centroid's rows together with the old centroid (m_k-means), so that an
+/// emptied centroid stays where it was. `centred` is [`Centred::new`] of the whole matrix `rows`
+/// are taken from.
 pub(crate) fn kmeans_from(
-    x: &Array2<f32>,
+    rows: Rows<'_>,
+    centred: &Centred,
     mut centroids: Array2<f32>,
     max_rounds: u64,
     tolerance: f32,
 ) -> Array2<f32> {
-    let rows = Centred::new(x);
     for _ in 0..max_rounds.max(1) {
-        let labels = rows.nearest(&centroids);
-        let moved = means(x, &labels, &centroids);
+        let labels = centred.nearest(rows, &centroids);
+        let moved = means(rows, &labels, &centroids);
         let shift = exact_sq_distance(
             centroids.as_slice().unwrap_or(&[]),
             moved.as_slice().unwrap_or(&[]),
@@ -55,9 +107,10 @@ pub(crate) fn kmeans_from(
     centroids
 }
 
-/// Each row's nearest centroid (ties: the lowest index), measured as [`exact_sq_distance`] does.
-pub(crate) fn nearest(x: &Array2<f32>, centroids: &Array2<f32>) -> Vec<usize> {
-    Centred::new(x).nearest(centroids)
+/// Each row's nearest centroid (ties: the lowest index), measured as [`exact_sq_distance`] does;
+/// `centred` is [`Centred::new`] of the whole matrix `rows` are taken from.
+pub(crate) fn nearest(rows: Rows<'_>, centred: &Centred, centroids: &Array2<f32>) -> Vec<usize> {
+    centred.nearest(rows, centroids)
 }
 
 /// The squared distance of two equally long vectors, summed in f32 from the first element on:
@@ -102,43 +155,31 @@ fn row_norms(x: &Array2<f32>) -> Array1<f32> {
     x.map_axis(Axis(1), |r| r.dot(&r))
 }
 
-fn row_slice<'a>(row: &'a ArrayView1<'_, f32>) -> std::borrow::Cow<'a, [f32]> {
-    match row.as_slice() {
-        Some(s) => std::borrow::Cow::Borrowed(s),
-        None => std::borrow::Cow::Owned(row.to_vec()),
-    }
-}
-
 /// The rows k-means++ picks as the `k` seeds of `x` (1 ≤ k ≤ rows), in order: the first a row
 /// drawn uniformly from `rng` (as a weighted draw over weights one), each next one a row drawn
 /// with probability proportional to its squared distance to the nearest seed so far (the first
 /// row if every distance is zero). The first k seeds of K > k are the k seeds (the same draws in
 /// the same order), so the seeds of a ladder's largest K serve every K of it.
-pub(crate) fn seed_rows(x: &Array2<f32>, k: usize, rng: &mut impl Rng) -> Vec<usize> {
-    let rows = x.nrows();
+pub(crate) fn seed_rows(x: Rows<'_>, k: usize, rng: &mut impl Rng) -> Vec<usize> {
+    let rows = x.len();
     let first = WeightedIndex::new(std::iter::repeat_n(1f32, rows)).map_or(0, |w| w.sample(rng));
     let mut picked = vec![first];
     let mut nearest_d2 = vec![f32::INFINITY; rows];
-    let standard = x.as_standard_layout();
-    let dim = x.ncols();
-    let flat = standard.as_slice().unwrap_or(&[]);
-    let row = |i: usize| flat.get(i * dim..(i + 1) * dim).unwrap_or(&[]);
     while picked.len() < k {
-        let newest = row(picked[picked.len() - 1]);
+        let newest = x.row(picked[picked.len() - 1]);
+        let newest = &newest[..];
         nearest_d2
             .par_chunks_mut(LANES)
             .enumerate()
             .for_each(|(c, ds)| {
                 let first = c * LANES;
                 if ds.len() == LANES {
-                    let d = exact_sq_distances(
-                        std::array::from_fn(|l| row(first + l)),
-                        [newest; LANES],
-                    );
+                    let rows: [_; LANES] = std::array::from_fn(|l| x.row(first + l));
+                    let d = exact_sq_distances(std::array::from_fn(|l| &rows[l][..]), [newest; LANES]);
                     ds.iter_mut().zip(d).for_each(|(m, d)| *m = m.min(d));
                 } else {
                     for (l, m) in ds.iter_mut().enumerate() {
-                        *m = m.min(exact_sq_distance(row(first + l), newest));
+                        *m = m.min(exact_sq_distance(&x.row(first + l), newest));
                     }
                 }
             });
@@ -147,26 +188,28 @@ pub(crate) fn seed_rows(x: &Array2<f32>, k: usize, rng: &mut impl Rng) -> Vec<us
     picked
 }
 
-/// Rows ready for the matrix product: moved so that their mean is the origin (distances do not
-/// change, and the product's rounding, relative to the norms, shrinks to the spread of the rows),
-/// with their squared norms.
-struct Centred<'a> {
-    x: &'a Array2<f32>,
+/// The rows of a matrix ready for the matrix product: moved so that their mean is the origin
+/// (distances do not change, and the product's rounding, relative to the norms, shrinks to the
+/// spread of the rows), with their squared norms. Made once per matrix, it serves every k-means
+/// and every K on that matrix or on rows of it: the labels are the exact nearest centroids
+/// whichever mean the rows were moved by (the product only shortlists them).
+#[derive(Debug)]
+pub(crate) struct Centred {
     mean: Array1<f32>,
     centred: Array2<f32>,
     norms: Array1<f32>,
-    /// [`largest_magnitude`] of `x`.
+    /// [`largest_magnitude`] of the matrix.
     largest: f32,
 }
 
-impl<'a> Centred<'a> {
-    fn new(x: &'a Array2<f32>) -> Self {
+impl Centred {
+    /// `x` moved to its mean.
+    pub(crate) fn new(x: &Array2<f32>) -> Self {
         let mean = x.mean_axis(Axis(0)).unwrap_or_else(|| Array1::zeros(x.ncols()));
         let centred = x - &mean;
         let norms = row_norms(&centred);
         let largest = largest_magnitude(x);
         Self {
-            x,
             mean,
             centred,
             norms,
@@ -174,37 +217,42 @@ impl<'a> Centred<'a> {
         }
     }
 
-    /// The nearest centroid of each row. The product's distances carry rounding of the order of
-    /// dim·ε(‖x‖² + ‖c‖²); every centroid within a wide margin of that around the product's nearest
-    /// is measured exactly, and the first of the exact minima wins, as in linfa.
-    fn nearest(&self, centroids: &Array2<f32>) -> Vec<usize> {
+    /// The nearest centroid of each of `rows` (rows of the matrix this was made from). The
+    /// product's distances carry rounding of the order of dim·ε(‖x‖² + ‖c‖²); every centroid within
+    /// a wide margin of that around the product's nearest is measured exactly, and the first of the
+    /// exact minima wins, as in linfa.
+    fn nearest(&self, rows: Rows<'_>, centroids: &Array2<f32>) -> Vec<usize> {
         let moved = centroids - &self.mean;
         let cross = self.centred.dot(&moved.t());
         let centroid_norms = row_norms(&moved);
         let largest_norm = centroid_norms.iter().copied().fold(0.0, f32::max);
         let centroid_rows: Vec<Vec<f32>> =
             centroids.rows().into_iter().map(|r| r.to_vec()).collect();
-        let dim = self.x.ncols().max(1) as f32;
+        let dim = self.centred.ncols().max(1) as f32;
         // Whether every exact distance is finite: each squared difference is at most
         // (2 × the largest magnitude among the rows and centroids)², and the factor 2 covers the
         // summation's rounding.
         let largest = self.largest.max(largest_magnitude(centroids));
         let distances_finite = largest.is_finite()
             && f64::from(dim) * (2.0 * f64::from(largest)).powi(2) * 2.0 < f64::from(f32::MAX);
-        (0..self.x.nrows())
+        (0..rows.len())
             .into_par_iter()
             .map(|i| {
-                let n = self.norms[i];
-                let approx: Vec<f32> = cross
-                    .row(i)
+                let whole = rows.index(i);
+                let (Some(&n), Some(products)) = (
+                    self.norms.get(whole),
+                    (whole < cross.nrows()).then(|| cross.row(whole)),
+                ) else {
+                    return 0;
+                };
+                let approx: Vec<f32> = products
                     .iter()
                     .zip(&centroid_norms)
                     .map(|(&xc, &cc)| n - 2.0 * xc + cc)
                     .collect();
                 let lowest = approx.iter().copied().fold(f32::INFINITY, f32::min);
                 let margin = 64.0 * dim * f32::EPSILON * (n + largest_norm);
-                let row = self.x.row(i);
-                let row = row_slice(&row);
+                let row = rows.row(i);
                 // NaN (a non-finite descriptor) is measured too, as linfa would.
                 let close: Vec<usize> = (0..approx.len())
                     .filter(|&j| {
@@ -238,12 +286,13 @@ impl<'a> Centred<'a> {
 
 /// m_k-means update: each centroid becomes the mean of its rows and its old self, the rows summed
 /// in f32 in row order and the sum divided by the count, as linfa does.
-fn means(x: &Array2<f32>, labels: &[usize], centroids: &Array2<f32>) -> Array2<f32> {
+fn means(x: Rows<'_>, labels: &[usize], centroids: &Array2<f32>) -> Array2<f32> {
     let mut sums = Array2::<f32>::zeros(centroids.raw_dim());
     let mut counts = vec![1usize; centroids.nrows()];
-    for (row, &l) in x.rows().into_iter().zip(labels) {
+    for (i, &l) in labels.iter().enumerate().take(x.len()) {
+        let row = x.row(i);
         let mut sum = sums.row_mut(l);
-        sum += &row;
+        sum += &ArrayView1::from(&row[..]);
         counts[l] += 1;
     }
     sums += centroids;
@@ -284,7 +333,7 @@ mod tests {
         };
         let centroids = run();
         assert_eq!(centroids, run());
-        let labels = nearest(&x, &centroids);
+        let labels = nearest(Rows::all(&x), &Centred::new(&x), &centroids);
         // Every blob in one cluster, every cluster one blob.
         for c in 0..3 {
             let of_blob: Vec<usize> = (0..300).filter(|&i| truth[i] == c).map(|i| labels[i]).collect();
@@ -302,7 +351,7 @@ mod tests {
         let centroids = Array2::from_shape_vec((2, 3), vec![1e4, 0.0, 0.0, -1e4, 0.0, 0.0]).unwrap();
         let rows: Vec<f32> = (0..40).flat_map(|i| [(i as f32 - 20.0) * 1e-3, 5.0, 5.0]).collect();
         let x = Array2::from_shape_vec((40, 3), rows).unwrap();
-        let labels = nearest(&x, &centroids);
+        let labels = nearest(Rows::all(&x), &Centred::new(&x), &centroids);
         for (i, &l) in labels.iter().enumerate() {
             let row = x.row(i).to_vec();
             let d: Vec<f32> = centroids
@@ -321,6 +370,8 @@ mod tests {
         let mut rng = Xoshiro256Plus::seed_from_u64(3);
         let centroids = kmeans(&x, 4, &mut rng, 10, 0.0);
         assert!(centroids.iter().all(|&v| v == 1.5));
-        assert!(nearest(&x, &centroids).iter().all(|&l| l < 4));
+        assert!(nearest(Rows::all(&x), &Centred::new(&x), &centroids)
+            .iter()
+            .all(|&l| l < 4));
     }
 }
