@@ -18,7 +18,9 @@ use std::sync::Arc;
 
 #[cfg(any(test, feature = "internals"))]
 pub use super::transform::DEAD_ZONE;
-pub use super::transform::{basis, forward, quantise, Inverse};
+#[cfg(any(test, feature = "internals"))]
+pub use super::transform::quantise;
+pub use super::transform::{basis, forward, quantise_band, Inverse};
 
 /// Frequency classes of the context model: band k is in class min(⌊log2(k+1)⌋, CLASSES − 1).
 const CLASSES: usize = 8;

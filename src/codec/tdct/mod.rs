@@ -82,16 +82,16 @@ impl ResidualEncoder for Encoder {
         let step64 = f64::from(step);
         // Plain rounding here only decides which bands are empty; the levels coded are chosen by
         // rate and distortion as each band is coded.
-        let levels = coefficients::quantise(&coefficients, step64, 0.0)?;
         let mut coder = BandCoder::new(Arc::new(kept.neighbourhood));
-        let chunks = (levels.iter().zip(&coefficients).enumerate())
-            .map(|(k, (band, values))| {
+        let chunks = (coefficients.iter().enumerate())
+            .map(|(k, values)| {
+                let band = coefficients::quantise_band(values, step64, 0.0)?;
                 let scaled: Vec<f64> = values.iter().map(|c| c / step64).collect();
                 let rounding = Rounding {
                     scaled: &scaled,
                     lambda: ROUNDING_LAMBDA,
                 };
-                Ok(coder.encode_rounded(k, band, &rounding, &Spatial::ALL)?.0)
+                Ok(coder.encode_rounded(k, &band, &rounding, &Spatial::ALL)?.0)
             })
             .collect::<Result<Vec<_>>>()?;
         let (mut index, payload) = BandIndex::build(step, chunks);
@@ -126,12 +126,12 @@ impl ResidualEncoder for Encoder {
         let step = f64::from(self.step);
         let kept = Kept::of(input)?;
         let coefficients = coefficients::forward(&kept.residuals)?;
-        let levels = coefficients::quantise(&coefficients, step, transform::DEAD_ZONE)?;
         let mut coder = BandCoder::new(Arc::new(kept.neighbourhood));
-        let mut chunks = Vec::with_capacity(levels.len());
+        let mut chunks = Vec::with_capacity(coefficients.len());
         let (mut so_far, mut stopped) = (1, false);
-        for (k, band) in levels.iter().enumerate() {
-            let chunk = coder.encode_among(k, band, &[Spatial::Mean])?;
+        for (k, values) in coefficients.iter().enumerate() {
+            let band = coefficients::quantise_band(values, step, transform::DEAD_ZONE)?;
+            let chunk = coder.encode_among(k, &band, &[Spatial::Mean])?;
             so_far += chunk.len() as u64;
             chunks.push(chunk);
             stopped = limit.passed(so_far);

@@ -117,29 +117,36 @@ impl Inverse {
     }
 }
 
+#[cfg(any(test, feature = "internals"))]
 /// Uniform quantisation with step `step` and dead-zone offset `dead_zone` (0 = plain rounding).
 pub fn quantise(coefficients: &[Vec<f64>], step: f64, dead_zone: f64) -> Result<Vec<Vec<i64>>> {
+    coefficients
+        .iter()
+        .map(|band| quantise_band(band, step, dead_zone))
+        .collect()
+}
+
+/// [`quantise`] of one band: the coders quantise a band at a time, so that a clip's levels are
+/// never all held beside its coefficients (for a 50 000-vertex segment of 125 frames, 150 MB).
+pub fn quantise_band(band: &[f64], step: f64, dead_zone: f64) -> Result<Vec<i64>> {
     if !(step.is_finite() && step > 0.0) {
         return Err(Error::Usage(format!(
             "temporal-DCT step {step} must be a positive number"
         )));
     }
-    coefficients
-        .iter()
-        .map(|band| {
-            band.iter()
-                .map(|&c| {
-                    let m = (c.abs() / step + 0.5 - dead_zone).floor().max(0.0);
-                    if m > MAX_LEVEL {
-                        return Err(Error::Usage(format!(
-                            "temporal-DCT step {step} is too fine for coefficient {c}"
-                        )));
-                    }
-                    Ok(if c < 0.0 { -(m as i64) } else { m as i64 })
-                })
-                .collect()
-        })
-        .collect()
+    // Filled to its known length: collecting `Result`s cannot size the vector ahead, and its
+    // doubling left a band's levels 1.7 times their bytes on average.
+    let mut levels = Vec::with_capacity(band.len());
+    for &c in band {
+        let m = (c.abs() / step + 0.5 - dead_zone).floor().max(0.0);
+        if m > MAX_LEVEL {
+            return Err(Error::Usage(format!(
+                "temporal-DCT step {step} is too fine for coefficient {c}"
+            )));
+        }
+        levels.push(if c < 0.0 { -(m as i64) } else { m as i64 });
+    }
+    Ok(levels)
 }
 
 #[cfg(test)]
