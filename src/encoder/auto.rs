@@ -91,7 +91,7 @@ enum Kept<'a> {
 }
 
 /// What coding a sampled trial's candidate in full needs: its partition, segmentation report,
-/// prediction and atlas.
+/// prediction (its residuals left out, made again by [`keep`]) and atlas.
 type Trial<'a> = (
     Partition,
     analysis::SegmentationReport,
@@ -295,6 +295,11 @@ impl<'a> Job<'a> {
                 let kept = match encoded {
                     Some(encoded) => Kept::Stream(Box::new(encoded)),
                     None => {
+                        // Its residuals are made again if it wins ([`keep`]): held by the best
+                        // of each running job beside the next candidate's, they were the
+                        // largest memory of long segments' choices.
+                        let mut prediction = prediction;
+                        prediction.residuals = Vec::new();
                         let analysis = (partition.clone(), segmented.clone(), prediction);
                         Kept::Analysis(Box::new((analysis.0, analysis.1, analysis.2, self.atlas)))
                     }
@@ -386,7 +391,11 @@ fn keep(
             Ok(encoded)
         }
         Kept::Analysis(analysis) => {
-            let (partition, segmentation, prediction, atlas) = *analysis;
+            let (partition, segmentation, mut prediction, atlas) = *analysis;
+            let (mesh, reference) = (shared.mesh, &shared.ff.decoded_positions);
+            let weights = prediction.weights.as_ref();
+            prediction.residuals =
+                analysis::residuals_of(mesh, reference, &partition, &prediction.track, weights)?;
             let analysed = Analysed {
                 model,
                 partition: &partition,
