@@ -157,12 +157,12 @@ impl MotionDescriptors {
     /// k-means can make (1 < K); `None` otherwise.
     fn training_rows(&self, clusters: usize) -> Option<(lloyd::Rows<'_>, bool)> {
         let k = clusters.min(self.features.nrows());
-        match () {
-            _ if k <= 1 => None,
-            _ if !self.inliers.is_empty() && self.inliers.len() >= k => {
-                Some((lloyd::Rows::picked(&self.features, &self.inliers), true))
-            }
-            _ => Some((lloyd::Rows::all(&self.features), false)),
+        if k <= 1 {
+            None
+        } else if self.inliers.len() >= k {
+            Some((lloyd::Rows::picked(&self.features, &self.inliers), true))
+        } else {
+            Some((lloyd::Rows::all(&self.features), false))
         }
     }
 
