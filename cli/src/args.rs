@@ -187,7 +187,7 @@ pub struct EncodeArgs {
     #[arg(long)]
     pub step: Option<f64>,
     /// Number of motion clusters K: alone, k-means with exactly K; with --segmentation auto,
-    /// K of its k-means candidate (tdct's auto also tries 1.5 K and 2 K) [default: 20].
+    /// K of its k-means candidate (tdct's auto also tries 1.5 K, and 2 K when 1.5 K paid) [default: 20].
     #[arg(long)]
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or

@@ -16,6 +16,7 @@
 //! sample's bytes alone can keep a candidate whose whole stream is both larger and worse
 //! (docs/design.md, "Automatic choice: bits at equal error").
 
+use super::ladder;
 use super::sampled_trial::Sample;
 use super::{analysis, code, distortion, estimate, Analysed, Encoded, Settings, Stopwatch};
 use crate::encoder::{MotionModel, Segmentation};
@@ -26,8 +27,7 @@ use crate::mesh::AnimatedMesh;
 use crate::motion::{Partition, PredictorKind};
 use crate::progress::Progress;
 use crate::stream::container::Part;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// What the automatic choice measured and kept.
@@ -137,8 +137,12 @@ pub(super) fn choose(
         .iter()
         .map(|_| AtlasCache::default())
         .collect();
+    let gates = match estimated && sample.is_none() {
+        true => ladder::gates(&segmentations),
+        false => vec![None; segmentations.len()],
+    };
     let mut jobs = Vec::with_capacity(segmentations.len());
-    for (&(segmentation, k), atlas) in segmentations.iter().zip(&atlases) {
+    for (index, (&(segmentation, k), atlas)) in segmentations.iter().zip(&atlases).enumerate() {
         let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);
         let first = jobs.iter().map(|j: &Job| j.models.len()).sum();
         let models = models.iter().filter(same).copied().collect();
@@ -147,28 +151,44 @@ pub(super) fn choose(
             models,
             first,
             atlas,
+            below: gates[index].map(|(a, b)| (segmentations[a].1, segmentations[b].1)),
+            may_stop: ladder::may_stop(&gates, index),
         });
     }
-    let outcomes = in_order(&jobs, |job| job.run(&shared, &segmenter, progress))?;
-    let (mut candidates, mut costs, mut best) = (Vec::new(), Vec::new(), None::<Best>);
-    for outcome in outcomes {
+    let outcomes = ladder::run_jobs(
+        &gates,
+        |i| jobs[i].run(&shared, &segmenter, progress),
+        |i| jobs[i].skip(&shared, progress),
+        |outcome| outcome.best.as_ref().map(|b| b.cost),
+    )?;
+    let (mut candidates, mut costs, mut best) = (Vec::new(), Vec::new(), None::<(Best, usize)>);
+    let mut skipped = Vec::new();
+    for (job, outcome) in jobs.iter().zip(outcomes) {
         clock.stages.extend(outcome.stages);
+        skipped.extend(outcome.skipped);
+        let position = candidates.len() as isize - job.first as isize;
         candidates.extend(outcome.candidates);
         costs.extend(outcome.costs);
         if let Some(b) = outcome.best {
-            if best.as_ref().is_none_or(|best| b.cost < best.cost) {
-                best = Some(b);
+            if best.as_ref().is_none_or(|(best, _)| b.cost < best.cost) {
+                let at = (b.index as isize + position) as usize;
+                best = Some((b, at));
             }
         }
     }
-    let best = best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
+    let (best, at) =
+        best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
     let model = models[best.index];
-    let reason = reason(&candidates, &costs, best.index, (trial_frames, frames));
+    let mut reason = reason(&candidates, &costs, at, (trial_frames, frames));
+    for s in skipped {
+        reason.push_str("; ");
+        reason.push_str(&s);
+    }
     let mut encoded = keep(&shared, model, best.kept, progress, clock)?;
-    if sample.is_none() && candidates[best.index].estimated {
+    if sample.is_none() && candidates[at].estimated {
         // The kept one's size is its stream's now, not an estimate.
-        candidates[best.index].bytes = encoded.report.bytes;
-        candidates[best.index].estimated = false;
+        candidates[at].bytes = encoded.report.bytes;
+        candidates[at].estimated = false;
     }
     encoded.report.choice = Some(ChoiceReport {
         chosen: model.name(),
@@ -179,53 +199,26 @@ pub(super) fn choose(
     Ok(encoded)
 }
 
-/// `run` of every job on rayon's threads, each thread taking the next job not yet started, so that
-/// jobs start in their order (a split work list would start the last half's first job beside the
-/// first one): the default candidates' estimates are known soonest, and the later jobs' stop
-/// sooner. The outcomes in the jobs' order; the first job's error in that order if any fails.
-fn in_order<'a, J: Sync, T: Send>(
-    jobs: &'a [J],
-    run: impl Fn(&'a J) -> Result<T> + Sync,
-) -> Result<Vec<T>> {
-    let next = AtomicUsize::new(0);
-    let done: Vec<Mutex<Option<Result<T>>>> = jobs.iter().map(|_| Mutex::new(None)).collect();
-    let workers = rayon::current_num_threads().clamp(1, jobs.len().max(1));
-    rayon::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|_| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(job) = jobs.get(i) else {
-                    break;
-                };
-                let outcome = run(job);
-                if let Ok(mut slot) = done[i].lock() {
-                    *slot = Some(outcome);
-                }
-            });
-        }
-    });
-    done.into_iter()
-        .map(|slot| {
-            let outcome = slot.into_inner().ok().flatten();
-            outcome.unwrap_or_else(|| Err(Error::Codec("a trial of the choice did not end".into())))
-        })
-        .collect()
-}
-
 /// One segmentation and the candidates that use it, numbered from `first` among all.
 struct Job<'a> {
     segmentation: (Segmentation, usize),
     models: Vec<MotionModel>,
     first: usize,
     atlas: &'a AtlasCache,
+    /// The K of the k-means rungs whose costs decide whether this one runs ([`ladder`]).
+    below: Option<(usize, usize)>,
+    /// Whether its estimates may stop early (not when a gate reads them).
+    may_stop: bool,
 }
 
-/// What a job measured: its candidates and their costs, its stages' seconds, its best.
+/// What a job measured: its candidates and their costs, its stages' seconds, its best; or why
+/// it was not tried.
 struct Outcome<'a> {
     candidates: Vec<Candidate>,
     costs: Vec<f64>,
     stages: Vec<(String, f64)>,
     best: Option<Best<'a>>,
+    skipped: Option<String>,
 }
 
 impl<'a> Job<'a> {
@@ -252,6 +245,7 @@ impl<'a> Job<'a> {
             costs: Vec::new(),
             stages: vec![(stage, start.elapsed().as_secs_f64())],
             best: None,
+            skipped: None,
         };
         let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
         for (i, &model) in self.models.iter().enumerate() {
@@ -271,7 +265,8 @@ impl<'a> Job<'a> {
                 prediction: &prediction,
                 atlas: Some(self.atlas),
             };
-            let (bytes, encoded, error, stopped) = trial(shared, &analysed, &progress)?;
+            let (bytes, encoded, error, stopped) =
+                trial(shared, &analysed, self.may_stop, &progress)?;
             let cost = distortion::cost(8.0 * bytes as f64, error);
             outcome.candidates.push(Candidate {
                 predictor: model.predictor,
@@ -309,6 +304,26 @@ impl<'a> Job<'a> {
         }
         Ok(outcome)
     }
+
+    /// The outcome of a rung the ladder does not climb to: no candidate, the reason, and its
+    /// trials' share of the progress bar.
+    fn skip(&self, shared: &Shared, progress: &dyn Progress) -> Outcome<'a> {
+        let below = self.below.unwrap_or_default();
+        let frames = shared.sample.map_or(shared.mesh.frame_count(), |s| s.frames.len());
+        progress.frames((self.models.len() * frames) as u64);
+        let k = self.segmentation.1;
+        let why = format!(
+            "k-means K = {k} not tried: K = {} did not beat K = {}",
+            below.1, below.0
+        );
+        Outcome {
+            candidates: Vec::new(),
+            costs: Vec::new(),
+            stages: vec![(format!("segmentation (kmeans, K = {k}) skipped"), 0.0)],
+            best: None,
+            skipped: Some(why),
+        }
+    }
 }
 
 /// What every trial shares: the animation (in the stream's vertex order), its coded first frame
@@ -330,6 +345,7 @@ struct Shared<'a> {
 fn trial(
     shared: &Shared,
     analysed: &Analysed,
+    may_stop: bool,
     progress: &dyn Progress,
 ) -> Result<(u64, Option<Encoded>, Option<f64>, bool)> {
     let Shared {
@@ -339,7 +355,10 @@ fn trial(
         None if settings.opts.codec.codec().estimated_trials() => {
             let ff_and_leading = (shared.ff, shared.leading);
             let smallest = &shared.smallest_estimate;
-            let estimate = estimate(mesh, ff_and_leading, settings, analysed, progress, smallest)?;
+            // A gated rung reads this estimate: it runs to the end, whatever ended before it.
+            let never = AtomicU64::new(u64::MAX);
+            let limit = if may_stop { smallest } else { &never };
+            let estimate = estimate(mesh, ff_and_leading, settings, analysed, progress, limit)?;
             if !estimate.stopped {
                 smallest.fetch_min(estimate.bytes, Ordering::Relaxed);
             }

@@ -16,6 +16,7 @@ internal! {
     auto;
     distortion;
     first_frame_bits;
+    ladder;
     sampled_trial;
     segment_runs;
     segments;

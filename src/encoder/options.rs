@@ -204,7 +204,7 @@ pub struct MotionModel {
 }
 
 /// The k-means cluster counts an automatic segmentation tries with a codec of cheap trials, from
-/// the caller's `k`: k, 1.5 k and 2 k. More clusters fit the motion more closely for more side
+/// the caller's `k`: k, 1.5 k and 2 k (a rung only when the one below paid: `encoder/ladder.rs`). More clusters fit the motion more closely for more side
 /// information; which wins depends on the animation and the step
 /// (docs/design.md, "First-frame bits trials and k-means ladder").
 pub fn kmeans_ladder(k: usize) -> Vec<usize> {
