@@ -166,12 +166,13 @@ pub(super) fn choose(
     for (job, outcome) in jobs.iter().zip(outcomes) {
         clock.stages.extend(outcome.stages);
         skipped.extend(outcome.skipped);
-        let position = candidates.len() as isize - job.first as isize;
+        // Where the job's candidates start in the report (a skipped rung has none).
+        let base = candidates.len();
         candidates.extend(outcome.candidates);
         costs.extend(outcome.costs);
         if let Some(b) = outcome.best {
             if best.as_ref().is_none_or(|(best, _)| b.cost < best.cost) {
-                let at = (b.index as isize + position) as usize;
+                let at = base + b.index.saturating_sub(job.first);
                 best = Some((b, at));
             }
         }
