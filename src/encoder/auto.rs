@@ -137,46 +137,24 @@ pub(super) fn choose(
         .iter()
         .map(|_| AtlasCache::default())
         .collect();
+    // The ladder's stop reads tdct's estimates of every frame (`ladder`).
     let gates = match estimated && sample.is_none() {
         true => ladder::gates(&segmentations),
         false => vec![None; segmentations.len()],
     };
-    let mut jobs = Vec::with_capacity(segmentations.len());
-    for (index, (&(segmentation, k), atlas)) in segmentations.iter().zip(&atlases).enumerate() {
-        let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);
-        let first = jobs.iter().map(|j: &Job| j.models.len()).sum();
-        let models = models.iter().filter(same).copied().collect();
-        jobs.push(Job {
-            segmentation: (segmentation, k),
-            models,
-            first,
-            atlas,
-            below: gates[index].map(|(a, b)| (segmentations[a].1, segmentations[b].1)),
-            may_stop: ladder::may_stop(&gates, index),
-        });
-    }
+    let jobs = jobs_of(models, &segmentations, &atlases, &gates);
     let outcomes = ladder::run_jobs(
         &gates,
         |i| jobs[i].run(&shared, &segmenter, progress),
         |i| jobs[i].skip(&shared, progress),
         |outcome| outcome.best.as_ref().map(|b| b.cost),
     )?;
-    let (mut candidates, mut costs, mut best) = (Vec::new(), Vec::new(), None::<(Best, usize)>);
-    let mut skipped = Vec::new();
-    for (job, outcome) in jobs.iter().zip(outcomes) {
-        clock.stages.extend(outcome.stages);
-        skipped.extend(outcome.skipped);
-        // Where the job's candidates start in the report (a skipped rung has none).
-        let base = candidates.len();
-        candidates.extend(outcome.candidates);
-        costs.extend(outcome.costs);
-        if let Some(b) = outcome.best {
-            if best.as_ref().is_none_or(|(best, _)| b.cost < best.cost) {
-                let at = base + b.index.saturating_sub(job.first);
-                best = Some((b, at));
-            }
-        }
-    }
+    let Tally {
+        mut candidates,
+        costs,
+        best,
+        skipped,
+    } = tally(&jobs, outcomes, &mut clock);
     let (best, at) =
         best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
     let model = models[best.index];
@@ -198,6 +176,68 @@ pub(super) fn choose(
         candidates,
     });
     Ok(encoded)
+}
+
+/// One job per segmentation of `models` (each with its atlas cache and gate), its candidates
+/// numbered on from the previous job's.
+fn jobs_of<'a>(
+    models: &[MotionModel],
+    segmentations: &[(Segmentation, usize)],
+    atlases: &'a [AtlasCache],
+    gates: &[Option<(usize, usize)>],
+) -> Vec<Job<'a>> {
+    let mut jobs = Vec::with_capacity(segmentations.len());
+    for (index, (&(segmentation, k), atlas)) in segmentations.iter().zip(atlases).enumerate() {
+        let same = |m: &&MotionModel| (m.segmentation, m.clusters) == (segmentation, k);
+        let first = jobs.iter().map(|j: &Job| j.models.len()).sum();
+        let models = models.iter().filter(same).copied().collect();
+        let gate = gates.get(index).copied().flatten();
+        let k_of = |job: usize| segmentations.get(job).map_or(0, |s| s.1);
+        jobs.push(Job {
+            segmentation: (segmentation, k),
+            models,
+            first,
+            atlas,
+            below: gate.map(|(a, b)| (k_of(a), k_of(b))),
+            may_stop: ladder::may_stop(gates, index),
+        });
+    }
+    jobs
+}
+
+/// Every job's candidates in the jobs' order, their costs, the lowest (and its place among the
+/// candidates), and why rungs were skipped.
+struct Tally<'a> {
+    candidates: Vec<Candidate>,
+    costs: Vec<f64>,
+    best: Option<(Best<'a>, usize)>,
+    skipped: Vec<String>,
+}
+
+/// Gathers the jobs' outcomes, their stages into `clock`; the lowest cost wins, the earliest
+/// candidate on a tie.
+fn tally<'a>(jobs: &[Job], outcomes: Vec<Outcome<'a>>, clock: &mut Stopwatch) -> Tally<'a> {
+    let mut tally = Tally {
+        candidates: Vec::new(),
+        costs: Vec::new(),
+        best: None,
+        skipped: Vec::new(),
+    };
+    for (job, outcome) in jobs.iter().zip(outcomes) {
+        clock.stages.extend(outcome.stages);
+        tally.skipped.extend(outcome.skipped);
+        // Where the job's candidates start in the report (a skipped rung has none).
+        let base = tally.candidates.len();
+        tally.candidates.extend(outcome.candidates);
+        tally.costs.extend(outcome.costs);
+        if let Some(b) = outcome.best {
+            if tally.best.as_ref().is_none_or(|(best, _)| b.cost < best.cost) {
+                let at = base + b.index.saturating_sub(job.first);
+                tally.best = Some((b, at));
+            }
+        }
+    }
+    tally
 }
 
 /// One segmentation and the candidates that use it, numbered from `first` among all.
