@@ -17,6 +17,7 @@
 //! ```
 
 mod block_laplace;
+mod block_operator;
 mod cg;
 mod dct_energy;
 mod empty_blocks;
@@ -30,6 +31,7 @@ pub use error::PaddingError;
 pub use options::{EmptyBlocks, JpegTable, Method, PaddingOptions};
 
 use block_laplace::BlockLaplace;
+use block_operator::BlockOperator;
 use dct_energy::{DctEnergy, Weighting};
 use grid::BlockGrid;
 
@@ -42,6 +44,8 @@ pub struct PadStats {
     pub cg_iterations: usize,
     /// Systems stopped by `max_iterations` before reaching `tolerance` (their last iterate is used).
     pub unconverged: usize,
+    /// Blocks filled by their mask's precomputed minimiser (the DCT-energy methods), no CG.
+    pub direct: usize,
 }
 
 impl PadStats {
@@ -64,6 +68,7 @@ impl PadStats {
 ///
 /// Errors (never panics) on an empty image, buffers whose length is not `width × height`, a zero
 /// block size (or not 8 for the DCT-based `dct`, `biharmonic` and `snap`), or a non-finite fixed or previous pixel.
+/// Many images on one mask (the frames of a clip) are padded faster by one [`Padder`].
 pub fn pad(
     image: &mut [f32],
     width: usize,
@@ -72,65 +77,162 @@ pub fn pad(
     previous: Option<&[f32]>,
     opts: &PaddingOptions,
 ) -> Result<PadStats, PaddingError> {
-    validate(image, width, height, fixed, previous, opts)?;
-    let grid = BlockGrid::new(width, height, opts.block);
-    let limits = cg::CgLimits {
-        tolerance: f64::from(opts.tolerance.max(0.0)),
-        max_iterations: opts.max_iterations,
-    };
-    let mut stats = PadStats::default();
-    let mut filled = grid.any_set(fixed);
-    let mut held = fixed.to_vec();
-    if let Some(previous) = previous {
-        empty_blocks::copy_from_previous(&grid, image, previous, &mut filled, &mut held);
+    Padder::new(width, height, fixed, opts)?.pad(image, previous)
+}
+
+/// [`pad`] for any number of images that share one mask: what depends on the mask alone (for the
+/// DCT-energy methods, each block mask's minimiser, see `block_operator.rs`) is made once here.
+/// The values are those of the exact block minimiser, where [`Method::Cg`] and [`Method::Laplace`]
+/// stop at [`PaddingOptions::tolerance`].
+#[derive(Debug, Clone)]
+pub struct Padder {
+    grid: BlockGrid,
+    fixed: Vec<bool>,
+    opts: PaddingOptions,
+    operators: BlockOperators,
+}
+
+impl Padder {
+    /// The padder of `width × height` images whose fixed pixels are those set in `fixed`. Errors as
+    /// [`pad`] does on the sizes and the options.
+    pub fn new(
+        width: usize,
+        height: usize,
+        fixed: &[bool],
+        opts: &PaddingOptions,
+    ) -> Result<Self, PaddingError> {
+        validate_mask(width, height, fixed, opts)?;
+        let grid = BlockGrid::new(width, height, opts.block);
+        let operators = match BlockSolver::new(opts) {
+            BlockSolver::Dct(solver) => BlockOperators::new(&grid, fixed, &solver),
+            _ => BlockOperators::default(),
+        };
+        Ok(Padder {
+            grid,
+            fixed: fixed.to_vec(),
+            opts: opts.clone(),
+            operators,
+        })
     }
-    if !held.iter().any(|&h| h) {
-        image.fill(0.0);
-        return Ok(stats);
+
+    /// The options this padder was made with.
+    pub fn options(&self) -> &PaddingOptions {
+        &self.opts
     }
-    match opts.method {
-        Method::MidGrey => {
-            let (lo, hi) = fixed_range(image, fixed);
-            let mid = if lo <= hi { 0.5 * (lo + hi) } else { 0.0 };
-            image
-                .iter_mut()
-                .zip(&held)
-                .filter(|(_, &h)| !h)
-                .for_each(|(v, _)| *v = mid);
+
+    /// Pads `image` (see [`pad`]); `previous` as there.
+    pub fn pad(
+        &self,
+        image: &mut [f32],
+        previous: Option<&[f32]>,
+    ) -> Result<PadStats, PaddingError> {
+        let (grid, fixed, opts) = (&self.grid, self.fixed.as_slice(), &self.opts);
+        validate_image(image, fixed, previous, grid.width * grid.height)?;
+        let (width, height) = (grid.width, grid.height);
+        let limits = cg::CgLimits {
+            tolerance: f64::from(opts.tolerance.max(0.0)),
+            max_iterations: opts.max_iterations,
+        };
+        let mut stats = PadStats::default();
+        let mut filled = grid.any_set(fixed);
+        let mut held = fixed.to_vec();
+        if let Some(previous) = previous {
+            empty_blocks::copy_from_previous(grid, image, previous, &mut filled, &mut held);
         }
-        Method::PushPull => push_pull::fill(image, width, height, &held),
-        Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
-        Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic | Method::Snap => {
-            let mut block_solver = BlockSolver::new(opts);
-            let with_fixed = grid.any_set(fixed);
-            for b in (0..grid.len()).filter(|&b| with_fixed[b]) {
+        if !held.iter().any(|&h| h) {
+            image.fill(0.0);
+            return Ok(stats);
+        }
+        match opts.method {
+            Method::MidGrey => {
+                let (lo, hi) = fixed_range(image, fixed);
+                let mid = if lo <= hi { 0.5 * (lo + hi) } else { 0.0 };
+                image
+                    .iter_mut()
+                    .zip(&held)
+                    .filter(|(_, &h)| !h)
+                    .for_each(|(v, _)| *v = mid);
+            }
+            Method::PushPull => push_pull::fill(image, width, height, &held),
+            Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
+            Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic | Method::Snap => {
+                let mut block_solver = BlockSolver::new(opts);
+                let with_fixed = grid.any_set(fixed);
+                for b in (0..grid.len()).filter(|&b| with_fixed[b]) {
+                    let rect = grid.rect(b);
+                    match &mut block_solver {
+                        BlockSolver::Mean => fill_block_mean(grid, rect, image, fixed),
+                        BlockSolver::Laplace(solver) => {
+                            solver.pad_block(grid, rect, image, fixed, limits, &mut stats)
+                        }
+                        BlockSolver::Dct(solver) => {
+                            let operator = self.operators.of(b);
+                            solver.pad_block(grid, rect, image, fixed, operator, limits, &mut stats)
+                        }
+                    }
+                }
+                self.fill_empty_blocks(image, &mut filled);
+            }
+        }
+        Ok(stats)
+    }
+
+    fn fill_empty_blocks(&self, image: &mut [f32], filled: &mut [bool]) {
+        let (grid, fixed) = (&self.grid, self.fixed.as_slice());
+        match self.opts.empty_blocks {
+            EmptyBlocks::NeighbourMean => {
+                empty_blocks::fill_flat_from_neighbours(grid, image, filled, 0.0);
+            }
+            EmptyBlocks::FixedMean => {
+                let mean = fixed_mean(image, fixed);
+                empty_blocks::fill_flat(grid, image, filled, mean);
+            }
+            EmptyBlocks::RasterPrevious => {
+                let mean = fixed_mean(image, fixed);
+                empty_blocks::fill_from_raster_previous(grid, image, filled, mean);
+            }
+        }
+    }
+}
+
+/// Each block's mask minimiser, one per distinct mask (many border blocks share a mask).
+#[derive(Debug, Clone, Default)]
+struct BlockOperators {
+    distinct: Vec<Option<BlockOperator>>,
+    /// Index into `distinct` per block; `None` for a block without fixed pixels (or no operators).
+    of_block: Vec<Option<usize>>,
+}
+
+impl BlockOperators {
+    fn new(grid: &BlockGrid, fixed: &[bool], solver: &DctEnergy) -> Self {
+        let energy = solver.energy_matrix();
+        let mut by_mask = std::collections::HashMap::new();
+        let mut distinct = Vec::new();
+        let of_block = (0..grid.len())
+            .map(|b| {
                 let rect = grid.rect(b);
-                match &mut block_solver {
-                    BlockSolver::Mean => fill_block_mean(&grid, rect, image, fixed),
-                    BlockSolver::Laplace(solver) => {
-                        solver.pad_block(&grid, rect, image, fixed, limits, &mut stats)
-                    }
-                    BlockSolver::Dct(solver) => {
-                        solver.pad_block(&grid, rect, image, fixed, limits, &mut stats)
+                let mut mask = 0u64;
+                for (i, pixel) in grid.pixels(rect).enumerate() {
+                    let local = (i / rect.w) * dct_energy::SIDE + i % rect.w;
+                    if fixed[pixel] {
+                        mask |= 1 << local;
                     }
                 }
-            }
-            match opts.empty_blocks {
-                EmptyBlocks::NeighbourMean => {
-                    empty_blocks::fill_flat_from_neighbours(&grid, image, &mut filled, 0.0);
-                }
-                EmptyBlocks::FixedMean => {
-                    let mean = fixed_mean(image, fixed);
-                    empty_blocks::fill_flat(&grid, image, &mut filled, mean);
-                }
-                EmptyBlocks::RasterPrevious => {
-                    let mean = fixed_mean(image, fixed);
-                    empty_blocks::fill_from_raster_previous(&grid, image, &mut filled, mean);
-                }
-            }
-        }
+                (mask != 0).then(|| {
+                    *by_mask.entry(mask).or_insert_with(|| {
+                        distinct.push(BlockOperator::new(&energy, mask));
+                        distinct.len() - 1
+                    })
+                })
+            })
+            .collect();
+        BlockOperators { distinct, of_block }
     }
-    Ok(stats)
+
+    fn of(&self, block: usize) -> Option<&BlockOperator> {
+        let index = (*self.of_block.get(block)?)?;
+        self.distinct[index].as_ref()
+    }
 }
 
 enum BlockSolver {
@@ -196,12 +298,10 @@ fn fixed_range(image: &[f32], fixed: &[bool]) -> (f32, f32) {
         })
 }
 
-fn validate(
-    image: &[f32],
+fn validate_mask(
     width: usize,
     height: usize,
     fixed: &[bool],
-    previous: Option<&[f32]>,
     opts: &PaddingOptions,
 ) -> Result<(), PaddingError> {
     if width == 0 || height == 0 {
@@ -210,38 +310,7 @@ fn validate(
     let expected = width
         .checked_mul(height)
         .ok_or(PaddingError::EmptyImage { width, height })?;
-    let check = |what, got| {
-        if got == expected {
-            Ok(())
-        } else {
-            Err(PaddingError::SizeMismatch {
-                what,
-                got,
-                expected,
-            })
-        }
-    };
-    check("image", image.len())?;
-    check("mask", fixed.len())?;
-    if let Some(previous) = previous {
-        check("previous", previous.len())?;
-        if let Some(index) = previous.iter().position(|v| !v.is_finite()) {
-            return Err(PaddingError::NonFinite {
-                what: "previous",
-                index,
-            });
-        }
-    }
-    if let Some(index) = image
-        .iter()
-        .zip(fixed)
-        .position(|(v, &f)| f && !v.is_finite())
-    {
-        return Err(PaddingError::NonFinite {
-            what: "image",
-            index,
-        });
-    }
+    check_len("mask", fixed.len(), expected)?;
     if opts.block == 0 {
         return Err(PaddingError::BadBlock {
             block: 0,
@@ -258,6 +327,47 @@ fn validate(
             block: opts.block,
             method: opts.method.to_string(),
             why: "the quantiser-weighted DCT works on JPEG's 8x8 blocks",
+        });
+    }
+    Ok(())
+}
+
+fn check_len(what: &'static str, got: usize, expected: usize) -> Result<(), PaddingError> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(PaddingError::SizeMismatch {
+            what,
+            got,
+            expected,
+        })
+    }
+}
+
+fn validate_image(
+    image: &[f32],
+    fixed: &[bool],
+    previous: Option<&[f32]>,
+    expected: usize,
+) -> Result<(), PaddingError> {
+    check_len("image", image.len(), expected)?;
+    if let Some(previous) = previous {
+        check_len("previous", previous.len(), expected)?;
+        if let Some(index) = previous.iter().position(|v| !v.is_finite()) {
+            return Err(PaddingError::NonFinite {
+                what: "previous",
+                index,
+            });
+        }
+    }
+    if let Some(index) = image
+        .iter()
+        .zip(fixed)
+        .position(|(v, &f)| f && !v.is_finite())
+    {
+        return Err(PaddingError::NonFinite {
+            what: "image",
+            index,
         });
     }
     Ok(())

@@ -18,8 +18,8 @@ pub struct GeometryImages {
     pub ranges: Vec<FrameRanges>,
     /// The residuals the ranges clip, sent apart.
     pub corrections: Corrections,
-    /// How free pixels are filled.
-    pub padding: padding::PaddingOptions,
+    /// How free pixels are filled: the options, made ready for the atlas's mask.
+    pub padding: padding::Padder,
     /// Frames per group: the first frame of a group is padded on its own, the others continue the
     /// previous frame's padding (P-frames); 1 for intra codecs.
     pub gop: usize,
@@ -29,7 +29,8 @@ pub struct GeometryImages {
 
 impl GeometryImages {
     /// The images of an encoding on `atlas` at `pixel_step` and `depth` bits a sample, with
-    /// offsets centred on the `residuals` of each frame or group as `mode` groups them.
+    /// offsets centred on the `residuals` of each frame or group as `mode` groups them. Errors when
+    /// the padding options do not fit the lattice.
     pub fn new(
         lattice: (u16, u16),
         atlas: atlas::Atlas,
@@ -37,9 +38,11 @@ impl GeometryImages {
         (mode, depth): (RangeMode, u8),
         pixel_step: f32,
         padding: padding::PaddingOptions,
-    ) -> Self {
+    ) -> Result<Self> {
         let (ranges, corrections) = quantise::choose(residuals, mode, pixel_step, depth);
-        Self {
+        let (w, h) = (usize::from(lattice.0), usize::from(lattice.1));
+        let padding = padding::Padder::new(w, h, &atlas.fixed_mask(), &padding)?;
+        Ok(Self {
             lattice,
             atlas,
             pixel_step,
@@ -48,11 +51,7 @@ impl GeometryImages {
             padding,
             gop: mode.group(),
             depth,
-        }
-    }
-
-    fn size(&self) -> (usize, usize) {
-        (self.lattice.0 as usize, self.lattice.1 as usize)
+        })
     }
 
     /// Frame `f`'s residuals of coordinate `axis` as levels in `0..=max level` on the lattice, before
@@ -86,19 +85,11 @@ impl GeometryImages {
         f: usize,
         previous: Option<&[Vec<f32>; 3]>,
     ) -> Result<[Vec<f32>; 3]> {
-        let (w, h) = self.size();
-        let fixed = self.atlas.fixed_mask();
         let mut out: [Vec<f32>; 3] = Default::default();
         for (a, img) in out.iter_mut().enumerate() {
             let mut image = self.level_image(frame, f, a)?;
-            padding::pad(
-                &mut image,
-                w,
-                h,
-                &fixed,
-                previous.map(|p| p[a].as_slice()),
-                &self.padding,
-            )?;
+            self.padding
+                .pad(&mut image, previous.map(|p| p[a].as_slice()))?;
             *img = image;
         }
         Ok(out)

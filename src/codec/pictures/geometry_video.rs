@@ -45,14 +45,14 @@ pub(crate) fn images(
         Some(cache) => cache.get_or_build(build)?,
         None => build()?,
     };
-    Ok(GeometryImages::new(
+    GeometryImages::new(
         size,
         atlas,
         residuals,
         (plan.ranges(), plan.depth),
         pixel_step,
         codec.padding(plan),
-    ))
+    )
 }
 
 /// The geometry-video residual encoder over one picture codec, with the plan's settings.
@@ -110,7 +110,7 @@ impl ResidualEncoder for Encoder {
             quantiser: self.plan.quantiser,
             gop: u32::try_from(self.plan.gop).unwrap_or(u32::MAX),
             depth: self.plan.depth,
-            padding: images.padding.method,
+            padding: images.padding.options().method,
             charts: stats.charts as u32,
             chart_pixels: stats.chart_pixels as u32,
             codec_data,
