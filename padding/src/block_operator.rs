@@ -57,6 +57,11 @@ impl BlockOperator {
         Some(BlockOperator { free, fixed, gain })
     }
 
+    /// Entries of G: free × fixed pixels.
+    pub fn gains(&self) -> usize {
+        self.gain.len()
+    }
+
     /// The block's free pixels (ascending), in the order [`Self::apply`] writes them.
     pub fn free(&self) -> impl Iterator<Item = usize> + '_ {
         self.free.iter().map(|&k| usize::from(k))
