@@ -131,6 +131,8 @@ pub struct PaddingOptions {
     pub block: usize,
     /// Conjugate gradient stops when ‖r‖₂ ≤ tolerance · ‖b‖₂. The default 1e-5 puts the padded values
     /// well under 0.01 grey level from the exact minimiser, far below the 0.5 of 8-bit rounding.
+    /// The DCT methods solve each block mask exactly ([`crate::Padder`]) and use CG, with this
+    /// tolerance, only for a block whose mask they could not factor.
     pub tolerance: f32,
     /// Cap on conjugate gradient iterations per system. A block system has at most 64 unknowns, so
     /// CG ends in ≤ 64 steps in exact arithmetic (far fewer on the bench images: README.md); the
