@@ -392,12 +392,7 @@ mod tests {
         let energy = solver.energy_matrix();
         for b in 0..grid.len() {
             let rect = grid.rect(b);
-            let mut mask = 0u64;
-            for (i, pixel) in grid.pixels(rect).enumerate() {
-                if fixed[pixel] {
-                    mask |= 1 << ((i / rect.w) * SIDE + i % rect.w);
-                }
-            }
+            let mask = grid.block_mask(rect, &fixed);
             let operator = BlockOperator::new(&energy, mask).expect("a pinned block");
             let (mut by_cg, mut direct) = (image.clone(), image.clone());
             solver.pad_block(&grid, rect, &mut by_cg, &fixed, None, limits, &mut stats);

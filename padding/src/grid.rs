@@ -51,6 +51,18 @@ impl BlockGrid {
             .flat_map(move |y| (rect.x0..rect.x0 + rect.w).map(move |x| y * self.width + x))
     }
 
+    /// The pixels of block `rect` set in `mask`, as bits of an 8 × 8 block: bit `y * 8 + x` for
+    /// the block's pixel (x, y); pixels of a partial edge block outside the image are clear.
+    pub fn block_mask(&self, rect: BlockRect, mask: &[bool]) -> u64 {
+        let mut bits = 0u64;
+        for (i, pixel) in self.pixels(rect).enumerate() {
+            if mask[pixel] {
+                bits |= 1 << ((i / rect.w) * 8 + i % rect.w);
+            }
+        }
+        bits
+    }
+
     /// For each block, whether it holds at least one pixel with `mask` set.
     pub fn any_set(&self, mask: &[bool]) -> Vec<bool> {
         (0..self.len())

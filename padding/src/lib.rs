@@ -88,6 +88,8 @@ pub fn pad(
 pub struct Padder {
     grid: BlockGrid,
     fixed: Vec<bool>,
+    /// For each block, whether it holds a fixed pixel.
+    with_fixed: Vec<bool>,
     opts: PaddingOptions,
     operators: BlockOperators,
 }
@@ -108,6 +110,7 @@ impl Padder {
             _ => BlockOperators::default(),
         };
         Ok(Padder {
+            with_fixed: grid.any_set(fixed),
             grid,
             fixed: fixed.to_vec(),
             opts: opts.clone(),
@@ -134,7 +137,7 @@ impl Padder {
             max_iterations: opts.max_iterations,
         };
         let mut stats = PadStats::default();
-        let mut filled = grid.any_set(fixed);
+        let mut filled = self.with_fixed.clone();
         let mut held = fixed.to_vec();
         if let Some(previous) = previous {
             empty_blocks::copy_from_previous(grid, image, previous, &mut filled, &mut held);
@@ -157,8 +160,7 @@ impl Padder {
             Method::Laplace => image_laplace::fill(image, width, height, &held, limits, &mut stats),
             Method::Mean | Method::Cg | Method::DctEnergy | Method::Biharmonic | Method::Snap => {
                 let mut block_solver = BlockSolver::new(opts);
-                let with_fixed = grid.any_set(fixed);
-                for b in (0..grid.len()).filter(|&b| with_fixed[b]) {
+                for b in (0..grid.len()).filter(|&b| self.with_fixed[b]) {
                     let rect = grid.rect(b);
                     match &mut block_solver {
                         BlockSolver::Mean => fill_block_mean(grid, rect, image, fixed),
@@ -217,14 +219,7 @@ impl BlockOperators {
         let mut gains = 0;
         let of_block: Vec<Option<usize>> = (0..grid.len())
             .map(|b| {
-                let rect = grid.rect(b);
-                let mut mask = 0u64;
-                for (i, pixel) in grid.pixels(rect).enumerate() {
-                    let local = (i / rect.w) * dct_energy::SIDE + i % rect.w;
-                    if fixed[pixel] {
-                        mask |= 1 << local;
-                    }
-                }
+                let mask = grid.block_mask(grid.rect(b), fixed);
                 (mask != 0).then(|| {
                     *by_mask.entry(mask).or_insert_with(|| {
                         let operator = BlockOperator::new(&energy, mask)
