@@ -18,7 +18,7 @@
 
 use super::ladder;
 use super::sampled_trial::Sample;
-use super::{analysis, code, distortion, estimate, Analysed, Encoded, Settings, Stopwatch};
+use super::{analysis, code, code_kept, distortion, estimate, Analysed, Encoded, Settings, Stopwatch};
 use crate::encoder::{MotionModel, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
@@ -411,7 +411,7 @@ fn trial(
                 mesh,
                 ff,
                 leading,
-                settings,
+                Settings::whole(settings.opts, settings.plan),
                 analysed,
                 progress,
                 Stopwatch::new(),
@@ -463,7 +463,7 @@ fn keep(
                 mesh, ff, settings, ..
             } = *shared;
             let leading = shared.leading.to_vec();
-            code(mesh, ff, leading, settings, &analysed, progress, clock)
+            code_kept(mesh, ff, leading, settings, &analysed, progress, clock)
         }
     }
 }

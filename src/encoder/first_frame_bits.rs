@@ -57,7 +57,7 @@ pub(super) fn choose(
     };
     let first = at(default, opts);
     let plan = settings.plan;
-    let mut best = encode_once(mesh, Settings { opts: &first, plan }, &progress, None)?;
+    let mut best = encode_once(mesh, Settings::whole(&first, plan), &progress, None)?;
     let model = EncodeOptions {
         predictor: PredictorChoice::Fixed(best.model.predictor),
         segmentation: best.model.segmentation.into(),
@@ -84,7 +84,7 @@ pub(super) fn choose(
     for bits in others {
         progress.stage(&format!("first frame at {bits} bits"));
         let opts = at(bits, &model);
-        let settings = Settings { opts: &opts, plan };
+        let settings = Settings::whole(&opts, plan);
         let encoded = match best_estimate {
             Some(estimate_before) => {
                 let fixed = (best.model, known.clone());

@@ -137,13 +137,44 @@ pub fn encode_with_progress(
     if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
         return segment_runs::encode(mesh, opts, length, progress);
     }
+    encode_clip(mesh, opts, progress, Keep::Whole)
+}
+
+/// Encodes `mesh` as one clip (its options checked), keeping of the stream what `keep` says.
+fn encode_clip(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    progress: &dyn Progress,
+    keep: Keep,
+) -> Result<Encoded> {
     let plan = opts.plan(mesh.bbox_diagonal())?;
-    let settings = Settings { opts, plan: &plan };
     let trials = opts.codec.codec().cheap_exact_trials();
     match opts.first_frame_bits {
-        None if trials => first_frame_bits::choose(mesh, settings, progress),
-        _ => encode_once(mesh, settings, progress, None),
+        // Its precisions are compared by their whole streams.
+        None if trials => {
+            let settings = Settings::whole(opts, &plan);
+            first_frame_bits::choose(mesh, settings, progress)
+        }
+        _ => {
+            let settings = Settings {
+                opts,
+                plan: &plan,
+                keep,
+            };
+            encode_once(mesh, settings, progress, None)
+        }
     }
+}
+
+/// What the caller reads of an encoding's stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Keep {
+    /// All of it.
+    Whole,
+    /// Its whole-stream parts alone (a segmented encoding's analysis clip, whose affine maps and
+    /// residuals are not the clip's): the kept motion model's residuals are coded on the first
+    /// frame only, a valid stream of one frame, instead of every frame to be dropped.
+    SharedParts,
 }
 
 /// What every stage of one encoding reads: the caller's options and the rate plan resolved from
@@ -154,6 +185,19 @@ pub(crate) struct Settings<'a> {
     pub opts: &'a EncodeOptions,
     /// Every step and codec setting.
     pub plan: &'a RatePlan,
+    /// What the caller reads of the kept stream (trials' streams are always whole).
+    pub keep: Keep,
+}
+
+impl<'a> Settings<'a> {
+    /// The settings of an encoding whose whole stream is read.
+    pub fn whole(opts: &'a EncodeOptions, plan: &'a RatePlan) -> Self {
+        Self {
+            opts,
+            plan,
+            keep: Keep::Whole,
+        }
+    }
 }
 
 /// Encodes an animation at one first-frame precision (the default if `opts` leaves it open); a
@@ -176,7 +220,7 @@ fn encode_once(
     };
     progress.total(mesh.frame_count() as u64);
     let once = Once::analyse(mesh, &ff, settings, model, known, &mut clock)?;
-    code(
+    code_kept(
         mesh,
         &ff,
         leading,
@@ -185,6 +229,38 @@ fn encode_once(
         progress,
         clock,
     )
+}
+
+/// [`code`] for the stream an encoding keeps: with [`Keep::SharedParts`], the first frame alone,
+/// its shared parts those of the whole analysis (partition, weights and atlas come from every
+/// frame; the first frame's residual is its own).
+fn code_kept(
+    mesh: &AnimatedMesh,
+    ff: &EncodedFirstFrame,
+    leading: Vec<Part>,
+    settings: Settings,
+    analysed: &Analysed,
+    progress: &dyn Progress,
+    clock: Stopwatch,
+) -> Result<Encoded> {
+    if settings.keep == Keep::Whole || mesh.frame_count() == 1 {
+        return code(mesh, ff, leading, settings, analysed, progress, clock);
+    }
+    let first = mesh.clip(0..1)?;
+    let whole = analysed.prediction;
+    let prediction = Prediction {
+        track: whole.track.select(&[0])?,
+        weights: whole.weights.clone(),
+        residuals: whole.residuals.iter().take(1).cloned().collect(),
+    };
+    let analysed = Analysed {
+        prediction: &prediction,
+        segmentation: analysed.segmentation.clone(),
+        ..*analysed
+    };
+    // The frames not coded count as done.
+    progress.frames(mesh.frame_count() as u64 - 1);
+    code(&first, ff, leading, settings, &analysed, progress, clock)
 }
 
 /// One motion model's analysis of an animation whose first frame is coded: its segmentation and
@@ -448,7 +524,7 @@ impl Stopwatch {
 /// The stream header of an encoding.
 fn header(
     mesh: &AnimatedMesh,
-    Settings { opts, plan }: Settings,
+    Settings { opts, plan, .. }: Settings,
     model: MotionModel,
     partition: &Partition,
 ) -> Header {

@@ -57,7 +57,9 @@ pub struct SegmentedEncoder {
 #[derive(Debug, Clone, PartialEq)]
 struct Analysis {
     /// The analysis clip encoded as a clip of its own: its first frame, partition, weights and
-    /// codec set-up are the whole stream's.
+    /// codec set-up are the whole stream's. A picture codec's is a stream of the first frame
+    /// alone ([`super::Keep::SharedParts`]): its residuals would be dropped; tdct's holds every
+    /// frame, as its first-frame precisions are compared by whole streams.
     stream: Vec<u8>,
     /// Frames per segment; every segment but the last has this many.
     length: usize,
@@ -245,7 +247,9 @@ impl SegmentedEncoder {
             segment_frames: None,
             ..opts.clone()
         };
-        let mut encoded = super::encode_with_progress(analysis, &whole, &NoTotal(progress))?;
+        whole.check(analysis)?;
+        let keep = super::Keep::SharedParts;
+        let mut encoded = super::encode_clip(analysis, &whole, &NoTotal(progress), keep)?;
         // The segments' atlas is the analysis clip's (same first frame, partition and lattice
         // option; `check_shared` holds them to its lattice part): built once, not twice.
         let atlas = encoded.atlas.take().map_or_else(AtlasCache::default, AtlasCache::holding);

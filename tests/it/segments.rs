@@ -261,6 +261,18 @@ fn encoders_resumed_from_one_analysis_make_the_stream_encode_makes() {
         .unwrap();
         let started = SegmentedEncoder::start(&analysis, &opts, 8, &Silent).unwrap();
         let shared = started.analysis();
+        // The analysis holds the analysis clip's stream and the connectivity (12 bytes a
+        // triangle); a picture codec codes that stream's residuals on its first frame alone (the
+        // segments code their own), tdct every frame (it compares first-frame precisions by
+        // whole streams).
+        let alone = EncodeOptions {
+            segment_frames: None,
+            ..opts.clone()
+        };
+        let alone = encode(&analysis, &alone).unwrap().to_bytes().len();
+        let connectivity = 12 * mesh.triangles().len();
+        let first_frame_only = shared.len() < alone + connectivity;
+        assert_eq!(first_frame_only, codec != Codec::Tdct, "{codec:?}");
         // Workers resume from the bytes (another `parallel_segments` is fine) and code segments
         // out of order; a joiner resumed alike adds them in order.
         let threads = EncodeOptions {
