@@ -193,13 +193,6 @@ impl Codec {
         matches!(self, Codec::Tdct)
     }
 
-    /// Whether the automatic choice may estimate a candidate from a sample of frames: the frames
-    /// are coded each on its own, whereas spread P-frames cost like I-frames and misrank the
-    /// candidates (docs/design.md, "Automatic choice: bits at equal error").
-    pub(crate) fn sampled_trials(self) -> bool {
-        matches!(self, Codec::Jpeg)
-    }
-
     /// Whether this build can code the codec (MPEG-4, HEVC and AV1 need the `ffmpeg` feature).
     pub fn available(self) -> bool {
         !matches!(self, Codec::Mpeg4 | Codec::Hevc | Codec::Av1) || cfg!(feature = "ffmpeg")

@@ -8,13 +8,14 @@
 //! is measured, not guessed.
 //!
 //! Shared between the candidates: the first frame, each segmentation (used by every predictor)
-//! and its affine track (skinning blends its maps). tdct codes every candidate whole (its
-//! residual coder is cheap next to the segmentation), and so does MPEG-4 (a sample misranks its
-//! P-frames); JPEG, whose pictures cost most of an encoding and are coded each on its own, codes a
-//! sample of frames per candidate, scales the sample's per-frame parts to the whole, weighs the
-//! error of the sample's own stream (decoded), and then codes the winner once in full: the
-//! sample's bytes alone can keep a candidate whose whole stream is both larger and worse
-//! (docs/design.md, "Automatic choice: bits at equal error").
+//! and its affine track (skinning blends its maps). tdct ranks every candidate by its codec's
+//! cheap estimate and codes the winner. The picture codecs, whose pictures cost most of an
+//! encoding, code a sample of frames per candidate ([`super::sampled_trial`]: a spread dozen of
+//! intra pictures, or runs of consecutive P-frames), scale the sample's per-frame parts to the
+//! whole, weigh the error of the sample's own stream (decoded), and then code the winner once in
+//! full: the sample's bytes alone can keep a candidate whose whole stream is both larger and
+//! worse (docs/design.md, "Automatic choice: bits at equal error"). Clips too short to sample
+//! code every candidate whole and keep the winner's stream.
 
 use super::ladder;
 use super::sampled_trial::Sample;
@@ -35,8 +36,8 @@ use std::time::Instant;
 pub struct ChoiceReport {
     /// The motion model kept, `predictor+segmentation`.
     pub chosen: String,
-    /// Frames each candidate's residuals were coded on: every frame, or an evenly spread sample
-    /// (picture codecs on long animations) whose per-frame parts were scaled to the whole.
+    /// Frames each candidate's residuals were coded on: every frame, or a sample (picture codecs
+    /// on animations long enough) whose per-frame parts were scaled to the whole.
     pub trial_frames: usize,
     /// Every candidate, in the order tried (the default first: it wins ties).
     pub candidates: Vec<Candidate>,

@@ -1,6 +1,9 @@
-//! A picture codec's trials on a sample of frames: an evenly spread dozen coded as an animation
-//! of their own, the per-frame parts scaled to the whole, and the sample's own stream decoded
-//! for its error (docs/design.md, "Automatic choice: bits at equal error").
+//! A picture codec's trials on a sample of frames, coded as an animation of their own, the
+//! per-frame parts scaled to the whole, and the sample's own stream decoded for its error
+//! (docs/design.md, "Automatic choice: bits at equal error"). Intra-coded pictures (JPEG, or a
+//! group of one picture) are sampled as an evenly spread dozen; P-frames as runs of consecutive
+//! frames spread over the clip, each run a group of pictures of its own: spread P-frames would
+//! cost like key frames and misrank the candidates.
 
 use super::{analysis, assemble, distortion, header, Analysed, Settings};
 use crate::codec::ResidualInput;
@@ -9,32 +12,51 @@ use crate::mesh::{AnimatedMesh, Point};
 use crate::progress::Progress;
 use crate::stream::container::Part;
 
-/// Frames the picture codecs' trials code per candidate when the animation has more than twice
-/// as many.
+/// Frames the trials of intra-coded pictures code per candidate when the animation has more
+/// than twice as many.
 pub const TRIAL_FRAMES: usize = 12;
 
-/// The frames a picture codec's trials code: an evenly spread sample from frame 0 (whose bounding
-/// box sets the step) to the last, as an animation of their own.
+/// Runs of consecutive frames the trials of P-frame codecs code per candidate, when the
+/// animation has at least twice as many frames in all (shorter ones are tried whole: their
+/// winner's whole encoding, one group of pictures on one thread, would take as long again).
+pub const TRIAL_RUNS: usize = 2;
+/// Frames a run of [`TRIAL_RUNS`].
+pub const RUN_FRAMES: usize = 16;
+
+/// The frames a picture codec's trials code, from frame 0 (whose bounding box sets the step)
+/// towards the last, as an animation of their own.
 pub(super) struct Sample {
     pub(super) frames: Vec<usize>,
     mesh: AnimatedMesh,
+    /// The sample's group of pictures when it is not the plan's (a run is one group at most).
+    gop: Option<usize>,
 }
 
 impl Sample {
-    /// `None` when every candidate is coded whole: a codec without sampled trials
-    /// ([`crate::codec::Codec`]'s `sampled_trials`), or a short animation.
+    /// `None` when every candidate is coded whole: a codec without pictures (tdct estimates
+    /// instead), or an animation too short to sample.
     pub(super) fn of(mesh: &AnimatedMesh, settings: Settings) -> Result<Option<Self>> {
         let count = mesh.frame_count();
-        let whole = !settings.opts.codec.codec().sampled_trials();
-        if whole || count <= 2 * TRIAL_FRAMES {
+        let Some(pictures) = settings.plan.pictures.as_ref() else {
             return Ok(None);
-        }
-        let frames: Vec<usize> = (0..TRIAL_FRAMES)
-            .map(|i| i * (count - 1) / (TRIAL_FRAMES - 1))
-            .collect();
+        };
+        let (frames, gop) = match pictures.gop {
+            0 | 1 if count > 2 * TRIAL_FRAMES => {
+                let spread = (0..TRIAL_FRAMES).map(|i| i * (count - 1) / (TRIAL_FRAMES - 1));
+                (spread.collect::<Vec<usize>>(), None)
+            }
+            0 | 1 => return Ok(None),
+            gop if count >= 2 * TRIAL_RUNS * RUN_FRAMES => {
+                let last = TRIAL_RUNS.saturating_sub(1).max(1);
+                let starts = (0..TRIAL_RUNS).map(|i| i * (count - RUN_FRAMES) / last);
+                let runs = starts.flat_map(|start| start..start + RUN_FRAMES);
+                (runs.collect(), Some(gop.min(RUN_FRAMES)))
+            }
+            _ => return Ok(None),
+        };
         let positions = frames.iter().map(|&f| mesh.frame(f).to_vec()).collect();
         let mesh = AnimatedMesh::new(mesh.triangles().to_vec(), positions)?;
-        Ok(Some(Self { frames, mesh }))
+        Ok(Some(Self { frames, mesh, gop }))
     }
 
     /// The stream bytes of `analysed` estimated from the sample: every part but the codec's
@@ -60,7 +82,11 @@ impl Sample {
                 .map(|&f| prediction.residuals[f].clone())
                 .collect(),
         };
-        let coded = settings.plan.encoder()?.encode(&ResidualInput {
+        let mut plan = settings.plan.clone();
+        if let (Some(gop), Some(pictures)) = (self.gop, plan.pictures.as_mut()) {
+            pictures.gop = gop;
+        }
+        let coded = plan.encoder()?.encode(&ResidualInput {
             mesh: &self.mesh,
             reference,
             partition: analysed.partition,
