@@ -105,7 +105,7 @@ pub fn encoder_images<R: Read + Seek>(
                 frame: f,
                 raw: compose(images.raw(&residuals[f], f)?),
                 padded: compose(images.padded_alone(residuals, f)?),
-                fixed: images.atlas.fixed_mask(),
+                fixed: images.padding.fixed().to_vec(),
             })
         })
         .collect()

@@ -118,6 +118,11 @@ impl Padder {
         })
     }
 
+    /// The fixed pixels this padder keeps, row-major.
+    pub fn fixed(&self) -> &[bool] {
+        &self.fixed
+    }
+
     /// The options this padder was made with.
     pub fn options(&self) -> &PaddingOptions {
         &self.opts

@@ -112,11 +112,6 @@ pub(super) fn choose(
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
     let sample = Sample::of(mesh, settings)?;
-    let frames = mesh.frame_count();
-    let trial_frames = sample.as_ref().map_or(frames, |s| s.frames.len());
-    let estimated = sample.is_some() || settings.opts.codec.codec().estimated_trials();
-    let final_frames = if estimated { frames } else { 0 };
-    progress.total((models.len() * trial_frames + final_frames) as u64);
     let shared = Shared {
         mesh,
         ff,
@@ -125,6 +120,10 @@ pub(super) fn choose(
         sample: sample.as_ref(),
         smallest_estimate: AtomicU64::new(u64::MAX),
     };
+    let (frames, trial_frames) = (mesh.frame_count(), shared.trial_frames());
+    let estimated = sample.is_some() || settings.opts.codec.codec().estimated_trials();
+    let final_frames = if estimated { frames } else { 0 };
+    progress.total((models.len() * trial_frames + final_frames) as u64);
     let segmenter = analysis::Segmenter::new(mesh);
     let segmentations = segmentations(models);
     let largest = segmentations.iter().filter(|(s, _)| *s == Segmentation::KMeans);
@@ -351,8 +350,7 @@ impl<'a> Job<'a> {
     /// trials' share of the progress bar.
     fn skip(&self, shared: &Shared, progress: &dyn Progress) -> Outcome<'a> {
         let below = self.below.unwrap_or_default();
-        let frames = shared.sample.map_or(shared.mesh.frame_count(), |s| s.frames.len());
-        progress.frames((self.models.len() * frames) as u64);
+        progress.frames((self.models.len() * shared.trial_frames()) as u64);
         let k = self.segmentation.1;
         let why = format!(
             "k-means K = {k} not tried: K = {} did not beat K = {}",
@@ -380,6 +378,14 @@ struct Shared<'a> {
     /// above it cannot be the smallest, whichever trials end first, so the stream kept is the
     /// same on any number of threads ("early exit when a candidate cannot win").
     smallest_estimate: AtomicU64,
+}
+
+impl Shared<'_> {
+    /// Frames each candidate's residuals are coded on: the sample's, or every frame.
+    fn trial_frames(&self) -> usize {
+        self.sample
+            .map_or(self.mesh.frame_count(), |s| s.frames.len())
+    }
 }
 
 /// Codes one candidate: its bytes, whole stream and (picture codecs) decoded error, or (sampled

@@ -64,11 +64,10 @@ impl GeometryImages {
 
     /// The three level images of frame `f` with every pixel that carries no vertex at 0.
     pub fn raw(&self, frame: &[[f32; 3]], f: usize) -> Result<[Vec<f32>; 3]> {
-        let fixed = self.atlas.fixed_mask();
         let mut out: [Vec<f32>; 3] = Default::default();
         for (a, img) in out.iter_mut().enumerate() {
             *img = self.level_image(frame, f, a)?;
-            for (p, &keep) in img.iter_mut().zip(&fixed) {
+            for (p, &keep) in img.iter_mut().zip(self.padding.fixed()) {
                 if !keep {
                     *p = 0.0;
                 }
