@@ -14,7 +14,7 @@ use crate::stretch::StretchSum;
 use crate::unwrap::Flattening;
 use crate::weld::welded;
 use crate::{AtlasError, AtlasOptions};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Builds the atlas of a mesh whose vertices are partitioned into clusters
 /// (one cluster id per vertex).
@@ -24,41 +24,93 @@ pub fn build(
     partition: &[u32],
     opts: &AtlasOptions,
 ) -> Result<Atlas, AtlasError> {
-    let start = Instant::now();
-    check_input(positions, triangles, partition, opts)?;
-    let welded = if opts.weld {
-        welded(positions, triangles)
-    } else {
-        triangles.to_vec()
-    };
-    let seeds = seeds(triangles, &welded, partition);
-    let flat = flatten_seeds(positions, &welded, &seeds, opts)?;
-    let (charts, absorbed) =
-        owned_layouts(triangles, partition, &seeds, &flat, positions.len(), opts);
-    let (scale, shapes, placements) = best_scale(&charts, opts)?;
-    let lattice = Lattice::write(
-        &charts,
-        &shapes,
-        &placements,
-        scale,
-        triangles,
-        positions.len(),
-        opts,
-    );
-    let mut stats = stats(&seeds, &flat, &charts, &lattice, scale, absorbed, opts);
-    stats.build_time = start.elapsed();
-    Ok(Atlas {
-        width: opts.width,
-        height: opts.height,
-        block: opts.block,
-        vertex_pixels: lattice.vertex_pixels,
-        vertex_chart: lattice.vertex_chart,
-        occupancy: lattice.occupancy,
-        block_chart: lattice.block_chart,
-        charts: lattice.charts,
-        interior: lattice.interior,
-        stats,
-    })
+    Flattened::new(positions, triangles, partition, opts)?.lay_out(opts.width, opts.height)
+}
+
+/// A mesh's charts flattened and every vertex given one (steps 1–3), before any lattice: most of
+/// a build's time (uvunwrap's solves) and the same whatever the lattice's size, so a caller that
+/// tries sizes until the charts fit flattens once and lays the charts out on each size.
+pub struct Flattened<'a> {
+    positions: &'a [[f32; 3]],
+    triangles: &'a [[u32; 3]],
+    partition: &'a [u32],
+    opts: AtlasOptions,
+    seeds: Seeds,
+    flat: Flattening,
+    charts: Vec<ChartLayout>,
+    absorbed: usize,
+    time: Duration,
+}
+
+impl<'a> Flattened<'a> {
+    /// Checks the inputs (for `opts`'s lattice size too) and flattens the charts with `opts`.
+    pub fn new(
+        positions: &'a [[f32; 3]],
+        triangles: &'a [[u32; 3]],
+        partition: &'a [u32],
+        opts: &AtlasOptions,
+    ) -> Result<Self, AtlasError> {
+        let start = Instant::now();
+        check_input(positions, triangles, partition, opts)?;
+        let welded = if opts.weld {
+            welded(positions, triangles)
+        } else {
+            triangles.to_vec()
+        };
+        let seeds = seeds(triangles, &welded, partition);
+        let flat = flatten_seeds(positions, &welded, &seeds, opts)?;
+        let (charts, absorbed) =
+            owned_layouts(triangles, partition, &seeds, &flat, positions.len(), opts);
+        Ok(Self {
+            positions,
+            triangles,
+            partition,
+            opts: opts.clone(),
+            seeds,
+            flat,
+            charts,
+            absorbed,
+            time: start.elapsed(),
+        })
+    }
+
+    /// The atlas on a `width × height` lattice (the flattening's other options): errors as
+    /// [`build`] does, e.g. when the charts do not fit.
+    pub fn lay_out(&self, width: u32, height: u32) -> Result<Atlas, AtlasError> {
+        let start = Instant::now();
+        let opts = AtlasOptions {
+            width,
+            height,
+            ..self.opts.clone()
+        };
+        let (positions, triangles) = (self.positions, self.triangles);
+        check_input(positions, triangles, self.partition, &opts)?;
+        let (scale, shapes, placements) = best_scale(&self.charts, &opts)?;
+        let lattice = Lattice::write(
+            &self.charts,
+            &shapes,
+            &placements,
+            scale,
+            triangles,
+            positions.len(),
+            &opts,
+        );
+        let (seeds, flat, charts) = (&self.seeds, &self.flat, &self.charts);
+        let mut stats = stats(seeds, flat, charts, &lattice, scale, self.absorbed, &opts);
+        stats.build_time = self.time + start.elapsed();
+        Ok(Atlas {
+            width: opts.width,
+            height: opts.height,
+            block: opts.block,
+            vertex_pixels: lattice.vertex_pixels,
+            vertex_chart: lattice.vertex_chart,
+            occupancy: lattice.occupancy,
+            block_chart: lattice.block_chart,
+            charts: lattice.charts,
+            interior: lattice.interior,
+            stats,
+        })
+    }
 }
 
 /// Steps 1–2: the seed pieces flattened into charts (none for a mesh without faces), on the

@@ -126,6 +126,6 @@ mod weld;
 mod whole;
 
 pub use atlas::{sample, Atlas, AtlasStats, Chart, Occupancy};
-pub use build::build;
+pub use build::{build, Flattened};
 pub use error::AtlasError;
 pub use options::{AtlasOptions, Interior};

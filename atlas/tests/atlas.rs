@@ -1,6 +1,6 @@
 //! Invariants of built atlases on small meshes made in code.
 
-use atlas::{build, sample, Atlas, AtlasError, AtlasOptions, Interior, Occupancy};
+use atlas::{build, sample, Atlas, AtlasError, AtlasOptions, Flattened, Interior, Occupancy};
 use std::collections::HashSet;
 
 /// An `n × n` quad grid (2 triangles per quad) bent over a cylinder arc,
@@ -185,6 +185,51 @@ fn small_lattice_forces_moves_but_stays_injective() -> Result<(), AtlasError> {
     };
     let atlas = build(&p, &t, &vec![0; p.len()], &opts)?;
     check_invariants(&atlas, p.len());
+    Ok(())
+}
+
+#[test]
+fn one_flattening_lays_out_on_each_size_as_a_build_there() -> Result<(), AtlasError> {
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    grid(&mut p, &mut t, 20, [0.0; 3]);
+    grid(&mut p, &mut t, 8, [3.0, 0.0, 0.0]);
+    let parts = halves(&p);
+    let at = |side: u32| AtlasOptions {
+        width: side,
+        height: side,
+        ..AtlasOptions::default()
+    };
+    let charts = Flattened::new(&p, &t, &parts, &at(24))?;
+    let mut fitted = 0;
+    for side in [24, 32, 48, 64] {
+        let (laid, built) = match (charts.lay_out(side, side), build(&p, &t, &parts, &at(side))) {
+            (Ok(laid), Ok(built)) => (laid, built),
+            // Charts that do not fit, refused alike.
+            (laid, built) => {
+                let (laid, built) = (laid.err().map(|e| e.to_string()), built.err());
+                assert_eq!(laid, built.map(|e| e.to_string()), "{side}x{side}");
+                continue;
+            }
+        };
+        assert_eq!(laid.vertex_pixels(), built.vertex_pixels(), "{side}x{side}");
+        assert_eq!(laid.vertex_charts(), built.vertex_charts());
+        assert_eq!(laid.charts(), built.charts());
+        assert_eq!(laid.occupancy(), built.occupancy());
+        // Every figure but the wall time.
+        let figures = |a: &Atlas| atlas::AtlasStats {
+            build_time: Default::default(),
+            ..a.stats().clone()
+        };
+        assert_eq!(figures(&laid), figures(&built));
+        fitted += 1;
+    }
+    // 24 × 24 is too small for these charts (the size a lattice search starts from), the rest fit.
+    assert_eq!(fitted, 3);
+    // A size too small for the vertices is refused as a build refuses it.
+    let small = charts.lay_out(16, 16).err().map(|e| e.to_string());
+    let refused = build(&p, &t, &parts, &at(16)).err().map(|e| e.to_string());
+    assert!(small.is_some());
+    assert_eq!(small, refused);
     Ok(())
 }
 

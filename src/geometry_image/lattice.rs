@@ -87,24 +87,33 @@ pub fn build_atlas(
     partition: &Partition,
     lattice: Lattice,
 ) -> Result<((u16, u16), atlas::Atlas)> {
-    let build = |w: u16, h: u16| {
-        atlas::build(
-            reference,
-            triangles,
-            partition.labels(),
-            &atlas::AtlasOptions {
-                width: u32::from(w),
-                height: u32::from(h),
-                ..atlas::AtlasOptions::default()
-            },
-        )
+    let options = |w: u16, h: u16| atlas::AtlasOptions {
+        width: u32::from(w),
+        height: u32::from(h),
+        ..atlas::AtlasOptions::default()
     };
+    let labels = partition.labels();
     let mut side = match lattice {
-        Lattice::Fixed(w, h) => return Ok(((w, h), build(w, h)?)),
+        Lattice::Fixed(w, h) => {
+            let atlas = atlas::build(reference, triangles, labels, &options(w, h))?;
+            return Ok(((w, h), atlas));
+        }
         Lattice::Auto => auto_side(reference.len()),
     };
+    // The charts are flattened once (most of the work), then laid out on each size tried.
+    let mut flattened: Option<atlas::Flattened> = None;
     loop {
-        let next = match build(side, side) {
+        let u32_side = u32::from(side);
+        let attempt = match &flattened {
+            Some(charts) => charts.lay_out(u32_side, u32_side),
+            None => atlas::Flattened::new(reference, triangles, labels, &options(side, side))
+                .and_then(|charts| {
+                    let atlas = charts.lay_out(u32_side, u32_side);
+                    flattened = Some(charts);
+                    atlas
+                }),
+        };
+        let next = match attempt {
             Ok(a) => return Ok(((side, side), a)),
             // The smallest square with as many blocks as the charts need, then 16 more at a time:
             // the greedy packer may need a little more than the bound, and each step of 16 costs a
