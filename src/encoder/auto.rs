@@ -17,15 +17,17 @@
 //! worse (docs/design.md, "Automatic choice: bits at equal error"). Clips too short to sample
 //! code every candidate whole and keep the winner's stream.
 
+use super::choice_reason::reason;
 use super::ladder;
 use super::sampled_trial::Sample;
 use super::{analysis, code, code_kept, distortion, estimate, Analysed, Encoded, Settings, Stopwatch};
 use crate::encoder::{MotionModel, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
-use crate::geometry_image::lattice::AtlasCache;
+use crate::geometry_image::lattice::{self, AtlasCache};
 use crate::mesh::AnimatedMesh;
-use crate::motion::{Partition, PredictorKind};
+use crate::motion::{AffineTrack, Partition, PredictorKind};
+use rayon::prelude::*;
 use crate::progress::Progress;
 use crate::stream::container::Part;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -70,8 +72,8 @@ pub struct Candidate {
     /// Its decoded stream's RMS vertex error over the first frame's bounding-box diagonal, when
     /// the choice weighed errors (picture codecs; a sampled trial's over its sample's frames).
     pub vertex_rmse: Option<f64>,
-    /// Seconds of its trial: prediction and residual coding (the segmentations are in the
-    /// report's stages).
+    /// Seconds of its trial: prediction and residual coding (the segmentations and the picture
+    /// codecs' atlases are in the report's stages).
     pub seconds: f64,
 }
 
@@ -252,6 +254,13 @@ struct Job<'a> {
     may_stop: bool,
 }
 
+/// One candidate tried: its report, cost, and what keeping it needs.
+struct Tried<'a> {
+    candidate: Candidate,
+    cost: f64,
+    kept: Kept<'a>,
+}
+
 /// What a job measured: its candidates and their costs, its stages' seconds, its best; or why
 /// it was not tried.
 struct Outcome<'a> {
@@ -288,54 +297,34 @@ impl<'a> Job<'a> {
             best: None,
             skipped: None,
         };
-        let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
-        for (i, &model) in self.models.iter().enumerate() {
+        // A picture codec's candidates on this partition share its atlas, most of a trial's
+        // work: built first, their trials then run side by side (tdct's, cheap and stopping
+        // once they cannot win, run in turn).
+        let pictures = settings.plan.pictures.as_ref();
+        if let Some(option) = pictures.map(|p| p.lattice) {
             let start = Instant::now();
-            let progress = Labelled {
-                inner: progress,
-                label: model.name(),
-            };
-            progress.stage("motion");
-            let (kind, track) = (model.predictor, track.clone());
-            let bits = settings.opts.weight_bits;
-            let prediction = analysis::predict_on(mesh, reference, &partition, bits, kind, track)?;
-            let analysed = Analysed {
-                model,
-                partition: &partition,
-                segmentation: segmented.clone(),
-                prediction: &prediction,
-                atlas: Some(self.atlas),
-            };
-            let (bytes, encoded, error, stopped) =
-                trial(shared, &analysed, self.may_stop, &progress)?;
-            let cost = distortion::cost(8.0 * bytes as f64, error);
-            outcome.candidates.push(Candidate {
-                predictor: model.predictor,
-                segmentation: segmentation.name(),
-                clusters: partition.clusters(),
-                bytes,
-                estimated: encoded.is_none(),
-                stopped,
-                estimate: (encoded.is_none() && shared.sample.is_none()).then_some(bytes),
-                vertex_rmse: error.map(|e| e / diagonal),
-                seconds: start.elapsed().as_secs_f64(),
-            });
-            let seconds = start.elapsed().as_secs_f64();
+            let triangles = mesh.triangles();
+            let build = || lattice::build_atlas(reference, triangles, &partition, option);
+            self.atlas.get_or_build(build)?;
+            outcome.stages.push(("atlas".into(), start.elapsed().as_secs_f64()));
+        }
+        let analysis = (&partition, &segmented, &track);
+        let one = |&model: &MotionModel| self.try_model(shared, analysis, model, progress);
+        let tried: Vec<Result<Tried>> = match pictures {
+            Some(_) => self.models.par_iter().map(one).collect(),
+            None => self.models.iter().map(one).collect(),
+        };
+        for (i, (model, tried)) in self.models.iter().zip(tried).enumerate() {
+            let Tried {
+                candidate,
+                cost,
+                kept,
+            } = tried?;
+            let seconds = candidate.seconds;
             outcome.stages.push((format!("trial {}", model.name()), seconds));
+            outcome.candidates.push(candidate);
             outcome.costs.push(cost);
             if outcome.best.as_ref().is_none_or(|b| cost < b.cost) {
-                let kept = match encoded {
-                    Some(encoded) => Kept::Stream(Box::new(encoded)),
-                    None => {
-                        // Its residuals are made again if it wins ([`keep`]): held by the best
-                        // of each running job beside the next candidate's, they were the
-                        // largest memory of long segments' choices.
-                        let mut prediction = prediction;
-                        prediction.residuals = Vec::new();
-                        let analysis = (partition.clone(), segmented.clone(), prediction);
-                        Kept::Analysis(Box::new((analysis.0, analysis.1, analysis.2, self.atlas)))
-                    }
-                };
                 outcome.best = Some(Best {
                     index: self.first + i,
                     cost,
@@ -344,6 +333,62 @@ impl<'a> Job<'a> {
             }
         }
         Ok(outcome)
+    }
+
+    /// Predicts `model` on the job's partition and track and tries it ([`trial`]).
+    fn try_model(
+        &self,
+        shared: &Shared,
+        (partition, segmented, track): (&Partition, &analysis::SegmentationReport, &AffineTrack),
+        model: MotionModel,
+        progress: &dyn Progress,
+    ) -> Result<Tried<'a>> {
+        let start = Instant::now();
+        let (mesh, settings) = (shared.mesh, shared.settings);
+        let progress = Labelled {
+            inner: progress,
+            label: model.name(),
+        };
+        progress.stage("motion");
+        let (reference, bits) = (&shared.ff.decoded_positions, settings.opts.weight_bits);
+        let (kind, track) = (model.predictor, track.clone());
+        let prediction = analysis::predict_on(mesh, reference, partition, bits, kind, track)?;
+        let analysed = Analysed {
+            model,
+            partition,
+            segmentation: segmented.clone(),
+            prediction: &prediction,
+            atlas: Some(self.atlas),
+        };
+        let (bytes, encoded, error, stopped) = trial(shared, &analysed, self.may_stop, &progress)?;
+        let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
+        let candidate = Candidate {
+            predictor: model.predictor,
+            segmentation: self.segmentation.0.name(),
+            clusters: partition.clusters(),
+            bytes,
+            estimated: encoded.is_none(),
+            stopped,
+            estimate: (encoded.is_none() && shared.sample.is_none()).then_some(bytes),
+            vertex_rmse: error.map(|e| e / diagonal),
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        let kept = match encoded {
+            Some(encoded) => Kept::Stream(Box::new(encoded)),
+            None => {
+                // Its residuals are made again if it wins ([`keep`]): held by each trial until
+                // the job picks its best, they were the largest memory of long segments' choices.
+                let mut prediction = prediction;
+                prediction.residuals = Vec::new();
+                let analysis = (partition.clone(), segmented.clone(), prediction);
+                Kept::Analysis(Box::new((analysis.0, analysis.1, analysis.2, self.atlas)))
+            }
+        };
+        Ok(Tried {
+            candidate,
+            cost: distortion::cost(8.0 * bytes as f64, error),
+            kept,
+        })
     }
 
     /// The outcome of a rung the ladder does not climb to: no candidate, the reason, and its
@@ -485,66 +530,6 @@ fn segmentations(models: &[MotionModel]) -> Vec<(Segmentation, usize)> {
         }
     }
     distinct
-}
-
-/// Why candidate `chosen` was kept, in words: its margin over the runner-up (the next lowest
-/// cost), in bytes or, when errors were weighed, in bits at equal error.
-fn reason(
-    candidates: &[Candidate],
-    costs: &[f64],
-    chosen: usize,
-    (trial_frames, frames): (usize, usize),
-) -> String {
-    let name = |c: &Candidate| {
-        let model = format!("{}+{}", c.predictor.name(), c.segmentation);
-        format!("{model} ({} clusters)", c.clusters)
-    };
-    let winner = &candidates[chosen];
-    // The runner-up among the complete estimates: a stopped one's bytes are how far it got.
-    let runner_up = (0..candidates.len())
-        .filter(|&i| i != chosen && !candidates[i].stopped)
-        .min_by(|&a, &b| costs[a].total_cmp(&costs[b]));
-    let stopped = candidates.iter().filter(|c| c.stopped).count();
-    let mut reason = match (runner_up, winner.vertex_rmse) {
-        (Some(next), Some(rmse)) => format!(
-            "fewest bits at equal error (RMSE ∝ rate^-{}): {} bytes at vertex RMSE {rmse:.3e}; \
-             {} ({} bytes at {:.3e}) would need {:.1} % more bits at that error",
-            distortion::RD_SLOPE,
-            winner.bytes,
-            name(&candidates[next]),
-            candidates[next].bytes,
-            candidates[next].vertex_rmse.unwrap_or(f64::NAN),
-            100.0 * ((costs[next] - costs[chosen]).exp2() - 1.0),
-        ),
-        (Some(next), None) => {
-            let next = &candidates[next];
-            let what = match winner.estimated {
-                true => "smallest estimate (one cheap pass over the residuals; the kept one then \
-                         coded in full)",
-                false => "smallest stream",
-            };
-            format!(
-                "{what} at the quality's step: {} bytes, {:.1} % below {} ({} bytes)",
-                winner.bytes,
-                100.0 * (1.0 - winner.bytes as f64 / next.bytes.max(1) as f64),
-                name(next),
-                next.bytes
-            )
-        }
-        (None, _) if stopped > 0 => "the smallest estimate".to_string(),
-        (None, _) => "the only candidate".to_string(),
-    };
-    if stopped > 0 {
-        reason.push_str(&format!(
-            "; {stopped} estimates stopped once they passed the smallest so far"
-        ));
-    }
-    if trial_frames < frames {
-        reason.push_str(&format!(
-            "; sizes estimated from {trial_frames} of {frames} frames"
-        ));
-    }
-    reason
 }
 
 /// Progress of one candidate's trial: its stages named after it.

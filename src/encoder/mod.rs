@@ -10,6 +10,7 @@
 
 mod attributes;
 mod budget;
+mod choice_reason;
 mod options;
 internal! {
     analysis;
