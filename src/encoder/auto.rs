@@ -20,7 +20,7 @@
 use super::choice_reason::reason;
 use super::ladder;
 use super::sampled_trial::Sample;
-use super::{analysis, code, code_kept, distortion, estimate, Analysed, Encoded, Settings, Stopwatch};
+use super::{analysis, code, code_kept, distortion, estimate, Analysed, Encoded, Keep, Settings, Stopwatch};
 use crate::encoder::{MotionModel, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
@@ -166,8 +166,9 @@ pub(super) fn choose(
         reason.push_str(&s);
     }
     let mut encoded = keep(&shared, model, best.kept, progress, clock)?;
-    if sample.is_none() && candidates[at].estimated {
-        // The kept one's size is its stream's now, not an estimate.
+    // The kept one's size is its stream's now, not an estimate (unless the stream is the analysis
+    // clip's first frame alone).
+    if sample.is_none() && candidates[at].estimated && settings.keep == Keep::Whole {
         candidates[at].bytes = encoded.report.bytes;
         candidates[at].estimated = false;
     }

@@ -243,6 +243,28 @@ fn tdct_tries_a_ladder_of_cluster_counts_and_keeps_the_smallest() {
 }
 
 #[test]
+fn a_segmented_choice_reports_sizes_of_the_whole_analysis_clip() {
+    // The analysis clip of a segmented encoding is kept as its shared parts (tdct at fixed
+    // first-frame bits codes it on one frame): its winner's size stays the estimate, not that
+    // one-frame stream's.
+    let mesh = skinned_bend_of(40);
+    let options = EncodeOptions {
+        segment_frames: Some(16),
+        ..opts(
+            Codec::Tdct,
+            PredictorChoice::Auto,
+            SegmentationChoice::auto(),
+        )
+    };
+    let encoded = encode(&mesh, &options).expect("encodes");
+    assert_eq!(encoded.report.segments, 3);
+    let choice = encoded.report.choice.clone().expect("a choice");
+    for c in &choice.candidates {
+        assert!(c.estimated && c.estimate == Some(c.bytes), "{c:?}");
+    }
+}
+
+#[test]
 fn picture_codecs_try_a_sample_of_frames_then_code_the_winner_whole() {
     // JPEG: a spread dozen of 30 frames; MPEG-4 (P-frames): two runs of 16 of 64.
     for (codec, frames, sample) in [(Codec::Jpeg, 30, 12), (Codec::Mpeg4, 64, 32)] {
