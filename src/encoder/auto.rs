@@ -58,7 +58,8 @@ pub struct Candidate {
     pub clusters: usize,
     /// Its stream's bytes: measured for the one kept; for the others, estimated when the trials
     /// estimate (tdct's from one cheap pass over the bands, the picture codecs' from a sample of
-    /// frames).
+    /// frames), and for the one kept too when only a segmented encoding's shared parts were
+    /// coded from it (its analysis clip's residuals are the segments').
     pub bytes: u64,
     /// Whether `bytes` is an estimate.
     pub estimated: bool,
