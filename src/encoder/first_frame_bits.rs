@@ -8,10 +8,15 @@
 //! shape costs the first-frame coder much; a flat grid it predicts almost exactly) and on the step.
 //! The motion model is chosen once, at the default precision (the automatic choice's trials), and
 //! the other precisions are coded with it fixed: the model follows the motion, the precision the
-//! first frame's shape.
+//! first frame's shape. Of a segmented encoding's analysis clip only the shared parts are used:
+//! the default precision is coded on its first frame alone, and whole only when a coarser one's
+//! estimate beats it and whole streams must be compared.
 
-use super::{encode_once, estimate_once, EncodeOptions, Encoded, PredictorChoice, Settings};
+use super::{encode_once, estimate_once, EncodeOptions, Encoded, Keep, PredictorChoice, Settings};
+use crate::codec::RatePlan;
 use crate::error::Result;
+use crate::motion::Partition;
+use super::SegmentationReport;
 use crate::mesh::AnimatedMesh;
 use crate::progress::Progress;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -26,7 +31,8 @@ pub struct FirstFrameTrial {
     /// The stream's bytes at that precision (estimated, see `estimated`).
     pub bytes: u64,
     /// Whether `bytes` is the codec's estimate (tdct: a precision whose estimate did not beat
-    /// the kept one's is not coded in full).
+    /// the kept one's is not coded in full; nor is the kept one of a segmented encoding's
+    /// analysis clip, whose shared parts alone are used).
     pub estimated: bool,
     /// Whether the estimate stopped once sure not to beat the kept one's: `bytes` is then how far
     /// it got, at least the kept one's estimate.
@@ -57,7 +63,17 @@ pub(super) fn choose(
     };
     let first = at(default, opts);
     let plan = settings.plan;
-    let mut best = encode_once(mesh, Settings::whole(&first, plan), &progress, None)?;
+    // A segmented encoding's analysis clip keeps its shared parts alone, unless precisions are
+    // compared by whole streams: a fixed model has no estimate to compare them by.
+    let estimated = opts.motion_models().len() > 1 && opts.codec.codec().estimated_trials();
+    let mut partial = settings.keep == Keep::SharedParts && estimated;
+    let keep = if partial { Keep::SharedParts } else { Keep::Whole };
+    let settings_first = Settings {
+        opts: &first,
+        plan,
+        keep,
+    };
+    let mut best = encode_once(mesh, settings_first, &progress, None)?;
     let model = EncodeOptions {
         predictor: PredictorChoice::Fixed(best.model.predictor),
         segmentation: best.model.segmentation.into(),
@@ -67,18 +83,25 @@ pub(super) fn choose(
     // The segmentation runs on the animation alone, so the trials keep the first one's, unless
     // the first-frame coder reorders the vertices (its order may change with the precision).
     let known = (!opts.reorder).then(|| (best.partition.clone(), best.report.segmentation.clone()));
+    // With a codec that estimates (tdct), precisions are compared by their estimates, and only
+    // one that beats the kept one's is coded in full. The kept one's is the least (its stream's
+    // size, unless only its shared parts were coded).
+    let chosen = best.report.choice.as_ref().and_then(|c| match partial {
+        false => c.candidates.iter().find(|k| !k.estimated)?.estimate,
+        true => c.candidates.iter().map(|k| k.bytes).min(),
+    });
     let mut trials = vec![FirstFrameTrial {
         bits: default,
-        bytes: best.report.bytes,
-        estimated: false,
+        bytes: chosen.filter(|_| partial).unwrap_or(best.report.bytes),
+        estimated: partial,
         stopped: false,
     }];
-    // With a codec that estimates (tdct), precisions are compared by their estimates, and only
-    // one that beats the kept one's is coded in full.
-    let chosen = best.report.choice.as_ref().and_then(|c| {
-        let kept = c.candidates.iter().find(|k| !k.estimated)?;
-        kept.estimate
-    });
+    if partial && chosen.is_none() {
+        // No estimate to compare by after all: compared by whole streams.
+        let whole = at(default, &model);
+        recode_whole(mesh, (&mut best, &mut trials[0]), &whole, plan, &progress, &known)?;
+        partial = false;
+    }
     // A fixed model has no estimate to compare with: its precisions are coded in full.
     let mut best_estimate = chosen;
     for bits in others {
@@ -108,6 +131,12 @@ pub(super) fn choose(
                     break;
                 }
                 best_estimate = Some(estimate);
+                if partial {
+                    // The finer stream is compared whole: coded whole now, as it would have been.
+                    let whole = at(default, &model);
+                    recode_whole(mesh, (&mut best, &mut trials[0]), &whole, plan, &progress, &known)?;
+                    partial = false;
+                }
                 // Coded in full after its estimate: its frames count twice.
                 progress.grow(frames);
                 analysis.code(settings, &progress)?
@@ -132,6 +161,31 @@ pub(super) fn choose(
     }
     best.report.first_frame_trials = trials;
     Ok(best)
+}
+
+/// Codes `best`, kept as its shared parts alone, whole with `opts` (its model fixed, its partition
+/// `known` unless reordered), as the automatic choice had kept it; `trial` is its precision's.
+fn recode_whole(
+    mesh: &AnimatedMesh,
+    (best, trial): (&mut Encoded, &mut FirstFrameTrial),
+    opts: &EncodeOptions,
+    plan: &RatePlan,
+    progress: &Ahead,
+    known: &Option<(Partition, SegmentationReport)>,
+) -> Result<()> {
+    progress.grow(mesh.frame_count() as u64);
+    let mut choice = best.report.choice.take();
+    *best = encode_once(mesh, Settings::whole(opts, plan), progress, known.clone())?;
+    // The kept candidate (the least estimate, the first on a tie) is measured now.
+    let candidates = choice.iter_mut().flat_map(|c| c.candidates.iter_mut());
+    if let Some(kept) = candidates.min_by_key(|c| c.bytes) {
+        kept.bytes = best.report.bytes;
+        kept.estimated = false;
+    }
+    best.report.choice = choice;
+    trial.bytes = best.report.bytes;
+    trial.estimated = false;
+    Ok(())
 }
 
 /// Passes progress on, telling the whole work ahead once: the first encoding's total plus the

@@ -150,20 +150,14 @@ fn encode_clip(
 ) -> Result<Encoded> {
     let plan = opts.plan(mesh.bbox_diagonal())?;
     let trials = opts.codec.codec().cheap_exact_trials();
+    let settings = Settings {
+        opts,
+        plan: &plan,
+        keep,
+    };
     match opts.first_frame_bits {
-        // Its precisions are compared by their whole streams.
-        None if trials => {
-            let settings = Settings::whole(opts, &plan);
-            first_frame_bits::choose(mesh, settings, progress)
-        }
-        _ => {
-            let settings = Settings {
-                opts,
-                plan: &plan,
-                keep,
-            };
-            encode_once(mesh, settings, progress, None)
-        }
+        None if trials => first_frame_bits::choose(mesh, settings, progress),
+        _ => encode_once(mesh, settings, progress, None),
     }
 }
 

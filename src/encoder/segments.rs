@@ -57,9 +57,9 @@ pub struct SegmentedEncoder {
 #[derive(Debug, Clone, PartialEq)]
 struct Analysis {
     /// The analysis clip encoded as a clip of its own: its first frame, partition, weights and
-    /// codec set-up are the whole stream's. A picture codec's is a stream of the first frame
-    /// alone ([`super::Keep::SharedParts`]): its residuals would be dropped; tdct's holds every
-    /// frame, as its first-frame precisions are compared by whole streams.
+    /// codec set-up are the whole stream's. Usually a stream of the first frame alone
+    /// ([`super::Keep::SharedParts`]): its residuals would be dropped; every frame when the
+    /// model is fixed and tdct's first-frame precisions are compared by whole streams.
     stream: Vec<u8>,
     /// Frames per segment; every segment but the last has this many.
     length: usize,

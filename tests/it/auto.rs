@@ -262,6 +262,20 @@ fn a_segmented_choice_reports_sizes_of_the_whole_analysis_clip() {
     for c in &choice.candidates {
         assert!(c.estimated && c.estimate == Some(c.bytes), "{c:?}");
     }
+    // With the first-frame precisions open, the finest one's trial is the kept candidate's size:
+    // its estimate, or its whole stream's when a coarser one's estimate called for comparing
+    // whole streams.
+    let open = EncodeOptions {
+        first_frame_bits: None,
+        ..options
+    };
+    let encoded = encode(&mesh, &open).expect("encodes");
+    let choice = encoded.report.choice.clone().expect("a choice");
+    let finest = encoded.report.first_frame_trials[0];
+    let measured = choice.candidates.iter().filter(|c| !c.estimated).count();
+    let least = choice.candidates.iter().map(|c| c.bytes).min();
+    assert_eq!(Some(finest.bytes), least, "{choice:?}");
+    assert_eq!(measured, usize::from(!finest.estimated), "{choice:?}");
 }
 
 #[test]

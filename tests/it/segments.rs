@@ -263,8 +263,8 @@ fn encoders_resumed_from_one_analysis_make_the_stream_encode_makes() {
         let shared = started.analysis();
         // The analysis holds the analysis clip's stream and the connectivity (12 bytes a
         // triangle); a picture codec codes that stream's residuals on its first frame alone (the
-        // segments code their own), tdct every frame (it compares first-frame precisions by
-        // whole streams).
+        // segments code their own), tdct every frame here (its model fixed, it compares
+        // first-frame precisions by whole streams).
         let alone = EncodeOptions {
             segment_frames: None,
             ..opts.clone()
