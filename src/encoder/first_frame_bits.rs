@@ -12,12 +12,12 @@
 //! the default precision is coded on its first frame alone, and whole only when a coarser one's
 //! estimate beats it and whole streams must be compared.
 
-use super::{encode_once, estimate_once, EncodeOptions, Encoded, Keep, PredictorChoice, Settings};
+use super::{encode_once, estimate_once, EncodeOptions, Encoded, Keep, PredictorChoice};
+use super::{SegmentationReport, Settings};
 use crate::codec::RatePlan;
 use crate::error::Result;
-use crate::motion::Partition;
-use super::SegmentationReport;
 use crate::mesh::AnimatedMesh;
+use crate::motion::Partition;
 use crate::progress::Progress;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
