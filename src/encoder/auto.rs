@@ -20,16 +20,16 @@
 use super::choice_reason::reason;
 use super::ladder;
 use super::sampled_trial::Sample;
-use super::{analysis, code, code_kept, distortion, estimate, Analysed, Encoded, Keep, Settings, Stopwatch};
+use super::{analysis, code, distortion, estimate, Analysed, Encoded, Keep, Settings, Stopwatch};
 use crate::encoder::{MotionModel, Segmentation};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::{self, AtlasCache};
 use crate::mesh::AnimatedMesh;
 use crate::motion::{AffineTrack, Partition, PredictorKind};
-use rayon::prelude::*;
 use crate::progress::Progress;
 use crate::stream::container::Part;
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -517,7 +517,7 @@ fn keep(
                 mesh, ff, settings, ..
             } = *shared;
             let leading = shared.leading.to_vec();
-            code_kept(mesh, ff, leading, settings, &analysed, progress, clock)
+            code(mesh, ff, leading, settings, &analysed, progress, clock)
         }
     }
 }

@@ -84,11 +84,10 @@ pub(super) fn choose(
     // the first-frame coder reorders the vertices (its order may change with the precision).
     let known = (!opts.reorder).then(|| (best.partition.clone(), best.report.segmentation.clone()));
     // With a codec that estimates (tdct), precisions are compared by their estimates, and only
-    // one that beats the kept one's is coded in full. The kept one's is the least (its stream's
-    // size, unless only its shared parts were coded).
-    let chosen = best.report.choice.as_ref().and_then(|c| match partial {
-        false => c.candidates.iter().find(|k| !k.estimated)?.estimate,
-        true => c.candidates.iter().map(|k| k.bytes).min(),
+    // one that beats the kept one's is coded in full. The kept one's is the least (a stopped one
+    // passed the least so far).
+    let chosen = best.report.choice.as_ref().and_then(|c| {
+        c.candidates.iter().filter_map(|k| k.estimate).min()
     });
     let mut trials = vec![FirstFrameTrial {
         bits: default,

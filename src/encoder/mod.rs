@@ -215,7 +215,7 @@ fn encode_once(
     };
     progress.total(mesh.frame_count() as u64);
     let once = Once::analyse(mesh, &ff, settings, model, known, &mut clock)?;
-    code_kept(
+    code(
         mesh,
         &ff,
         leading,
@@ -226,36 +226,23 @@ fn encode_once(
     )
 }
 
-/// [`code`] for the stream an encoding keeps: with [`Keep::SharedParts`], the first frame alone,
-/// its shared parts those of the whole analysis (partition, weights and atlas come from every
-/// frame; the first frame's residual is its own).
-fn code_kept(
+/// With [`Keep::SharedParts`], the first frame of `mesh` alone and its prediction: the stream's
+/// shared parts are those of the whole analysis (partition, weights and atlas come from every
+/// frame; the first frame's residual is its own). `None` to code every frame.
+fn first_frame_only(
     mesh: &AnimatedMesh,
-    ff: &EncodedFirstFrame,
-    leading: Vec<Part>,
-    settings: Settings,
-    analysed: &Analysed,
-    progress: &dyn Progress,
-    clock: Stopwatch,
-) -> Result<Encoded> {
-    if settings.keep == Keep::Whole || mesh.frame_count() == 1 {
-        return code(mesh, ff, leading, settings, analysed, progress, clock);
+    prediction: &Prediction,
+    keep: Keep,
+) -> Result<Option<(AnimatedMesh, Prediction)>> {
+    if keep == Keep::Whole || mesh.frame_count() == 1 {
+        return Ok(None);
     }
-    let first = mesh.clip(0..1)?;
-    let whole = analysed.prediction;
-    let prediction = Prediction {
-        track: whole.track.select(&[0])?,
-        weights: whole.weights.clone(),
-        residuals: whole.residuals.iter().take(1).cloned().collect(),
+    let first = Prediction {
+        track: prediction.track.select(&[0])?,
+        weights: prediction.weights.clone(),
+        residuals: prediction.residuals.iter().take(1).cloned().collect(),
     };
-    let analysed = Analysed {
-        prediction: &prediction,
-        segmentation: analysed.segmentation.clone(),
-        ..*analysed
-    };
-    // The frames not coded count as done.
-    progress.frames(mesh.frame_count() as u64 - 1);
-    code(&first, ff, leading, settings, &analysed, progress, clock)
+    Ok(Some((mesh.clip(0..1)?, first)))
 }
 
 /// One motion model's analysis of an animation whose first frame is coded: its segmentation and
@@ -442,7 +429,8 @@ struct Analysed<'a> {
 }
 
 /// Codes the residuals of `analysed` and assembles the stream behind the `leading` parts; the
-/// report's stages are the `clock`'s and the coder's.
+/// report's stages are the `clock`'s and the coder's. Every frame, or the first alone when the
+/// caller keeps the shared parts ([`Keep::SharedParts`]).
 fn code(
     mesh: &AnimatedMesh,
     ff: &EncodedFirstFrame,
@@ -452,6 +440,21 @@ fn code(
     progress: &dyn Progress,
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
+    let first_only = first_frame_only(mesh, analysed.prediction, settings.keep)?;
+    let restricted;
+    let (mesh, analysed) = match &first_only {
+        Some((first, prediction)) => {
+            // The frames not coded count as done.
+            progress.frames(mesh.frame_count() as u64 - 1);
+            restricted = Analysed {
+                prediction,
+                segmentation: analysed.segmentation.clone(),
+                ..*analysed
+            };
+            (first, &restricted)
+        }
+        None => (mesh, analysed),
+    };
     let (partition, prediction) = (analysed.partition, analysed.prediction);
     let mut coded =
         (settings.plan.encoder()?).encode(&residual_input(mesh, ff, analysed, progress))?;
