@@ -5,11 +5,13 @@
 //! stack (glam) and `f32` only. The surface measures make tens of millions of queries whose answer is
 //! almost always the triangle the previous sample hit (or the same-numbered triangle, when the
 //! connectivity is shared), so the query takes a *hint* triangle whose distance bounds the search from
-//! the start; that bound is what makes a 200-frame sequence take seconds. The tree itself is a plain
-//! median split, built once in O(n log n) and refitted to each later frame in O(n).
+//! the start; that bound is what makes a 200-frame sequence take seconds. A uniform grid
+//! ([`super::grid`]) settles almost every such query; the tree, a plain median split, takes the
+//! rest. It is built in O(n log n) when a query first needs it and refitted in O(n) when one needs
+//! it in a later frame, so the frames the grid settles whole never pay for it.
 
 use super::grid::TriangleGrid;
-use super::triangle::{point_triangle_distance_squared, Vec3};
+use super::triangle::{PreparedTriangle, Vec3};
 use crate::mesh::{Point, Triangle};
 
 /// Triangles per leaf: a few exact distance tests are cheaper than another level of boxes.
@@ -61,19 +63,44 @@ pub struct Nearest {
 /// Nearest-triangle index over one set of triangle positions.
 #[derive(Debug, Clone)]
 pub struct TriangleBvh {
+    /// The triangles, indexed by the caller's triangle number.
+    triangles: Vec<PreparedTriangle>,
+    /// Settles most hinted queries without the tree (see [`super::grid`]).
+    grid: TriangleGrid,
+    /// The tree, built when a query first needs it: most measures never do.
+    tree: Option<Tree>,
+    /// Whether the tree's boxes hold the triangles as they are now (false after a refit, until a
+    /// query needs the tree).
+    fitted: bool,
+}
+
+/// The hierarchy of boxes.
+#[derive(Debug, Clone)]
+struct Tree {
     nodes: Vec<Node>,
-    /// Corner positions per triangle, indexed by the caller's triangle number.
-    corners: Vec<[Vec3; 3]>,
     /// Triangle numbers in leaf order.
     order: Vec<u32>,
     /// The leaf holding each triangle.
     leaf_of: Vec<u32>,
-    /// Settles most hinted queries without the tree (see [`super::grid`]).
-    grid: TriangleGrid,
+}
+
+/// The triangles at `positions`, prepared for distance queries.
+fn prepared<'a>(
+    triangles: &'a [Triangle],
+    positions: &'a [Point],
+) -> impl Iterator<Item = PreparedTriangle> + 'a {
+    let at = |i: u32| -> Vec3 {
+        positions
+            .get(i as usize)
+            .map_or([0.0; 3], |p| [p[0] as f64, p[1] as f64, p[2] as f64])
+    };
+    triangles
+        .iter()
+        .map(move |t| PreparedTriangle::new([at(t[0]), at(t[1]), at(t[2])]))
 }
 
 impl TriangleBvh {
-    /// Builds the tree over `triangles` placed at `positions`; `None` when there are no triangles.
+    /// Indexes `triangles` placed at `positions`; `None` when there are no triangles.
     ///
     /// Every index must be in range of `positions` (as [`crate::AnimatedMesh`] guarantees);
     /// a triangle with an out-of-range index is placed at the origin rather than panicking.
@@ -81,133 +108,72 @@ impl TriangleBvh {
         if triangles.is_empty() {
             return None;
         }
-        let at = |i: u32| -> Vec3 {
-            positions
-                .get(i as usize)
-                .map_or([0.0; 3], |p| [p[0] as f64, p[1] as f64, p[2] as f64])
-        };
-        let corners: Vec<[Vec3; 3]> = triangles
-            .iter()
-            .map(|t| [at(t[0]), at(t[1]), at(t[2])])
-            .collect();
-        let centroids: Vec<Vec3> = corners
-            .iter()
-            .map(|c| {
-                let mut m = [0.0; 3];
-                for (a, v) in m.iter_mut().enumerate() {
-                    *v = (c[0][a] + c[1][a] + c[2][a]) / 3.0;
-                }
-                m
-            })
-            .collect();
-        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
-        build(&mut nodes, &mut order, 0, NO_NODE, &corners, &centroids);
-        let mut leaf_of = vec![0u32; triangles.len()];
-        for (i, n) in nodes.iter().enumerate().filter(|(_, n)| n.count > 0) {
-            let held = order
-                .get(n.first as usize..(n.first + n.count) as usize)
-                .unwrap_or(&[]);
-            for &t in held {
-                if let Some(slot) = leaf_of.get_mut(t as usize) {
-                    *slot = i as u32;
-                }
-            }
-        }
+        let triangles: Vec<PreparedTriangle> = prepared(triangles, positions).collect();
         let mut grid = TriangleGrid::default();
-        grid.rebuild(&corners);
+        grid.rebuild(&triangles);
         Some(Self {
-            nodes,
-            corners,
-            order,
-            leaf_of,
+            triangles,
             grid,
+            tree: None,
+            fitted: false,
         })
     }
 
-    /// Moves the tree's triangles to `positions` (the same `triangles` it was built from, in a later
-    /// frame) and refits every box, keeping the tree's shape: far cheaper than a rebuild, and as
-    /// good while the motion keeps neighbouring triangles together (the answer is exact either way).
-    /// Returns false, changing nothing, when `triangles` is not the size the tree was built for.
+    /// Moves the index's triangles to `positions` (the same `triangles` it was built from, in a
+    /// later frame). The tree, when there is one, keeps its shape and has its boxes refitted when
+    /// a query next needs it: far cheaper than a rebuild, and as good while the motion keeps
+    /// neighbouring triangles together (the answer is exact either way). Returns false, changing
+    /// nothing, when `triangles` is not the size the index was built for.
     pub fn refit(&mut self, triangles: &[Triangle], positions: &[Point]) -> bool {
-        if triangles.len() != self.corners.len() {
+        if triangles.len() != self.triangles.len() {
             return false;
         }
-        let at = |i: u32| -> Vec3 {
-            positions
-                .get(i as usize)
-                .map_or([0.0; 3], |p| [p[0] as f64, p[1] as f64, p[2] as f64])
-        };
-        for (c, t) in self.corners.iter_mut().zip(triangles) {
-            *c = [at(t[0]), at(t[1]), at(t[2])];
+        for (slot, t) in self.triangles.iter_mut().zip(prepared(triangles, positions)) {
+            *slot = t;
         }
-        // Children follow their parent in `nodes`, so a backward sweep sees children first.
-        for i in (0..self.nodes.len()).rev() {
-            let Some(&n) = self.nodes.get(i) else {
-                continue;
-            };
-            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            let mut grow = |p: &Vec3| {
-                for a in 0..3 {
-                    lo[a] = lo[a].min(p[a]);
-                    hi[a] = hi[a].max(p[a]);
-                }
-            };
-            if n.count > 0 {
-                let leaf = self
-                    .order
-                    .get(n.first as usize..(n.first + n.count) as usize)
-                    .unwrap_or(&[]);
-                for &t in leaf {
-                    if let Some(c) = self.corners.get(t as usize) {
-                        c.iter().for_each(&mut grow);
-                    }
-                }
-            } else {
-                for child in [n.first, n.right] {
-                    if let Some(c) = self.nodes.get(child as usize) {
-                        grow(&c.lo);
-                        grow(&c.hi);
-                    }
-                }
-            }
-            if let Some(node) = self.nodes.get_mut(i) {
-                node.lo = lo;
-                node.hi = hi;
-            }
-        }
-        self.grid.rebuild(&self.corners);
+        self.grid.rebuild(&self.triangles);
+        self.fitted = false;
         true
     }
 
-    /// The corner positions of triangle `t` as the tree holds them.
+    /// Makes the tree hold the triangles as they are now: built on first use, refitted after
+    /// a move.
+    fn fit_tree(&mut self) {
+        match &mut self.tree {
+            Some(tree) if !self.fitted => tree.refit(&self.triangles),
+            Some(_) => {}
+            None => self.tree = Some(Tree::new(&self.triangles)),
+        }
+        self.fitted = true;
+    }
+
+    /// The corner positions of triangle `t` as the index holds them.
     pub fn corners(&self, t: u32) -> Option<&[Vec3; 3]> {
-        self.corners.get(t as usize)
+        self.triangles.get(t as usize).map(|t| &t.corners)
     }
 
     #[cfg(any(test, feature = "internals"))]
-    /// Number of triangles in the tree.
+    /// Number of triangles in the index.
     pub fn len(&self) -> usize {
-        self.corners.len()
+        self.triangles.len()
     }
 
     #[cfg(any(test, feature = "internals"))]
-    /// Always false: a tree is never built over no triangles.
+    /// Always false: an index is never built over no triangles.
     pub fn is_empty(&self) -> bool {
-        self.corners.is_empty()
+        self.triangles.is_empty()
     }
 
     fn triangle_distance_squared(&self, t: u32, p: Vec3) -> f64 {
-        match self.corners.get(t as usize) {
-            Some(c) => point_triangle_distance_squared(p, c[0], c[1], c[2]),
-            None => f64::INFINITY,
-        }
+        self.triangles
+            .get(t as usize)
+            .map_or(f64::INFINITY, |t| t.distance_squared(p))
     }
 
     #[cfg(any(test, feature = "internals"))]
     /// The triangle nearest to `p`. `hint`, a triangle likely to be near (out-of-range hints are
     /// ignored), only speeds the search up: the answer is exact either way.
-    pub fn nearest(&self, p: Vec3, hint: Option<u32>) -> Nearest {
+    pub fn nearest(&mut self, p: Vec3, hint: Option<u32>) -> Nearest {
         let best = self.nearest_hint(p, hint);
         self.nearest_from(p, best, &mut Vec::with_capacity(MAX_DEPTH))
     }
@@ -232,30 +198,121 @@ impl TriangleBvh {
         best
     }
 
-    /// The triangle nearest to `p`, searching from `best` (a triangle of this tree and its
+    /// The triangle nearest to `p`, searching from `best` (a triangle of this index and its
     /// distance, or an infinite distance; see [`Self::nearest_hint`]), which only bounds the
     /// search; a caller-kept traversal `stack` spares a run of queries any allocation.
-    pub fn nearest_from(&self, p: Vec3, mut best: Nearest, stack: &mut Vec<(u32, f64)>) -> Nearest {
+    pub fn nearest_from(
+        &mut self,
+        p: Vec3,
+        mut best: Nearest,
+        stack: &mut Vec<(u32, f64)>,
+    ) -> Nearest {
         // A near hint bounds the search to a few grid cells.
         let mut found = (best.distance_squared, best.triangle);
-        if self.grid.improve(p, &self.corners, &mut found) {
+        if self.grid.improve(p, &self.triangles, &mut found) {
             return Nearest {
                 triangle: found.1,
                 distance_squared: found.0,
             };
         }
-        // Otherwise climb from the hint's leaf: every other subtree is the sibling of a node on that
-        // path, and the siblings far from `p` are dismissed by one box test each. That skips the
+        self.fit_tree();
+        if let Some(tree) = &self.tree {
+            tree.nearest_from(p, &mut best, &self.triangles, stack);
+        }
+        best
+    }
+}
+
+impl Tree {
+    /// A median-split tree over `triangles`.
+    fn new(triangles: &[PreparedTriangle]) -> Self {
+        let centroids: Vec<Vec3> = triangles
+            .iter()
+            .map(|t| {
+                let c = &t.corners;
+                let mut m = [0.0; 3];
+                for (a, v) in m.iter_mut().enumerate() {
+                    *v = (c[0][a] + c[1][a] + c[2][a]) / 3.0;
+                }
+                m
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
+        build(&mut nodes, &mut order, 0, NO_NODE, triangles, &centroids);
+        let mut leaf_of = vec![0u32; triangles.len()];
+        for (i, n) in nodes.iter().enumerate().filter(|(_, n)| n.count > 0) {
+            let held = order
+                .get(n.first as usize..(n.first + n.count) as usize)
+                .unwrap_or(&[]);
+            for &t in held {
+                if let Some(slot) = leaf_of.get_mut(t as usize) {
+                    *slot = i as u32;
+                }
+            }
+        }
+        Self {
+            nodes,
+            order,
+            leaf_of,
+        }
+    }
+
+    /// Refits every box to `triangles`, keeping the tree's shape.
+    fn refit(&mut self, triangles: &[PreparedTriangle]) {
+        // Children follow their parent in `nodes`, so a backward sweep sees children first.
+        for i in (0..self.nodes.len()).rev() {
+            let Some(&n) = self.nodes.get(i) else {
+                continue;
+            };
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            let mut grow = |p: &Vec3| {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            };
+            if n.count > 0 {
+                for &t in self.leaf(&n) {
+                    if let Some(t) = triangles.get(t as usize) {
+                        t.corners.iter().for_each(&mut grow);
+                    }
+                }
+            } else {
+                for child in [n.first, n.right] {
+                    if let Some(c) = self.nodes.get(child as usize) {
+                        grow(&c.lo);
+                        grow(&c.hi);
+                    }
+                }
+            }
+            if let Some(node) = self.nodes.get_mut(i) {
+                node.lo = lo;
+                node.hi = hi;
+            }
+        }
+    }
+
+    /// Lowers `best` to the triangle nearest to `p`.
+    fn nearest_from(
+        &self,
+        p: Vec3,
+        best: &mut Nearest,
+        triangles: &[PreparedTriangle],
+        stack: &mut Vec<(u32, f64)>,
+    ) {
+        // Climb from the hint's leaf: every other subtree is the sibling of a node on that path,
+        // and the siblings far from `p` are dismissed by one box test each. That skips the
         // descent from the root, which was most of the cost of a well-hinted query.
         let Some(&start) = self
             .leaf_of
             .get(best.triangle as usize)
             .filter(|_| best.distance_squared.is_finite())
         else {
-            self.descend(0, p, &mut best, stack);
-            return best;
+            self.descend(0, p, best, triangles, stack);
+            return;
         };
-        self.descend(start, p, &mut best, stack);
+        self.descend(start, p, best, triangles, stack);
         let (mut child, mut node) = (
             start,
             self.nodes.get(start as usize).map_or(NO_NODE, |n| n.parent),
@@ -263,33 +320,35 @@ impl TriangleBvh {
         while let Some(n) = self.nodes.get(node as usize) {
             let sibling = if n.first == child { n.right } else { n.first };
             if self.box_distance(sibling, p) < best.distance_squared {
-                self.descend(sibling, p, &mut best, stack);
+                self.descend(sibling, p, best, triangles, stack);
             }
             child = node;
             node = n.parent;
         }
-        best
     }
 
     /// Searches the subtree under `start` for anything nearer than `best`.
-    fn descend(&self, start: u32, p: Vec3, best: &mut Nearest, stack: &mut Vec<(u32, f64)>) {
+    fn descend(
+        &self,
+        start: u32,
+        p: Vec3,
+        best: &mut Nearest,
+        triangles: &[PreparedTriangle],
+        stack: &mut Vec<(u32, f64)>,
+    ) {
         stack.clear();
         let mut node = start;
         while let Some(n) = self.nodes.get(node as usize) {
             if n.count > 0 {
-                let leaf = self
-                    .order
-                    .get(n.first as usize..(n.first + n.count) as usize)
-                    .unwrap_or(&[]);
-                for &t in leaf {
-                    let Some(c) = self.corners.get(t as usize) else {
+                for &t in self.leaf(n) {
+                    let Some(tri) = triangles.get(t as usize) else {
                         continue;
                     };
                     // The triangle's own box: a few comparisons that spare most exact tests.
-                    if corner_box_distance_squared(c, p) >= best.distance_squared {
+                    if corner_box_distance_squared(&tri.corners, p) >= best.distance_squared {
                         continue;
                     }
-                    let d = point_triangle_distance_squared(p, c[0], c[1], c[2]);
+                    let d = tri.distance_squared(p);
                     if d < best.distance_squared {
                         *best = Nearest {
                             triangle: t,
@@ -329,6 +388,13 @@ impl TriangleBvh {
         }
     }
 
+    /// The triangles of leaf `n` (none for an inner node).
+    fn leaf(&self, n: &Node) -> &[u32] {
+        self.order
+            .get(n.first as usize..(n.first + n.count) as usize)
+            .unwrap_or(&[])
+    }
+
     fn box_distance(&self, node: u32, p: Vec3) -> f64 {
         self.nodes
             .get(node as usize)
@@ -355,7 +421,7 @@ fn build(
     order: &mut [u32],
     offset: usize,
     parent: u32,
-    corners: &[[Vec3; 3]],
+    triangles: &[PreparedTriangle],
     centroids: &[Vec3],
 ) -> u32 {
     let mut lo = [f64::INFINITY; 3];
@@ -363,9 +429,9 @@ fn build(
     let mut clo = [f64::INFINITY; 3];
     let mut chi = [f64::NEG_INFINITY; 3];
     for &t in order.iter() {
-        if let (Some(c), Some(m)) = (corners.get(t as usize), centroids.get(t as usize)) {
+        if let (Some(t), Some(m)) = (triangles.get(t as usize), centroids.get(t as usize)) {
             for a in 0..3 {
-                for v in c {
+                for v in &t.corners {
                     lo[a] = lo[a].min(v[a]);
                     hi[a] = hi[a].max(v[a]);
                 }
@@ -398,8 +464,8 @@ fn build(
     let key = |t: &u32| centroids.get(*t as usize).map_or(0.0, |m| m[axis]);
     order.select_nth_unstable_by(mid, |x, y| key(x).total_cmp(&key(y)));
     let (left, right) = order.split_at_mut(mid);
-    let l = build(nodes, left, offset, index, corners, centroids);
-    let r = build(nodes, right, offset + mid, index, corners, centroids);
+    let l = build(nodes, left, offset, index, triangles, centroids);
+    let r = build(nodes, right, offset + mid, index, triangles, centroids);
     if let Some(n) = nodes.get_mut(index as usize) {
         n.first = l;
         n.count = 0;
@@ -428,7 +494,7 @@ mod tests {
             .map(|i| [3 * i, 3 * i + 1, (3 * i + 2) % 600])
             .chain([[0, 0, 1], [5, 5, 5]])
             .collect();
-        let Some(bvh) = TriangleBvh::new(&triangles, &positions) else {
+        let Some(mut bvh) = TriangleBvh::new(&triangles, &positions) else {
             panic!("no tree over 202 triangles");
         };
         assert_eq!(bvh.len(), 202);
@@ -458,13 +524,17 @@ mod tests {
         };
         let (first, later, queries) = (points(300), points(300), points(500));
         let triangles: Vec<Triangle> = (0..100u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
-        let (Some(mut tree), Some(fresh)) = (
+        let (Some(mut tree), Some(mut fresh)) = (
             TriangleBvh::new(&triangles, &first),
             TriangleBvh::new(&triangles, &later),
         ) else {
             panic!("no tree");
         };
+        // An unhinted query needs the tree: it is built over the first positions, then refitted.
+        tree.nearest([0.5; 3], None);
+        assert!(tree.tree.is_some() && tree.fitted);
         assert!(tree.refit(&triangles, &later));
+        assert!(!tree.fitted);
         assert!(!tree.refit(&triangles[1..], &later));
         for q in queries {
             let p = [q[0] as f64, q[1] as f64, q[2] as f64];

@@ -61,7 +61,7 @@ pub struct Surface<'a> {
 pub fn one_sided(
     samples: &[Sample],
     a: Surface<'_>,
-    b: &TriangleBvh,
+    b: &mut TriangleBvh,
     same_triangles: bool,
     twins: Option<&[u32]>,
 ) -> Result<OneSided> {
@@ -149,14 +149,14 @@ fn refit_or_build<'c>(
     slot: &'c mut Option<TriangleBvh>,
     s: Surface<'_>,
     which: &str,
-) -> Result<&'c TriangleBvh> {
+) -> Result<&'c mut TriangleBvh> {
     let refitted = slot
         .as_mut()
         .is_some_and(|t| t.refit(s.triangles, s.positions));
     if !refitted {
         *slot = Some(index_surface(s, which)?);
     }
-    slot.as_ref()
+    slot.as_mut()
         .ok_or_else(|| Error::Mesh(format!("the {which} mesh could not be indexed")))
 }
 

@@ -48,53 +48,92 @@ pub fn closest_point_on_segment(p: Vec3, a: Vec3, b: Vec3) -> Vec3 {
 /// the face-region formulas divide by `|ab × ac|²`, which loses every digit near zero.
 const DEGENERATE_SINE_SQUARED: f64 = 1e-14;
 
+#[cfg(any(test, feature = "internals"))]
 /// The point of triangle `abc` (edges and interior included) closest to `p`.
 ///
 /// Every Voronoi region (three vertices, three edges, the face) is handled; a degenerate triangle
 /// (collinear or coincident corners) is treated as the union of its three edges.
 pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
-    let ab = sub(b, a);
-    let ac = sub(c, a);
-    let n = cross(ab, ac);
-    let n2 = dot(n, n);
-    if n2 <= DEGENERATE_SINE_SQUARED * dot(ab, ab) * dot(ac, ac) || n2 == 0.0 {
-        return closest_on_edges(p, a, b, c);
+    PreparedTriangle::new([a, b, c]).closest_point(p)
+}
+
+/// A triangle with what every distance query to it needs computed once (two edge vectors and
+/// whether it is degenerate): the surface measures ask each triangle of a frame for the distance
+/// to several points. The answers are those of [`closest_point_on_triangle`] to the last bit.
+#[derive(Debug, Clone, Copy)]
+pub struct PreparedTriangle {
+    /// The corners.
+    pub corners: [Vec3; 3],
+    ab: Vec3,
+    ac: Vec3,
+    /// Collinear or coincident corners: the triangle is its three edges.
+    degenerate: bool,
+}
+
+impl PreparedTriangle {
+    /// Prepares the triangle with `corners`.
+    pub fn new(corners: [Vec3; 3]) -> Self {
+        let [a, b, c] = corners;
+        let ab = sub(b, a);
+        let ac = sub(c, a);
+        let n = cross(ab, ac);
+        let n2 = dot(n, n);
+        Self {
+            corners,
+            ab,
+            ac,
+            degenerate: n2 <= DEGENERATE_SINE_SQUARED * dot(ab, ab) * dot(ac, ac) || n2 == 0.0,
+        }
     }
-    let ap = sub(p, a);
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
+
+    /// Squared distance from `p` to the triangle.
+    pub fn distance_squared(&self, p: Vec3) -> f64 {
+        distance_squared(p, self.closest_point(p))
     }
-    let bp = sub(p, b);
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
+
+    /// The point of the triangle closest to `p` (Ericson's Voronoi-region walk).
+    pub fn closest_point(&self, p: Vec3) -> Vec3 {
+        let [a, b, c] = self.corners;
+        if self.degenerate {
+            return closest_on_edges(p, a, b, c);
+        }
+        let (ab, ac) = (self.ab, self.ac);
+        let ap = sub(p, a);
+        let d1 = dot(ab, ap);
+        let d2 = dot(ac, ap);
+        if d1 <= 0.0 && d2 <= 0.0 {
+            return a;
+        }
+        let bp = sub(p, b);
+        let d3 = dot(ab, bp);
+        let d4 = dot(ac, bp);
+        if d3 >= 0.0 && d4 <= d3 {
+            return b;
+        }
+        let vc = d1 * d4 - d3 * d2;
+        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            return affine(a, ab, d1 / (d1 - d3), ac, 0.0);
+        }
+        let cp = sub(p, c);
+        let d5 = dot(ab, cp);
+        let d6 = dot(ac, cp);
+        if d6 >= 0.0 && d5 <= d6 {
+            return c;
+        }
+        let vb = d5 * d2 - d1 * d6;
+        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            return affine(a, ab, 0.0, ac, d2 / (d2 - d6));
+        }
+        let va = d3 * d6 - d5 * d4;
+        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+            let bc = sub(c, b);
+            return affine(b, bc, w, bc, 0.0);
+        }
+        // Face region: va + vb + vc = |ab × ac|², which the degeneracy test keeps away from zero.
+        let inv = 1.0 / (va + vb + vc);
+        affine(a, ab, vb * inv, ac, vc * inv)
     }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return affine(a, ab, d1 / (d1 - d3), ac, 0.0);
-    }
-    let cp = sub(p, c);
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return affine(a, ab, 0.0, ac, d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        let bc = sub(c, b);
-        return affine(b, bc, w, bc, 0.0);
-    }
-    // Face region: va + vb + vc = |ab × ac|², which the degeneracy test above keeps away from zero.
-    let inv = 1.0 / (va + vb + vc);
-    affine(a, ab, vb * inv, ac, vc * inv)
 }
 
 fn closest_on_edges(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
@@ -115,6 +154,7 @@ fn closest_on_edges(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     best
 }
 
+#[cfg(any(test, feature = "internals"))]
 /// Squared distance from `p` to triangle `abc`.
 pub fn point_triangle_distance_squared(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f64 {
     distance_squared(p, closest_point_on_triangle(p, a, b, c))
