@@ -14,10 +14,12 @@
 //! intra pictures, or runs of consecutive P-frames), scale the sample's per-frame parts to the
 //! whole, weigh the error of the sample's own stream (decoded), and then code the winner once in
 //! full: the sample's bytes alone can keep a candidate whose whole stream is both larger and
-//! worse (docs/design.md, "Automatic choice: bits at equal error"). Clips too short to sample
+//! worse (docs/design.md, "Automatic choice: bits at equal error"). When the sample cannot tell
+//! its two best apart, both are coded whole ([`super::close_call`]). Clips too short to sample
 //! code every candidate whole and keep the winner's stream.
 
 use super::choice_reason::reason;
+use super::close_call::{self, Podium};
 use super::ladder;
 use super::sampled_trial::Sample;
 use super::{analysis, code, distortion, estimate, Analysed, Encoded, Keep, Settings, Stopwatch};
@@ -59,7 +61,9 @@ pub struct Candidate {
     /// Its stream's bytes: measured for the one kept; for the others, estimated when the trials
     /// estimate (tdct's from one cheap pass over the bands, the picture codecs' from a sample of
     /// frames), and for the one kept too when only a segmented encoding's shared parts were
-    /// coded from it (its analysis clip's residuals are the segments').
+    /// coded from it (its analysis clip's residuals are the segments'), or when the picture
+    /// codecs' sample kept it (measured for the two best when the sample could not tell them
+    /// apart and both were coded whole).
     pub bytes: u64,
     /// Whether `bytes` is an estimate.
     pub estimated: bool,
@@ -79,13 +83,13 @@ pub struct Candidate {
 }
 
 /// The best candidate so far: its whole stream, or (sampled trials) what coding it in full needs.
-struct Best<'a> {
-    index: usize,
-    cost: f64,
-    kept: Kept<'a>,
+pub(super) struct Best<'a> {
+    pub(super) index: usize,
+    pub(super) cost: f64,
+    pub(super) kept: Kept<'a>,
 }
 
-enum Kept<'a> {
+pub(super) enum Kept<'a> {
     Stream(Box<Encoded>),
     Analysis(Box<Trial<'a>>),
 }
@@ -126,7 +130,8 @@ pub(super) fn choose(
     let (frames, trial_frames) = (mesh.frame_count(), shared.trial_frames());
     let estimated = sample.is_some() || settings.opts.codec.codec().estimated_trials();
     let final_frames = if estimated { frames } else { 0 };
-    progress.total((models.len() * trial_frames + final_frames) as u64);
+    let total = (models.len() * trial_frames + final_frames) as u64;
+    progress.total(total);
     let segmenter = analysis::Segmenter::new(mesh);
     let segmentations = segmentations(models);
     let largest = segmentations.iter().filter(|(s, _)| *s == Segmentation::KMeans);
@@ -150,23 +155,40 @@ pub(super) fn choose(
         &gates,
         |i| jobs[i].run(&shared, &segmenter, progress),
         |i| jobs[i].skip(&shared, progress),
-        |outcome| outcome.best.as_ref().map(|b| b.cost),
+        |outcome| outcome.podium.best.as_ref().map(|(b, _)| b.cost),
     )?;
     let Tally {
         mut candidates,
         costs,
-        best,
+        podium,
         skipped,
-    } = tally(&jobs, outcomes, &mut clock);
-    let (best, at) =
-        best.ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
-    let model = models[best.index];
+    } = tally(outcomes, &mut clock);
+    let (best, at) = (podium.best)
+        .ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
     let mut reason = reason(&candidates, &costs, at, (trial_frames, frames));
     for s in skipped {
         reason.push_str("; ");
         reason.push_str(&s);
     }
-    let mut encoded = keep(&shared, model, best.kept, progress, clock)?;
+    // A sample too close to call: both coded whole (a segmented encoding's analysis clip is
+    // coded on its first frame alone, so its sample decides).
+    let whole_streams = sample.is_some() && settings.keep == Keep::Whole;
+    let close = (podium.runner_up)
+        .filter(|(r, _)| whole_streams && close_call::is_close(best.cost, r.cost));
+    let (mut encoded, model) = match close {
+        Some(runner_up) => {
+            progress.total(total + frames as u64);
+            let pair = [(best, at), runner_up];
+            let (encoded, model, why) =
+                close_call::settle(&shared, pair, models, &mut candidates, progress, clock)?;
+            reason = format!("{why}. On the sample: {reason}");
+            (encoded, model)
+        }
+        None => {
+            let model = models[best.index];
+            (keep(&shared, model, best.kept, progress, clock)?, model)
+        }
+    };
     // The kept one's size is its stream's now, not an estimate (unless the stream is the analysis
     // clip's first frame alone).
     if sample.is_none() && candidates[at].estimated && settings.keep == Keep::Whole {
@@ -214,31 +236,30 @@ fn jobs_of<'a>(
 struct Tally<'a> {
     candidates: Vec<Candidate>,
     costs: Vec<f64>,
-    best: Option<(Best<'a>, usize)>,
+    /// The two lowest costs, with their places among `candidates`.
+    podium: Podium<'a>,
     skipped: Vec<String>,
 }
 
 /// Gathers the jobs' outcomes, their stages into `clock`; the lowest cost wins, the earliest
 /// candidate on a tie.
-fn tally<'a>(jobs: &[Job], outcomes: Vec<Outcome<'a>>, clock: &mut Stopwatch) -> Tally<'a> {
+fn tally<'a>(outcomes: Vec<Outcome<'a>>, clock: &mut Stopwatch) -> Tally<'a> {
     let mut tally = Tally {
         candidates: Vec::new(),
         costs: Vec::new(),
-        best: None,
+        podium: Podium::new(),
         skipped: Vec::new(),
     };
-    for (job, outcome) in jobs.iter().zip(outcomes) {
+    for outcome in outcomes {
         clock.stages.extend(outcome.stages);
         tally.skipped.extend(outcome.skipped);
         // Where the job's candidates start in the report (a skipped rung has none).
         let base = tally.candidates.len();
         tally.candidates.extend(outcome.candidates);
         tally.costs.extend(outcome.costs);
-        if let Some(b) = outcome.best {
-            if tally.best.as_ref().is_none_or(|(best, _)| b.cost < best.cost) {
-                let at = base + b.index.saturating_sub(job.first);
-                tally.best = Some((b, at));
-            }
+        let Podium { best, runner_up } = outcome.podium;
+        for (b, at) in [best, runner_up].into_iter().flatten() {
+            tally.podium.offer(b, base + at);
         }
     }
     tally
@@ -263,13 +284,13 @@ struct Tried<'a> {
     kept: Kept<'a>,
 }
 
-/// What a job measured: its candidates and their costs, its stages' seconds, its best; or why
-/// it was not tried.
+/// What a job measured: its candidates and their costs, its stages' seconds, its two best (each
+/// with its place among the job's candidates); or why it was not tried.
 struct Outcome<'a> {
     candidates: Vec<Candidate>,
     costs: Vec<f64>,
     stages: Vec<(String, f64)>,
-    best: Option<Best<'a>>,
+    podium: Podium<'a>,
     skipped: Option<String>,
 }
 
@@ -296,7 +317,7 @@ impl<'a> Job<'a> {
             candidates: Vec::new(),
             costs: Vec::new(),
             stages: vec![(stage, start.elapsed().as_secs_f64())],
-            best: None,
+            podium: Podium::new(),
             skipped: None,
         };
         // A picture codec's candidates on this partition share its atlas, most of a trial's
@@ -326,13 +347,12 @@ impl<'a> Job<'a> {
             outcome.stages.push((format!("trial {}", model.name()), seconds));
             outcome.candidates.push(candidate);
             outcome.costs.push(cost);
-            if outcome.best.as_ref().is_none_or(|b| cost < b.cost) {
-                outcome.best = Some(Best {
-                    index: self.first + i,
-                    cost,
-                    kept,
-                });
-            }
+            let best = Best {
+                index: self.first + i,
+                cost,
+                kept,
+            };
+            outcome.podium.offer(best, i);
         }
         Ok(outcome)
     }
@@ -407,7 +427,7 @@ impl<'a> Job<'a> {
             candidates: Vec::new(),
             costs: Vec::new(),
             stages: vec![(format!("segmentation (kmeans, K = {k}) skipped"), 0.0)],
-            best: None,
+            podium: Podium::new(),
             skipped: Some(why),
         }
     }
@@ -415,8 +435,8 @@ impl<'a> Job<'a> {
 
 /// What every trial shares: the animation (in the stream's vertex order), its coded first frame
 /// and the parts before the partition, the options and, for sampled trials, the sample.
-struct Shared<'a> {
-    mesh: &'a AnimatedMesh,
+pub(super) struct Shared<'a> {
+    pub(super) mesh: &'a AnimatedMesh,
     ff: &'a EncodedFirstFrame,
     leading: &'a [Part],
     settings: Settings<'a>,
@@ -487,7 +507,7 @@ fn trial(
 
 /// The winner's stream: kept from its trial (its report's stages replaced by the whole
 /// choice's), or coded in full now.
-fn keep(
+pub(super) fn keep(
     shared: &Shared,
     model: MotionModel,
     kept: Kept,

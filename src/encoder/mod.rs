@@ -15,6 +15,7 @@ mod options;
 internal! {
     analysis;
     auto;
+    close_call;
     distortion;
     first_frame_bits;
     ladder;
@@ -495,6 +496,7 @@ fn code(
 }
 
 /// Seconds per stage.
+#[derive(Clone)]
 struct Stopwatch {
     stages: Vec<(String, f64)>,
     start: Instant,

@@ -38,10 +38,15 @@ fn skinned_bend_of(frames: usize) -> AnimatedMesh {
 /// Two separate tubes, each turning rigidly: one affine map per tube is exact, so skinning
 /// weights can only add bytes.
 fn rigid_pair() -> AnimatedMesh {
+    rigid_pair_of(30)
+}
+
+/// [`rigid_pair`] over `frames` frames.
+fn rigid_pair_of(frames: usize) -> AnimatedMesh {
     let (mut points, mut tris) = (Vec::new(), Vec::new());
     tube(&mut points, &mut tris, -2.0, -0.2, 12, 12);
     tube(&mut points, &mut tris, 0.2, 2.0, 12, 12);
-    animate(&points, tris, 30, |t, _, p: Point| {
+    animate(&points, tris, frames, |t, _, p: Point| {
         let a = if p[0] < 0.0 { 0.8 * t } else { -1.1 * t };
         let (s, c) = a.sin_cos();
         [c * p[0] - s * p[1], s * p[0] + c * p[1] + t, p[2]]
@@ -341,6 +346,59 @@ fn kept_at_least_cost(choice: &ChoiceReport, diagonal: f64) -> Candidate {
         format!("{}+{}", best.predictor.name(), best.segmentation)
     );
     best.clone()
+}
+
+#[test]
+fn a_sample_too_close_to_call_codes_its_two_best_whole_and_keeps_the_better() {
+    // Both segmentations find the two tubes, so the sample cannot tell them apart.
+    let mesh = rigid_pair_of(64);
+    let options = opts(
+        Codec::Mpeg4,
+        PredictorChoice::Auto,
+        SegmentationChoice::auto(),
+    );
+    let encoded = encode(&mesh, &options).expect("encodes");
+    let choice = encoded.report.choice.clone().expect("a choice");
+    assert_eq!(choice.trial_frames, 32, "{choice:?}");
+    assert!(
+        choice.reason.contains("too close to tell"),
+        "{}",
+        choice.reason
+    );
+    let diagonal = mesh.bbox_diagonal();
+    let whole: Vec<&Candidate> = choice.candidates.iter().filter(|c| !c.estimated).collect();
+    assert_eq!(whole.len(), 2, "{choice:?}");
+    let mut costs = Vec::new();
+    for c in &whole {
+        let segmentation = match c.segmentation {
+            "kmeans" => Segmentation::KMeans,
+            _ => Segmentation::Decimation {
+                e0: mcgv_video::motion::DEFAULT_E0,
+            },
+        };
+        // Each was coded whole, as if fixed, and its error measured on every frame.
+        let fixed = fixed_bytes(&mesh, &options, (c.predictor, segmentation));
+        assert_eq!(c.bytes, fixed.len() as u64, "{c:?}");
+        let measured = vertex_rmse(&mesh, &decode_all(fixed.clone()).expect("decodes"));
+        let reported = c.vertex_rmse.expect("an error");
+        assert!(
+            (reported / measured - 1.0).abs() < 1e-6,
+            "{c:?}: {measured}"
+        );
+        let model = format!("{}+{}", c.predictor.name(), c.segmentation);
+        let cost = distortion::cost(8.0 * c.bytes as f64, Some(reported * diagonal));
+        costs.push((cost, model, fixed));
+    }
+    // The better of the two whole streams is the one kept, on any number of threads.
+    let (_, model, fixed) = costs
+        .into_iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .expect("two");
+    assert_eq!(choice.chosen, model);
+    assert_eq!(encoded.to_bytes(), fixed);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build();
+    let alone = pool.expect("a pool").install(|| encode(&mesh, &options));
+    assert_eq!(alone.expect("encodes").to_bytes(), encoded.to_bytes());
 }
 
 #[test]
