@@ -11,7 +11,10 @@
 //! regula falsi inside the bracket if the model misses. It never returns a stream over the budget
 //! (docs/design.md, "Budgets").
 
-use super::{encode_with_progress, EncodeOptions, Encoded, PredictorChoice, SegmentationChoice};
+use super::{
+    encode_reusing, encode_with_progress, EncodeOptions, Encoded, PredictorChoice, Reuse,
+    SegmentationChoice,
+};
 use crate::codec::Codec;
 use crate::codec::{fine_scale_percent, ijg_scale_percent};
 use crate::error::{Error, Result};
@@ -187,12 +190,14 @@ pub fn encode_to_budget_with_progress(
     opts.check(mesh)?;
     let mut search = Search::new(mesh, opts, budget);
     let start = opts.fine_quality.unwrap_or(f64::from(opts.quality));
-    let first = encode_with_progress(mesh, &at_quality(opts, start), progress)?;
+    let mut first = encode_with_progress(mesh, &at_quality(opts, start), progress)?;
     let pinned = pin_choices(opts, &first);
     search.model = model_name(&pinned, first.report.segmentation.clusters);
+    // The later encodes keep the first one's partition and atlas: no quality changes them.
+    let reuse = Reuse::take(&mut first);
     search.record(first, start)?;
     while let Some(quality) = search.next_quality()? {
-        let encoded = encode_with_progress(mesh, &at_quality(&pinned, quality), progress)?;
+        let encoded = encode_reusing(mesh, &at_quality(&pinned, quality), progress, &reuse)?;
         search.record(encoded, quality)?;
     }
     search.finish()

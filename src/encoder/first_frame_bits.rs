@@ -73,7 +73,7 @@ pub(super) fn choose(
         plan,
         keep,
     };
-    let mut best = encode_once(mesh, settings_first, &progress, None)?;
+    let mut best = encode_once(mesh, settings_first, &progress, None, None)?;
     let model = EncodeOptions {
         predictor: PredictorChoice::Fixed(best.model.predictor),
         segmentation: best.model.segmentation.into(),
@@ -140,7 +140,7 @@ pub(super) fn choose(
                 progress.grow(frames);
                 analysis.code(settings, &progress)?
             }
-            None => encode_once(mesh, settings, &progress, known.clone())?,
+            None => encode_once(mesh, settings, &progress, known.clone(), None)?,
         };
         trials.push(FirstFrameTrial {
             bits,
@@ -174,7 +174,7 @@ fn recode_whole(
 ) -> Result<()> {
     progress.grow(mesh.frame_count() as u64);
     let mut choice = best.report.choice.take();
-    *best = encode_once(mesh, Settings::whole(opts, plan), progress, known.clone())?;
+    *best = encode_once(mesh, Settings::whole(opts, plan), progress, known.clone(), None)?;
     // The kept candidate (the least estimate, the first on a tie) is measured now.
     let candidates = choice.iter_mut().flat_map(|c| c.candidates.iter_mut());
     if let Some(kept) = candidates.min_by_key(|c| c.bytes) {

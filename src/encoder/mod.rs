@@ -137,17 +137,19 @@ pub fn encode_with_progress(
 ) -> Result<Encoded> {
     opts.check(mesh)?;
     if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
-        return segment_runs::encode(mesh, opts, length, progress);
+        return segment_runs::encode_reusing(mesh, opts, length, progress, None);
     }
-    encode_clip(mesh, opts, progress, Keep::Whole)
+    encode_clip(mesh, opts, progress, Keep::Whole, None)
 }
 
-/// Encodes `mesh` as one clip (its options checked), keeping of the stream what `keep` says.
+/// Encodes `mesh` as one clip (its options checked), keeping of the stream what `keep` says, on
+/// what `reuse` holds when its options fix the motion model and first-frame precision.
 fn encode_clip(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
     progress: &dyn Progress,
     keep: Keep,
+    reuse: Option<&Reuse>,
 ) -> Result<Encoded> {
     let plan = opts.plan(mesh.bbox_diagonal())?;
     let trials = opts.codec.codec().cheap_exact_trials();
@@ -156,10 +158,56 @@ fn encode_clip(
         plan: &plan,
         keep,
     };
+    let fixed = opts.motion_models().len() == 1 && opts.first_frame_bits.is_some();
+    if let Some(reuse) = reuse.filter(|_| fixed) {
+        let known = (reuse.partition.clone(), reuse.segmentation.clone());
+        return encode_once(mesh, settings, progress, Some(known), Some(&reuse.atlas));
+    }
     match opts.first_frame_bits {
         None if trials => first_frame_bits::choose(mesh, settings, progress),
-        _ => encode_once(mesh, settings, progress, None),
+        _ => encode_once(mesh, settings, progress, None, None),
     }
+}
+
+/// What a later encoding of the same animation, first-frame precision and motion model takes
+/// from an earlier one instead of finding it again: its partition (and segmentation report) and
+/// its atlas (picture codecs), which no quality changes. A budget search's encodes differ in
+/// their quality alone.
+pub(crate) struct Reuse {
+    partition: Partition,
+    segmentation: SegmentationReport,
+    atlas: AtlasCache,
+}
+
+impl Reuse {
+    /// Takes what `encoded` found (its atlas moves out of it).
+    pub(crate) fn take(encoded: &mut Encoded) -> Self {
+        Self {
+            partition: encoded.partition.clone(),
+            segmentation: encoded.report.segmentation.clone(),
+            atlas: encoded
+                .atlas
+                .take()
+                .map_or_else(AtlasCache::default, AtlasCache::holding),
+        }
+    }
+}
+
+/// [`encode_with_progress`] on what an earlier encoding `reuse` holds, of the same animation
+/// with the same motion model and first-frame precision (fixed by `opts`, or else `reuse` is
+/// ignored): the same stream without segmenting and flattening the charts again (a segmented
+/// encoding's analysis clip is the one that reuses them).
+pub(crate) fn encode_reusing(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    progress: &dyn Progress,
+    reuse: &Reuse,
+) -> Result<Encoded> {
+    opts.check(mesh)?;
+    if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
+        return segment_runs::encode_reusing(mesh, opts, length, progress, Some(reuse));
+    }
+    encode_clip(mesh, opts, progress, Keep::Whole, Some(reuse))
 }
 
 /// What the caller reads of an encoding's stream.
@@ -197,12 +245,14 @@ impl<'a> Settings<'a> {
 }
 
 /// Encodes an animation at one first-frame precision (the default if `opts` leaves it open); a
-/// single motion model's segmentation is `known` when a trial before found it.
+/// single motion model's segmentation is `known` when a trial before found it, and its `atlas`
+/// when an encoding before built it.
 fn encode_once(
     mesh: &AnimatedMesh,
     settings: Settings,
     progress: &dyn Progress,
     known: Option<(Partition, SegmentationReport)>,
+    atlas: Option<&AtlasCache>,
 ) -> Result<Encoded> {
     let mut clock = Stopwatch::new();
     progress.stage("first frame");
@@ -216,15 +266,11 @@ fn encode_once(
     };
     progress.total(mesh.frame_count() as u64);
     let once = Once::analyse(mesh, &ff, settings, model, known, &mut clock)?;
-    code(
-        mesh,
-        &ff,
-        leading,
-        settings,
-        &once.analysed(),
-        progress,
-        clock,
-    )
+    let analysed = Analysed {
+        atlas,
+        ..once.analysed()
+    };
+    code(mesh, &ff, leading, settings, &analysed, progress, clock)
 }
 
 /// With [`Keep::SharedParts`], the first frame of `mesh` alone and its prediction: the stream's

@@ -4,7 +4,7 @@
 //! side by side on rayon's threads.
 
 use super::segments::{CodedSegment, SegmentedEncoder};
-use super::{EncodeOptions, Encoded};
+use super::{EncodeOptions, Encoded, Reuse};
 use crate::error::Result;
 use crate::mesh::{AnimatedMesh, FrameSource, Point};
 use crate::progress::Progress;
@@ -51,16 +51,18 @@ fn spread_clip(
         .map(|mesh| mesh.with_frame_rate(first.frame_rate()))
 }
 
-/// Encodes `mesh` in segments of `length` frames.
-pub fn encode(
+/// Encodes `mesh` in segments of `length` frames, its analysis clip on what `reuse` holds (see
+/// [`super::encode_reusing`]).
+pub(crate) fn encode_reusing(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
     length: usize,
     progress: &dyn Progress,
+    reuse: Option<&Reuse>,
 ) -> Result<Encoded> {
     let frames = mesh.frame_count();
     let read = |list: &[usize], _| Ok(list.iter().map(|&f| mesh.frame(f).to_vec()).collect());
-    encode_runs(mesh, frames, length, opts, progress, read)
+    encode_runs(mesh, frames, length, (opts, reuse), progress, read)
 }
 
 /// Encodes the animation `source` reads, in segments when it is longer than the options' segment
@@ -77,7 +79,7 @@ pub fn encode_source(
         _ => return super::encode_with_progress(&source.clip(0..frames)?, opts, progress),
     };
     let first = source.first().clone();
-    encode_runs(&first, frames, length, opts, progress, |list, again| {
+    encode_runs(&first, frames, length, (opts, None), progress, |list, again| {
         match again {
             ReadAgain::Yes => source.read_list_keeping(list),
             ReadAgain::No => source.read_list(list),
@@ -100,13 +102,13 @@ fn encode_runs(
     first: &AnimatedMesh,
     frames: usize,
     length: usize,
-    opts: &EncodeOptions,
+    (opts, reuse): (&EncodeOptions, Option<&Reuse>),
     progress: &dyn Progress,
     mut read: impl FnMut(&[usize], ReadAgain) -> Result<Vec<Vec<Point>>>,
 ) -> Result<Encoded> {
     let analysis = spread_clip(first, frames, length, |list| read(list, ReadAgain::Yes))?;
     progress.total(frames as u64);
-    let mut encoder = SegmentedEncoder::start(&analysis, opts, length, progress)?;
+    let mut encoder = SegmentedEncoder::start_reusing(&analysis, opts, length, progress, reuse)?;
     drop(analysis);
     progress.stage("segments");
     let ranges = segment_ranges(frames, length);

@@ -233,6 +233,18 @@ impl SegmentedEncoder {
         length: usize,
         progress: &dyn Progress,
     ) -> Result<Self> {
+        Self::start_reusing(analysis, opts, length, progress, None)
+    }
+
+    /// [`Self::start`], the analysis clip coded on what `reuse` holds (see
+    /// [`super::encode_reusing`]).
+    pub(crate) fn start_reusing(
+        analysis: &AnimatedMesh,
+        opts: &EncodeOptions,
+        length: usize,
+        progress: &dyn Progress,
+        reuse: Option<&super::Reuse>,
+    ) -> Result<Self> {
         if length == 0 || analysis.frame_count() > length {
             return Err(Error::option(
                 "segment_frames",
@@ -249,7 +261,8 @@ impl SegmentedEncoder {
         };
         whole.check(analysis)?;
         let keep = super::Keep::SharedParts;
-        let mut encoded = super::encode_clip(analysis, &whole, &NoTotal(progress), keep)?;
+        let progress = &NoTotal(progress);
+        let mut encoded = super::encode_clip(analysis, &whole, progress, keep, reuse)?;
         // The segments' atlas is the analysis clip's (same first frame, partition and lattice
         // option; `check_shared` holds them to its lattice part): built once, not twice.
         let atlas = encoded.atlas.take().map_or_else(AtlasCache::default, AtlasCache::holding);
@@ -445,7 +458,7 @@ impl SegmentedEncoder {
             report,
             model: self.analysis.model,
             partition: self.partition,
-            atlas: None,
+            atlas: self.atlas.into_inner(),
         })
     }
 

@@ -63,6 +63,11 @@ impl AtlasCache {
         Self(std::sync::OnceLock::from(built))
     }
 
+    /// The atlas held, if one was built.
+    pub fn into_inner(self) -> Option<((u16, u16), atlas::Atlas)> {
+        self.0.into_inner()
+    }
+
     /// The cached atlas, or `build`'s result (kept for the next call).
     pub fn get_or_build(
         &self,

@@ -7,7 +7,10 @@
 
 use crate::common::{decode_all, read_media};
 use mcgv_video::codec::Codec;
-use mcgv_video::encoder::{encode_to_budget, Budget, Budgeted, EncodeOptions, Segmentation};
+use mcgv_video::encoder::{
+    encode_to_budget, Budget, Budgeted, EncodeOptions, PredictorChoice, Segmentation,
+    SegmentationChoice,
+};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, ReadOptions};
 use mcgv_video::metrics::vertex_errors;
 use mcgv_video::motion::PredictorKind;
@@ -98,6 +101,49 @@ fn av1_lands_under_a_size_and_an_error() {
     let found = encode_to_budget(&mesh, &fixed(Codec::Av1), budget).expect("within budget");
     assert_within(&mesh, &found, budget, budget.tolerance());
     assert!(found.search.encodes <= mcgv_video::encoder::MAX_BUDGET_ENCODES);
+}
+
+#[test]
+fn the_later_encodes_keep_the_first_ones_partition_and_atlas_and_make_its_streams() {
+    // The first encode chooses the model; the later ones reuse its partition and atlas (of the
+    // analysis clip when segmented) instead of finding them again. The stream kept is the one a
+    // plain encode of the model found, at the quality found, makes.
+    let mesh = cesium_man_at(12.0);
+    for segment_frames in [None, Some(8)] {
+        let opts = EncodeOptions {
+            codec: Codec::Mpeg4.into(),
+            segment_frames,
+            ..EncodeOptions::default()
+        };
+        let plain = mcgv_video::encode(&mesh, &opts).expect("encodes");
+        let budget = Budget::Bytes(plain.report.bytes * 4 / 5);
+        let found = encode_to_budget(&mesh, &opts, budget).expect("within budget");
+        assert!(found.search.encodes >= 2, "{:?}", found.search);
+        let report = &found.encoded.report;
+        let segmentation = match report.segmentation.method {
+            "kmeans" => Segmentation::KMeans,
+            _ => Segmentation::Decimation {
+                e0: mcgv_video::motion::DEFAULT_E0,
+            },
+        };
+        let quality = found.search.quality;
+        let pinned = EncodeOptions {
+            predictor: PredictorChoice::Fixed(report.header.predictor),
+            segmentation: SegmentationChoice::Fixed(segmentation),
+            clusters: report.header.requested_clusters as usize,
+            first_frame_bits: Some(report.header.first_frame_bits),
+            quality: quality.round() as u8,
+            fine_quality: (quality.fract() != 0.0).then_some(quality),
+            ..opts.clone()
+        };
+        let again = mcgv_video::encode(&mesh, &pinned).expect("encodes");
+        assert_eq!(
+            again.to_bytes(),
+            found.encoded.to_bytes(),
+            "{segment_frames:?}: {:?}",
+            found.search
+        );
+    }
 }
 
 #[test]
