@@ -197,7 +197,7 @@ pub fn encode_to_budget_with_progress(
     let reuse = Reuse::take(&mut first);
     search.record(first, start)?;
     while let Some(quality) = search.next_quality()? {
-        let encoded = encode_reusing(mesh, &at_quality(&pinned, quality), progress, &reuse)?;
+        let encoded = encode_reusing(mesh, &at_quality(&pinned, quality), progress, Some(&reuse))?;
         search.record(encoded, quality)?;
     }
     search.finish()

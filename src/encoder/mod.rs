@@ -135,11 +135,7 @@ pub fn encode_with_progress(
     opts: &EncodeOptions,
     progress: &dyn Progress,
 ) -> Result<Encoded> {
-    opts.check(mesh)?;
-    if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
-        return segment_runs::encode_reusing(mesh, opts, length, progress, None);
-    }
-    encode_clip(mesh, opts, progress, Keep::Whole, None)
+    encode_reusing(mesh, opts, progress, None)
 }
 
 /// Encodes `mesh` as one clip (its options checked), keeping of the stream what `keep` says, on
@@ -193,21 +189,21 @@ impl Reuse {
     }
 }
 
-/// [`encode_with_progress`] on what an earlier encoding `reuse` holds, of the same animation
-/// with the same motion model and first-frame precision (fixed by `opts`, or else `reuse` is
-/// ignored): the same stream without segmenting and flattening the charts again (a segmented
-/// encoding's analysis clip is the one that reuses them).
+/// [`encode_with_progress`] on what an earlier encoding `reuse` holds, if any, of the same
+/// animation with the same motion model and first-frame precision (fixed by `opts`, or else
+/// `reuse` is ignored): the same stream without segmenting and flattening the charts again (a
+/// segmented encoding's analysis clip is the one that reuses them).
 pub(crate) fn encode_reusing(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
     progress: &dyn Progress,
-    reuse: &Reuse,
+    reuse: Option<&Reuse>,
 ) -> Result<Encoded> {
     opts.check(mesh)?;
     if let Some(length) = opts.segment_frames.filter(|&n| mesh.frame_count() > n) {
-        return segment_runs::encode_reusing(mesh, opts, length, progress, Some(reuse));
+        return segment_runs::encode_reusing(mesh, opts, length, progress, reuse);
     }
-    encode_clip(mesh, opts, progress, Keep::Whole, Some(reuse))
+    encode_clip(mesh, opts, progress, Keep::Whole, reuse)
 }
 
 /// What the caller reads of an encoding's stream.
