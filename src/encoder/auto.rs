@@ -383,7 +383,7 @@ impl<'a> Job<'a> {
             atlas: Some(self.atlas),
         };
         let (bytes, encoded, error, stopped) = trial(shared, &analysed, self.may_stop, &progress)?;
-        let diagonal = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
+        let diagonal = shared.diagonal();
         let candidate = Candidate {
             predictor: model.predictor,
             segmentation: self.segmentation.0.name(),
@@ -452,6 +452,11 @@ impl Shared<'_> {
     fn trial_frames(&self) -> usize {
         self.sample
             .map_or(self.mesh.frame_count(), |s| s.frames.len())
+    }
+
+    /// The unit of the candidates' reported errors: the bounding-box diagonal (never zero).
+    pub(super) fn diagonal(&self) -> f64 {
+        self.mesh.bbox_diagonal().max(f64::MIN_POSITIVE)
     }
 }
 

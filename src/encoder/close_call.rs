@@ -86,7 +86,7 @@ pub(super) fn settle(
     let second_clock = clock.clone();
     let (first, second) = rayon::join(|| whole(best, clock), || whole(runner_up, second_clock));
     let (first, second) = (first?, second?);
-    let diagonal = shared.mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
+    let diagonal = shared.diagonal();
     for w in [&first, &second] {
         if let Some(c) = candidates.get_mut(w.at) {
             c.bytes = w.encoded.report.bytes;
