@@ -1,10 +1,51 @@
 //! Temporal prediction of a trajectory of integer levels (one stored coefficient of a cluster's
 //! affine map over the frames): the extrapolation orders the affine coder predicts with
-//! (`stream/affine_coding.rs`), and the encoder's estimate of the bits a trajectory costs, by
-//! which it picks each trajectory's order and each cluster's [`super::LinearForm`].
+//! (`stream/affine_coding.rs`), the reference cluster's innovation it may add, and the encoder's
+//! estimate of the bits a trajectory costs, by which it picks each trajectory's [`Choice`] and
+//! each cluster's [`super::LinearForm`].
+//!
+//! A trajectory's *innovation* at frame f is its level there less its own extrapolation: what its
+//! past did not foretell. Clusters of one body share much of it (the body walks, turns or jumps
+//! as a whole), so a trajectory may also add the innovation of the same coefficient of an earlier
+//! coded cluster nearby, in its own units (container version 8).
 
 /// Predictor orders a trajectory may use (1..=ORDERS).
 pub const ORDERS: usize = 3;
+
+/// Symbols of a trajectory's [`Choice`].
+pub const CHOICES: usize = 2 * ORDERS;
+
+/// How a trajectory is predicted: its extrapolation order, and whether it adds its reference
+/// cluster's innovation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Choice {
+    /// 1: the previous level, 2: linear, 3: quadratic extrapolation.
+    pub order: usize,
+    /// Whether the reference's innovation, scaled to this trajectory's step, is added.
+    pub follows: bool,
+}
+
+impl Choice {
+    /// The plain previous-level predictor.
+    pub const FIRST: Choice = Choice {
+        order: 1,
+        follows: false,
+    };
+
+    /// The coded symbol, `0..CHOICES`.
+    pub fn symbol(self) -> usize {
+        (self.order.clamp(1, ORDERS) - 1) + ORDERS * usize::from(self.follows)
+    }
+
+    /// The choice of symbol `s` (`s % CHOICES`).
+    pub fn of_symbol(s: usize) -> Self {
+        let s = s % CHOICES;
+        Choice {
+            order: 1 + s % ORDERS,
+            follows: s >= ORDERS,
+        }
+    }
+}
 
 /// The level `order` predicts from `history` (most recent last; shorter histories lower the
 /// order): 1 the previous level, 2 a linear, 3 a quadratic extrapolation.
@@ -14,8 +55,19 @@ pub fn extrapolate(order: usize, history: &[i64]) -> i64 {
     match order.min(n) {
         0 => 0,
         1 => at(1),
-        2 => 2 * at(1) - at(2),
-        _ => 3 * at(1) - 3 * at(2) + at(3),
+        2 => (2 * at(1)).wrapping_sub(at(2)),
+        _ => (3 * at(1)).wrapping_sub(3 * at(2)).wrapping_add(at(3)),
+    }
+}
+
+/// `innovation` (a reference trajectory's, in its step) in levels of a trajectory whose step is
+/// `ratio` times smaller: rounded half away from zero, saturating; IEEE-exact, so the same on
+/// every machine. Translations share one step (`ratio` 1): the innovation itself.
+pub fn scaled(innovation: i64, ratio: f64) -> i64 {
+    if ratio == 1.0 {
+        innovation
+    } else {
+        (innovation as f64 * ratio).round() as i64
     }
 }
 
@@ -24,18 +76,54 @@ fn cost(residual: i64) -> f64 {
     2.0 * (1.0 + residual.unsigned_abs() as f64).log2() + 1.0
 }
 
-/// Estimated bits of `trajectory` (its first level aside) under predictor `order`.
-fn bits_with(order: usize, trajectory: &[i64]) -> f64 {
+/// Estimated bits of `trajectory` (its first level aside) under predictor `order`, adding
+/// `reference` (already in this trajectory's levels) at each frame when given.
+fn bits_with(order: usize, trajectory: &[i64], reference: Option<&[i64]>) -> f64 {
     (1..trajectory.len())
-        .map(|f| cost(trajectory[f].wrapping_sub(extrapolate(order, &trajectory[..f]))))
+        .map(|f| {
+            let guess = extrapolate(order, &trajectory[f.saturating_sub(ORDERS)..f]);
+            let lift = reference.and_then(|r| r.get(f)).copied().unwrap_or(0);
+            cost(trajectory[f].wrapping_sub(guess.saturating_add(lift)))
+        })
         .sum()
 }
 
 /// The order (1..=ORDERS) that codes `trajectory` smallest by the estimate, and its bits.
 pub fn best_order(trajectory: &[i64]) -> (usize, f64) {
-    (1..=ORDERS)
-        .map(|order| (order, bits_with(order, trajectory)))
-        .fold((1, f64::INFINITY), |best, c| if c.1 < best.1 { c } else { best })
+    let (choice, bits) = best_choice(trajectory, None);
+    (choice.order, bits)
+}
+
+/// The [`Choice`] that codes `trajectory` smallest by the estimate, and its bits; `reference` is
+/// the reference cluster's innovation in this trajectory's levels, if it has one. Ties keep the
+/// lower order, and not following.
+pub fn best_choice(trajectory: &[i64], reference: Option<&[i64]>) -> (Choice, f64) {
+    let follows: &[bool] = if reference.is_some() {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    let mut best = (Choice::FIRST, f64::INFINITY);
+    for &follows in follows {
+        for order in 1..=ORDERS {
+            let bits = bits_with(order, trajectory, reference.filter(|_| follows));
+            if bits < best.1 {
+                best = (Choice { order, follows }, bits);
+            }
+        }
+    }
+    best
+}
+
+/// The innovation of `trajectory` under `order` at every frame (0 at the first).
+pub fn innovations(order: usize, trajectory: &[i64]) -> Vec<i64> {
+    (0..trajectory.len())
+        .map(|f| match f {
+            0 => 0,
+            _ => trajectory[f]
+                .wrapping_sub(extrapolate(order, &trajectory[f.saturating_sub(ORDERS)..f])),
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -54,5 +142,29 @@ mod tests {
         assert_eq!(extrapolate(3, &square[..1]), 0);
         assert_eq!(best_order(&[0, 1, 4, 9, 16, 25, 36]).0, 3);
         assert_eq!(best_order(&[4, 4, 4, 4]), (1, 3.0));
+    }
+
+    #[test]
+    fn a_trajectory_that_moves_as_its_reference_follows_it() {
+        // A jerky common motion, and a trajectory that is that motion plus a steady drift.
+        let common = [0i64, 5, 3, 11, 2, 9, 14, 1, 7];
+        let own: Vec<i64> = common.iter().enumerate().map(|(f, c)| c + 2 * f as i64).collect();
+        let reference = innovations(1, &common);
+        assert_eq!(reference[0], 0);
+        assert_eq!(reference[3], 8);
+        let (choice, bits) = best_choice(&own, Some(&reference));
+        assert!(choice.follows, "{choice:?}");
+        assert!(bits < best_choice(&own, None).1);
+        // Without a reference, or one that does not help, it does not follow.
+        assert!(!best_choice(&own, None).0.follows);
+        let (still, _) = best_choice(&[4, 4, 4, 4], Some(&[0, 9, -9, 9]));
+        assert_eq!(still, Choice::FIRST);
+        for s in 0..CHOICES {
+            assert_eq!(Choice::of_symbol(s).symbol(), s);
+        }
+        assert_eq!(scaled(-7, 1.0), -7);
+        assert_eq!(scaled(5, 0.5), 3);
+        assert_eq!(scaled(-5, 0.5), -3);
+        assert_eq!(scaled(i64::MAX, 4.0), i64::MAX);
     }
 }

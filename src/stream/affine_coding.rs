@@ -3,11 +3,15 @@
 //! residual of a temporal predictor.
 //!
 //! Each cluster starts with its [`LinearForm`] (entries, or rotation and stretch), one adaptive
-//! symbol. Per trajectory the encoder picks the predictor order that codes smallest (1: the
-//! previous level, 2: linear extrapolation, 3: quadratic), one adaptive symbol; the first frame is
+//! symbol. Per trajectory the encoder picks a choice (`motion/trajectory.rs`), one adaptive
+//! symbol: the predictor order that codes smallest (1: the previous level, 2: linear
+//! extrapolation, 3: quadratic), and whether the prediction adds the *innovation* (level less its
+//! own extrapolation) of the same coefficient of the trajectory's reference cluster: the nearest
+//! earlier-coded cluster (by centroid on the decoded frame 0; for the linear part, the nearest of
+//! the same form), scaled to this cluster's step (container version 8). The first frame is
 //! predicted by the identity map (frame 0 is fitted from the decoded frame 0 itself). Residuals go
-//! through adaptive integer models chosen by the coefficient's kind (entry, rotation, stretch
-//! or translation) and the size of the trajectory's previous residual, which tracks how busy the
+//! through adaptive integer models chosen by the coefficient's kind (entry, rotation, stretch or
+//! translation) and the size of the trajectory's previous residual, which tracks how busy the
 //! motion is.
 //!
 //! The extrapolation codes smaller than a temporal DCT of each trajectory
@@ -16,7 +20,9 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::Point;
-use crate::motion::trajectory::{best_order, extrapolate, ORDERS};
+use crate::motion::trajectory::{
+    best_choice, extrapolate, innovations, scaled, Choice, CHOICES, ORDERS,
+};
 use crate::motion::{
     identity_levels, AffineTrack, ClusterGeometry, LinearForm, Partition, QuantisedAffine,
     MAX_AFFINE_LEVEL,
@@ -68,7 +74,7 @@ impl Kind {
 /// The adaptive models of the traversal: the clusters' forms, and per coefficient [`Kind`].
 struct Models {
     form: SymbolModel,
-    order: [SymbolModel; KINDS],
+    choice: [SymbolModel; KINDS],
     first: [IntModel; KINDS],
     residual: [[IntModel; MAGNITUDES]; KINDS],
 }
@@ -77,48 +83,84 @@ impl Models {
     fn new() -> Self {
         Self {
             form: SymbolModel::new(LinearForm::ALL.len()),
-            order: std::array::from_fn(|_| SymbolModel::new(ORDERS)),
+            choice: std::array::from_fn(|_| SymbolModel::new(CHOICES)),
             first: Default::default(),
             residual: Default::default(),
         }
     }
 }
 
+/// Each cluster's reference clusters, by the decoded frame 0's centroids: for its translations,
+/// the nearest earlier cluster; for its linear part, the nearest earlier one of the same form
+/// (their numbers mean the same only then). Ties go to the lower number.
+struct References<'a> {
+    geometry: &'a ClusterGeometry,
+}
+
+impl References<'_> {
+    /// Cluster `k`'s reference for coefficient `coeff`, given the earlier clusters' forms.
+    fn of(&self, k: usize, coeff: usize, forms: &[LinearForm]) -> Option<usize> {
+        let here = self.geometry.centroid(k);
+        let distance = |j: usize| {
+            let c = self.geometry.centroid(j);
+            (0..3).map(|a| (c[a] - here[a]) * (c[a] - here[a])).sum::<f64>()
+        };
+        let mut best: Option<(usize, f64)> = None;
+        for j in 0..k {
+            if Kind::of(coeff, forms[k]) != Kind::Translation && forms[j] != forms[k] {
+                continue;
+            }
+            let d = distance(j);
+            if best.is_none_or(|(_, b)| d < b) {
+                best = Some((j, d));
+            }
+        }
+        best.map(|(j, _)| j)
+    }
+}
+
 /// Codes the levels cluster by cluster (its [`LinearForm`] first), coefficient by coefficient,
-/// each trajectory over all frames; `orders[k * 12 + c]` is trajectory (k, c)'s predictor order
-/// and `q.forms[k]` cluster k's form (both filled when decoding). With `q.values` empty, a
+/// each trajectory over all frames; `choices[k * 12 + c]` is trajectory (k, c)'s [`Choice`] and
+/// `q.forms[k]` cluster k's form (both filled when decoding). With `q.values` empty, a
 /// decoder reads every level and keeps none: a dry run that checks the part (its end word
 /// included) in constant memory before its levels are given room.
 fn code_trajectories<C: SymbolCoder>(
     c: &mut C,
     q: &mut QuantisedAffine,
-    orders: &mut [usize],
+    choices: &mut [Choice],
     geometry: &ClusterGeometry,
 ) -> Result<()> {
     let mut models = Models::new();
     let (frames, clusters) = (q.frames, q.clusters);
     if geometry.centroids.len() != clusters
         || q.forms.len() != clusters
-        || orders.len() != clusters * 12
+        || choices.len() != clusters * 12
     {
         return Err(Error::Stream(format!(
             "affine coefficients: {clusters} clusters, the partition has {}",
             geometry.centroids.len()
         )));
     }
+    let references = References { geometry };
+    let step = f64::from(q.step);
     for k in 0..clusters {
         let form = LinearForm::ALL[c.symbol(q.forms[k] as usize, &mut models.form)?];
         q.forms[k] = form;
-        let steps = geometry.steps(k, f64::from(q.step), form);
+        let steps = geometry.steps(k, step, form);
         let identity = identity_levels(geometry.centroid(k), &steps, form);
         for (coeff, &first) in identity.iter().enumerate() {
+            let reference = references.of(k, coeff, &q.forms).map(|j| {
+                let theirs = geometry.steps(j, step, q.forms[j])[coeff];
+                (j, theirs / steps[coeff])
+            });
             let trajectory = Trajectory {
                 cluster: k,
                 coeff,
                 first,
                 kind: Kind::of(coeff, form),
+                reference,
             };
-            code_trajectory(c, q, &mut orders[k * 12 + coeff], &trajectory, &mut models)?;
+            code_trajectory(c, q, choices, &trajectory, &mut models)?;
         }
     }
     if c.raw_bits(u64::from(AFFINE_END), 32)? != u64::from(AFFINE_END) {
@@ -130,45 +172,98 @@ fn code_trajectories<C: SymbolCoder>(
     Ok(())
 }
 
-/// One coefficient's trajectory: where it is, and its identity level (frame 0's prediction).
+/// One coefficient's trajectory: where it is, its identity level (frame 0's prediction), and its
+/// reference cluster with the ratio of that cluster's step to its own.
 struct Trajectory {
     cluster: usize,
     coeff: usize,
     first: i64,
     kind: Kind,
+    reference: Option<(usize, f64)>,
 }
 
-/// Codes `t`'s predictor order, then its level at every frame as the residual of the prediction.
+/// Trajectory (`cluster`, `coeff`)'s innovation at frame `f` under `order`: its level less its
+/// extrapolation from the levels before (0 at the first frame), from levels already coded.
+fn innovation(q: &QuantisedAffine, cluster: usize, coeff: usize, order: usize, f: usize) -> i64 {
+    let at = |g: usize| {
+        q.values
+            .get((g * q.clusters + cluster) * 12 + coeff)
+            .copied()
+            .unwrap_or(0)
+    };
+    if f == 0 {
+        return 0;
+    }
+    let from = f.saturating_sub(ORDERS);
+    let mut history = [0i64; ORDERS];
+    for (slot, g) in history.iter_mut().zip(from..f) {
+        *slot = at(g);
+    }
+    at(f).wrapping_sub(extrapolate(order, &history[..f - from]))
+}
+
+/// Codes `t`'s choice (`choices[cluster * 12 + coeff]`), then its level at every frame as the
+/// residual of the prediction. With the levels kept (`q.values` not empty) a trajectory that
+/// follows its reference adds the reference's innovation, recomputed from the reference's levels
+/// and choice; a dry run reads the same symbols.
 fn code_trajectory<C: SymbolCoder>(
     c: &mut C,
     q: &mut QuantisedAffine,
-    order: &mut usize,
+    choices: &mut [Choice],
     t: &Trajectory,
     models: &mut Models,
 ) -> Result<()> {
     let (frames, clusters, kind) = (q.frames, q.clusters, t.kind as usize);
-    *order = 1 + c.symbol(*order - 1, &mut models.order[kind])?;
+    let slot = t.cluster * 12 + t.coeff;
+    let coded = c.symbol(choices[slot].symbol(), &mut models.choice[kind])?;
+    let choice = Choice::of_symbol(coded);
+    choices[slot] = choice;
+    let reference = match (choice.follows, t.reference) {
+        (false, _) => None,
+        (true, Some((j, ratio))) => Some((j, choices[j * 12 + t.coeff].order, ratio)),
+        (true, None) => {
+            return Err(Error::Stream(format!(
+                "affine coefficients: cluster {}, coefficient {} follows a reference cluster it \
+                 does not have",
+                t.cluster, t.coeff
+            )))
+        }
+    };
+    let keep = !q.values.is_empty();
     // The last ORDERS levels, oldest first: all that `extrapolate` looks back at.
     let mut history = [0i64; ORDERS];
     let mut class = 0;
     for f in 0..frames {
         let i = (f * clusters + t.cluster) * 12 + t.coeff;
-        let (guess, model) = match f {
+        let (own, model) = match f {
             0 => (t.first, &mut models.first[kind]),
             _ => (
-                extrapolate(*order, &history[ORDERS - f.min(ORDERS)..]),
+                extrapolate(choice.order, &history[ORDERS - f.min(ORDERS)..]),
                 &mut models.residual[kind][class],
             ),
         };
+        let lift = match reference {
+            Some((j, order, ratio)) if f > 0 && keep => {
+                scaled(innovation(q, j, t.coeff, order, f), ratio)
+            }
+            _ => 0,
+        };
+        let guess = own.saturating_add(lift);
         let target = q.values.get(i).copied().unwrap_or(guess);
         let r = c.signed(target.wrapping_sub(guess), model)?;
         let value = guess.checked_add(r).filter(|v| v.abs() <= MAX_AFFINE_LEVEL);
-        let Some(value) = value else {
-            return Err(Error::Stream(format!(
-                "affine coefficients: level of cluster {}, coefficient {}, frame {f} is beyond \
-                 ±2^40",
-                t.cluster, t.coeff
-            )));
+        let value = match (value, keep) {
+            (Some(v), _) => v,
+            // A dry run does not know the references' innovations, so its levels are not the
+            // real ones: only the real read checks their range.
+            (None, false) => 0,
+            (None, true) => {
+                return Err(Error::Stream(format!(
+                    "affine coefficients: level of cluster {}, coefficient {}, frame {f} is \
+                     beyond ±2^40",
+                    t.cluster, t.coeff
+                )))
+            }
         };
         if let Some(slot) = q.values.get_mut(i) {
             *slot = value;
@@ -180,23 +275,44 @@ fn code_trajectory<C: SymbolCoder>(
     Ok(())
 }
 
+/// Each trajectory's [`Choice`] by the estimate, cluster by cluster as the coder goes: a
+/// trajectory's reference innovations are those of the choices already made.
+fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
+    let (frames, clusters) = (q.frames, q.clusters);
+    let references = References { geometry };
+    let step = f64::from(q.step);
+    let mut choices = vec![Choice::FIRST; clusters * 12];
+    // innovation[k * 12 + c]: trajectory (k, c)'s, over the frames.
+    let mut innovation: Vec<Vec<i64>> = vec![Vec::new(); clusters * 12];
+    for k in 0..clusters {
+        let steps = geometry.steps(k, step, q.forms[k]);
+        for coeff in 0..12 {
+            let levels: Vec<i64> = (0..frames)
+                .map(|f| q.values[(f * clusters + k) * 12 + coeff])
+                .collect();
+            let lift: Option<Vec<i64>> = references.of(k, coeff, &q.forms).map(|j| {
+                let ratio = geometry.steps(j, step, q.forms[j])[coeff] / steps[coeff];
+                innovation[j * 12 + coeff]
+                    .iter()
+                    .map(|&x| scaled(x, ratio))
+                    .collect()
+            });
+            let (choice, _) = best_choice(&levels, lift.as_deref());
+            choices[k * 12 + coeff] = choice;
+            innovation[k * 12 + coeff] = innovations(choice.order, &levels);
+        }
+    }
+    choices
+}
+
 /// Codes the affine track: its base step, then the level trajectories.
 pub fn encode_affine(track: &AffineTrack) -> Result<Vec<u8>> {
     let mut q = track.quantised().clone();
-    let (frames, clusters) = (q.frames, q.clusters);
-    let mut orders: Vec<usize> = (0..clusters * 12)
-        .map(|slot| {
-            let (k, coeff) = (slot / 12, slot % 12);
-            let trajectory: Vec<i64> = (0..frames)
-                .map(|f| q.values[(f * clusters + k) * 12 + coeff])
-                .collect();
-            best_order(&trajectory).0
-        })
-        .collect();
+    let mut choices = choose(&q, track.geometry());
     let mut w = ByteWriter::new();
     w.f32(q.step);
     let mut enc = Encoder::new();
-    code_trajectories(&mut enc, &mut q, &mut orders, track.geometry())?;
+    code_trajectories(&mut enc, &mut q, &mut choices, track.geometry())?;
     w.raw(&enc.finish()?);
     Ok(w.into_bytes())
 }
@@ -288,8 +404,8 @@ impl<'a> AffinePart<'a> {
 
     /// Reads every level and the end word, keeping the levels where `q.values` has room.
     fn read(&mut self) -> Result<()> {
-        let mut orders = vec![1usize; self.q.clusters * 12];
+        let mut choices = vec![Choice::FIRST; self.q.clusters * 12];
         let mut dec = Decoder::new(self.coded)?;
-        code_trajectories(&mut dec, &mut self.q, &mut orders, &self.geometry)
+        code_trajectories(&mut dec, &mut self.q, &mut choices, &self.geometry)
     }
 }
