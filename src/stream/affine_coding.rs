@@ -90,32 +90,53 @@ impl Models {
     }
 }
 
+/// Earlier clusters searched for a reference: a window, so that the search stays linear in the
+/// clusters (a forged or a huge partition must not cost their square); the nearest of any
+/// cluster's 256 predecessors is nearly always near enough.
+const REFERENCE_WINDOW: usize = 256;
+
 /// Each cluster's reference clusters, by the decoded frame 0's centroids: for its translations,
-/// the nearest earlier cluster; for its linear part, the nearest earlier one of the same form
-/// (their numbers mean the same only then). Ties go to the lower number.
-struct References<'a> {
-    geometry: &'a ClusterGeometry,
+/// the nearest of the earlier clusters (the last [`REFERENCE_WINDOW`]); for its linear part, the
+/// nearest of those of the same form (their numbers mean the same only then). Ties go to the
+/// lower number.
+#[derive(Clone, Copy)]
+struct References {
+    translation: Option<usize>,
+    linear: Option<usize>,
 }
 
-impl References<'_> {
-    /// Cluster `k`'s reference for coefficient `coeff`, given the earlier clusters' forms.
-    fn of(&self, k: usize, coeff: usize, forms: &[LinearForm]) -> Option<usize> {
-        let here = self.geometry.centroid(k);
+impl References {
+    /// Cluster `k`'s, given the forms of clusters `0..=k`.
+    fn of(geometry: &ClusterGeometry, k: usize, forms: &[LinearForm]) -> Self {
+        let here = geometry.centroid(k);
         let distance = |j: usize| {
-            let c = self.geometry.centroid(j);
+            let c = geometry.centroid(j);
             (0..3).map(|a| (c[a] - here[a]) * (c[a] - here[a])).sum::<f64>()
         };
-        let mut best: Option<(usize, f64)> = None;
-        for j in 0..k {
-            if Kind::of(coeff, forms[k]) != Kind::Translation && forms[j] != forms[k] {
-                continue;
-            }
+        // (cluster, squared distance) of the nearest so far.
+        let mut translation: Option<(usize, f64)> = None;
+        let mut linear: Option<(usize, f64)> = None;
+        for j in k.saturating_sub(REFERENCE_WINDOW)..k {
             let d = distance(j);
-            if best.is_none_or(|(_, b)| d < b) {
-                best = Some((j, d));
+            if translation.is_none_or(|(_, b)| d < b) {
+                translation = Some((j, d));
+            }
+            if forms.get(j) == forms.get(k) && linear.is_none_or(|(_, b)| d < b) {
+                linear = Some((j, d));
             }
         }
-        best.map(|(j, _)| j)
+        Self {
+            translation: translation.map(|(j, _)| j),
+            linear: linear.map(|(j, _)| j),
+        }
+    }
+
+    /// The reference of stored coefficient `coeff` of a cluster in `form`.
+    fn for_coeff(self, coeff: usize, form: LinearForm) -> Option<usize> {
+        match Kind::of(coeff, form) {
+            Kind::Translation => self.translation,
+            _ => self.linear,
+        }
     }
 }
 
@@ -141,15 +162,15 @@ fn code_trajectories<C: SymbolCoder>(
             geometry.centroids.len()
         )));
     }
-    let references = References { geometry };
     let step = f64::from(q.step);
     for k in 0..clusters {
         let form = LinearForm::ALL[c.symbol(q.forms[k] as usize, &mut models.form)?];
         q.forms[k] = form;
         let steps = geometry.steps(k, step, form);
         let identity = identity_levels(geometry.centroid(k), &steps, form);
+        let references = References::of(geometry, k, &q.forms);
         for (coeff, &first) in identity.iter().enumerate() {
-            let reference = references.of(k, coeff, &q.forms).map(|j| {
+            let reference = references.for_coeff(coeff, form).map(|j| {
                 let theirs = geometry.steps(j, step, q.forms[j])[coeff];
                 (j, theirs / steps[coeff])
             });
@@ -279,18 +300,18 @@ fn code_trajectory<C: SymbolCoder>(
 /// trajectory's reference innovations are those of the choices already made.
 fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
     let (frames, clusters) = (q.frames, q.clusters);
-    let references = References { geometry };
     let step = f64::from(q.step);
     let mut choices = vec![Choice::FIRST; clusters * 12];
     // innovation[k * 12 + c]: trajectory (k, c)'s, over the frames.
     let mut innovation: Vec<Vec<i64>> = vec![Vec::new(); clusters * 12];
     for k in 0..clusters {
         let steps = geometry.steps(k, step, q.forms[k]);
+        let references = References::of(geometry, k, &q.forms);
         for coeff in 0..12 {
             let levels: Vec<i64> = (0..frames)
                 .map(|f| q.values[(f * clusters + k) * 12 + coeff])
                 .collect();
-            let lift: Option<Vec<i64>> = references.of(k, coeff, &q.forms).map(|j| {
+            let lift: Option<Vec<i64>> = references.for_coeff(coeff, q.forms[k]).map(|j| {
                 let ratio = geometry.steps(j, step, q.forms[j])[coeff] / steps[coeff];
                 innovation[j * 12 + coeff]
                     .iter()
