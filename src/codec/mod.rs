@@ -450,17 +450,33 @@ mod tests {
             }
             config.plan(&rate(None), 1.0).unwrap().affine_precision
         };
-        // In sixteenths: 4 = 1/4, 3 = 3/16, 1 = 1/16.
+        // In sixteenths: 4 = 1/4, 3 = 3/16, 2 = 1/8, 1 = 1/16.
         for (codec, gop, expected) in [
             (Codec::Tdct, 50, 3),
             (Codec::Jpeg, 50, 4),
             (Codec::Hevc, 1, 4),
             (Codec::Hevc, 50, 4),
             (Codec::Av1, 1, 4),
-            (Codec::Av1, 50, 1),
-            (Codec::Mpeg4, 50, 1),
+            (Codec::Av1, 50, 2),
+            (Codec::Mpeg4, 50, 2),
+            (Codec::Mpeg4, 1, 1),
         ] {
             assert_eq!(code(codec, gop), expected, "{codec:?} gop {gop}");
+        }
+        // P-frame groups take finer maps from quality 85, where their noise costs more.
+        for (quality, expected) in [(84, 2), (85, 1), (97, 1)] {
+            let plan = Codec::Av1.default_config().plan(
+                &Rate {
+                    quality,
+                    ..rate(None)
+                },
+                1.0,
+            );
+            assert_eq!(
+                plan.unwrap().affine_precision,
+                expected,
+                "quality {quality}"
+            );
         }
         let asked = Codec::Av1.default_config().plan(&rate(Some(0.5)), 1.0);
         assert_eq!(asked.unwrap().affine_precision, 8);

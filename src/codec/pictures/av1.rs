@@ -28,12 +28,12 @@ pub(crate) fn check(config: &DeepConfig) -> Result<()> {
 }
 
 /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: [`av1_law`]; affine
-/// maps at a quarter of the residual step all-intra, at 1/16 in P-frame groups, whose prediction
-/// coarser maps spoil (docs/design.md, "Affine precision per codec").
+/// maps at a quarter of the residual step all-intra, finer in P-frame groups, whose prediction
+/// coarser maps spoil ([`Rate::p_frame_affine_precision`]).
 pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
     let affine_precision = match config.gop {
         1 => DEFAULT_AFFINE_PRECISION,
-        _ => 1.0 / 16.0,
+        _ => rate.p_frame_affine_precision(),
     };
     let law = (av1_law_at as fn(f64, u8) -> PictureLaw, affine_precision);
     config.plan(Codec::Av1, law, rate, diagonal)
@@ -279,20 +279,22 @@ mod tests {
 
     #[test]
     fn affine_maps_are_finer_in_p_frame_groups_only() {
-        let rate = Rate {
-            quality: 50,
-            fine_quality: None,
-            step: None,
-            affine_precision: None,
-        };
-        let code = |gop| {
+        let code = |gop, quality| {
+            let rate = Rate {
+                quality,
+                fine_quality: None,
+                step: None,
+                affine_precision: None,
+            };
             let config = DeepConfig {
                 gop,
                 ..DeepConfig::default()
             };
             plan(&config, &rate, 1.0).unwrap().affine_precision
         };
-        assert_eq!((code(1), code(50)), (4, 1));
+        // In sixteenths: a quarter all-intra; 1/8 in P-frame groups, 1/16 from quality 85.
+        assert_eq!((code(1, 50), code(50, 50)), (4, 2));
+        assert_eq!((code(1, 90), code(50, 90)), (4, 1));
     }
 }
 

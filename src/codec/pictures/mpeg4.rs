@@ -53,8 +53,8 @@ impl Mpeg4Config {
     }
 
     /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: the law's pixel
-    /// step and qscale, ranges per group, `biharmonic` padding, affine maps at 1/16 of the
-    /// residual step (coarser maps' quantisation noise spoils P-frame prediction).
+    /// step and qscale, ranges per group, `biharmonic` padding, affine maps at the P-frame
+    /// precision ([`Rate::p_frame_affine_precision`]; 1/16 all-intra, as always, unmeasured).
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
         let law = read_law(&MPEG4_LAW, rate.level());
         let resolved = Resolved {
@@ -64,7 +64,10 @@ impl Mpeg4Config {
             gop: self.gop,
             depth: 8,
             padding: padding::Method::Biharmonic,
-            affine_precision: 1.0 / 16.0,
+            affine_precision: match self.gop {
+                1 => 1.0 / 16.0,
+                _ => rate.p_frame_affine_precision(),
+            },
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }
