@@ -457,15 +457,15 @@ mod tests {
             (Codec::Hevc, 1, 4),
             (Codec::Hevc, 50, 4),
             (Codec::Av1, 1, 4),
-            (Codec::Av1, 50, 2),
+            (Codec::Av1, 50, 1),
             (Codec::Mpeg4, 50, 2),
             (Codec::Mpeg4, 1, 1),
         ] {
             assert_eq!(code(codec, gop), expected, "{codec:?} gop {gop}");
         }
-        // P-frame groups take finer maps from quality 85, where their noise costs more.
+        // MPEG-4's P-frame groups take finer maps from quality 85, where their noise costs more.
         for (quality, expected) in [(84, 2), (85, 1), (97, 1)] {
-            let plan = Codec::Av1.default_config().plan(
+            let plan = Codec::Mpeg4.default_config().plan(
                 &Rate {
                     quality,
                     ..rate(None)

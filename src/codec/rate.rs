@@ -56,24 +56,7 @@ pub fn target_step(quality: u8, diagonal: f64) -> f64 {
     diagonal * 1e-3 * f64::from(s) / 100.0
 }
 
-/// The residual step (a fraction of the diagonal) at and below which P-frame groups take their
-/// affine maps at 1/16 of the step instead of 1/8: between quality 84 (3.2e-4) and 85 (3e-4).
-const FINE_P_FRAME_STEP: f64 = 3.1e-4;
-
 impl Rate {
-    /// The affine precision of P-frame groups (MPEG-4, AV1): 1/8 of the residual step, 1/16 from
-    /// quality 85 (or an explicit step that fine), where the maps' white quantisation noise
-    /// spoils the prediction between frames more than finer maps cost (docs/design.md, "Affine
-    /// precision per codec").
-    pub fn p_frame_affine_precision(&self) -> f64 {
-        let fraction = self.step.unwrap_or_else(|| self.target_step(1.0));
-        if fraction > FINE_P_FRAME_STEP {
-            1.0 / 8.0
-        } else {
-            1.0 / 16.0
-        }
-    }
-
     /// The quality every law reads: the fine one when given.
     pub fn level(&self) -> f64 {
         self.fine_quality.unwrap_or(f64::from(self.quality))
