@@ -202,7 +202,7 @@ pub struct EncodeArgs {
     pub e0: Option<f64>,
     /// The affine coefficients' quantiser step as a multiple of the residual step (whose size
     /// --quality or --step sets): smaller = finer maps, more side information (1/16..15.9;
-    /// default 3/16 for tdct, 0.25 for jpeg, hevc and all-intra av1, 1/16 for av1 with --gop
+    /// default 3/16 for tdct, jpeg and hevc, 0.25 for all-intra av1, 1/16 for av1 with --gop
     /// above 1, whose P-frames suffer from coarser maps; for mpeg4 1/8 below quality 85, 1/16
     /// from there and all-intra).
     #[arg(long)]

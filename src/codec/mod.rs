@@ -453,9 +453,9 @@ mod tests {
         // In sixteenths: 4 = 1/4, 3 = 3/16, 2 = 1/8, 1 = 1/16.
         for (codec, gop, expected) in [
             (Codec::Tdct, 50, 3),
-            (Codec::Jpeg, 50, 4),
-            (Codec::Hevc, 1, 4),
-            (Codec::Hevc, 50, 4),
+            (Codec::Jpeg, 50, 3),
+            (Codec::Hevc, 1, 3),
+            (Codec::Hevc, 50, 3),
             (Codec::Av1, 1, 4),
             (Codec::Av1, 50, 1),
             (Codec::Mpeg4, 50, 2),

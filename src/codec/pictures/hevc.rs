@@ -22,7 +22,7 @@ use super::deep::DeepConfig;
 use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::Result;
-use crate::motion::DEFAULT_AFFINE_PRECISION;
+use super::AFFINE_PRECISION;
 
 #[cfg(feature = "ffmpeg")]
 pub(crate) use coder::PICTURES;
@@ -36,12 +36,12 @@ pub(crate) fn check(config: &DeepConfig) -> Result<()> {
 }
 
 /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: [`hevc_law`], affine
-/// maps at a quarter of the residual step in P-frame groups too
+/// maps at [`AFFINE_PRECISION`] of the residual step in P-frame groups too
 /// (docs/design.md, "Affine precision per codec").
 pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
     let law = (
         hevc_law_at as fn(f64, u8) -> PictureLaw,
-        DEFAULT_AFFINE_PRECISION,
+        AFFINE_PRECISION,
     );
     config.plan(Codec::Hevc, law, rate, diagonal)
 }

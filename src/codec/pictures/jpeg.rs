@@ -13,7 +13,7 @@ use super::PictureEncoder;
 use super::{PicturePlan, PictureSetup, Resolved};
 use crate::codec::rate::{anchor, read_law, Anchor, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
-use crate::motion::DEFAULT_AFFINE_PRECISION;
+use super::AFFINE_PRECISION;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::frame_index::FrameChunk;
 use crate::{Error, Result};
@@ -141,7 +141,7 @@ impl JpegConfig {
             gop: 1,
             depth: 8,
             padding: padding::Method::Snap,
-            affine_precision: DEFAULT_AFFINE_PRECISION,
+            affine_precision: AFFINE_PRECISION,
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }
