@@ -57,6 +57,12 @@ pub fn target_step(quality: u8, diagonal: f64) -> f64 {
 }
 
 impl Rate {
+    /// The residual step as a fraction of the bounding-box diagonal: the explicit one, else the
+    /// quality's.
+    pub fn step_fraction(&self) -> f64 {
+        self.step.unwrap_or_else(|| self.target_step(1.0))
+    }
+
     /// The quality every law reads: the fine one when given.
     pub fn level(&self) -> f64 {
         self.fine_quality.unwrap_or(f64::from(self.quality))
@@ -122,7 +128,7 @@ impl Rate {
         pictures: Option<PicturePlan>,
     ) -> RatePlan {
         let affine_precision = self.affine_precision_code(default_affine_precision);
-        let fraction = self.step.unwrap_or_else(|| self.target_step(1.0));
+        let fraction = self.step_fraction();
         let k = f64::from(affine_precision) / 16.0;
         RatePlan {
             quality: self.label(),

@@ -115,15 +115,14 @@ pub fn best_choice(trajectory: &[i64], reference: Option<&[i64]>) -> (Choice, f6
     best
 }
 
-/// The innovation of `trajectory` under `order` at every frame (0 at the first).
-pub fn innovations(order: usize, trajectory: &[i64]) -> Vec<i64> {
-    (0..trajectory.len())
-        .map(|f| match f {
-            0 => 0,
-            _ => trajectory[f]
-                .wrapping_sub(extrapolate(order, &trajectory[f.saturating_sub(ORDERS)..f])),
-        })
-        .collect()
+/// The innovation of `level` under `order` after `before`, the trajectory's earlier levels (the
+/// last [`ORDERS`] are read): `level` less their extrapolation; 0 with nothing before (the first
+/// frame, predicted by the identity).
+pub fn innovation(order: usize, before: &[i64], level: i64) -> i64 {
+    if before.is_empty() {
+        return 0;
+    }
+    level.wrapping_sub(extrapolate(order, &before[before.len().saturating_sub(ORDERS)..]))
 }
 
 #[cfg(test)]
@@ -149,7 +148,9 @@ mod tests {
         // A jerky common motion, and a trajectory that is that motion plus a steady drift.
         let common = [0i64, 5, 3, 11, 2, 9, 14, 1, 7];
         let own: Vec<i64> = common.iter().enumerate().map(|(f, c)| c + 2 * f as i64).collect();
-        let reference = innovations(1, &common);
+        let reference: Vec<i64> = (0..common.len())
+            .map(|f| innovation(1, &common[..f], common[f]))
+            .collect();
         assert_eq!(reference[0], 0);
         assert_eq!(reference[3], 8);
         let (choice, bits) = best_choice(&own, Some(&reference));

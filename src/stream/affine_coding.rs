@@ -21,7 +21,7 @@
 use crate::error::{Error, Result};
 use crate::mesh::Point;
 use crate::motion::trajectory::{
-    best_choice, extrapolate, innovations, scaled, Choice, CHOICES, ORDERS,
+    best_choice, extrapolate, innovation, scaled, Choice, CHOICES, ORDERS,
 };
 use crate::motion::{
     identity_levels, AffineTrack, ClusterGeometry, LinearForm, Partition, QuantisedAffine,
@@ -95,19 +95,24 @@ impl Models {
 /// cluster's 256 predecessors is nearly always near enough.
 const REFERENCE_WINDOW: usize = 256;
 
+/// An earlier cluster a trajectory may follow, with the steps of its coefficients.
+struct Reference {
+    cluster: usize,
+    steps: [f64; 12],
+}
+
 /// Each cluster's reference clusters, by the decoded frame 0's centroids: for its translations,
 /// the nearest of the earlier clusters (the last [`REFERENCE_WINDOW`]); for its linear part, the
 /// nearest of those of the same form (their numbers mean the same only then). Ties go to the
 /// lower number.
-#[derive(Clone, Copy)]
 struct References {
-    translation: Option<usize>,
-    linear: Option<usize>,
+    translation: Option<Reference>,
+    linear: Option<Reference>,
 }
 
 impl References {
-    /// Cluster `k`'s, given the forms of clusters `0..=k`.
-    fn of(geometry: &ClusterGeometry, k: usize, forms: &[LinearForm]) -> Self {
+    /// Cluster `k`'s, given the forms of clusters `0..=k` and the base step.
+    fn of(geometry: &ClusterGeometry, k: usize, forms: &[LinearForm], step: f64) -> Self {
         let here = geometry.centroid(k);
         let distance = |j: usize| {
             let c = geometry.centroid(j);
@@ -125,18 +130,26 @@ impl References {
                 linear = Some((j, d));
             }
         }
+        let reference = |found: Option<(usize, f64)>| {
+            found.map(|(j, _)| Reference {
+                cluster: j,
+                steps: geometry.steps(j, step, forms[j]),
+            })
+        };
         Self {
-            translation: translation.map(|(j, _)| j),
-            linear: linear.map(|(j, _)| j),
+            translation: reference(translation),
+            linear: reference(linear),
         }
     }
 
-    /// The reference of stored coefficient `coeff` of a cluster in `form`.
-    fn for_coeff(self, coeff: usize, form: LinearForm) -> Option<usize> {
-        match Kind::of(coeff, form) {
-            Kind::Translation => self.translation,
-            _ => self.linear,
-        }
+    /// The reference of stored coefficient `coeff` of a cluster in `form` whose steps are `own`,
+    /// and the ratio of the reference's step to its own (what its innovation is scaled by).
+    fn for_coeff(&self, coeff: usize, form: LinearForm, own: &[f64; 12]) -> Option<(usize, f64)> {
+        let reference = match Kind::of(coeff, form) {
+            Kind::Translation => self.translation.as_ref(),
+            _ => self.linear.as_ref(),
+        };
+        reference.map(|r| (r.cluster, r.steps[coeff] / own[coeff]))
     }
 }
 
@@ -168,18 +181,14 @@ fn code_trajectories<C: SymbolCoder>(
         q.forms[k] = form;
         let steps = geometry.steps(k, step, form);
         let identity = identity_levels(geometry.centroid(k), &steps, form);
-        let references = References::of(geometry, k, &q.forms);
+        let references = References::of(geometry, k, &q.forms, step);
         for (coeff, &first) in identity.iter().enumerate() {
-            let reference = references.for_coeff(coeff, form).map(|j| {
-                let theirs = geometry.steps(j, step, q.forms[j])[coeff];
-                (j, theirs / steps[coeff])
-            });
             let trajectory = Trajectory {
                 cluster: k,
                 coeff,
                 first,
                 kind: Kind::of(coeff, form),
-                reference,
+                reference: references.for_coeff(coeff, form, &steps),
             };
             code_trajectory(c, q, choices, &trajectory, &mut models)?;
         }
@@ -203,24 +212,22 @@ struct Trajectory {
     reference: Option<(usize, f64)>,
 }
 
-/// Trajectory (`cluster`, `coeff`)'s innovation at frame `f` under `order`: its level less its
-/// extrapolation from the levels before (0 at the first frame), from levels already coded.
-fn innovation(q: &QuantisedAffine, cluster: usize, coeff: usize, order: usize, f: usize) -> i64 {
+/// Trajectory (`cluster`, `coeff`)'s innovation at frame `f` under `order`, from its levels in
+/// `q` (0 at the first frame): what the coder adds to a follower's prediction, and what the
+/// encoder's choice weighs.
+fn level_innovation(q: &QuantisedAffine, cluster: usize, coeff: usize, order: usize, f: usize) -> i64 {
     let at = |g: usize| {
         q.values
             .get((g * q.clusters + cluster) * 12 + coeff)
             .copied()
             .unwrap_or(0)
     };
-    if f == 0 {
-        return 0;
-    }
     let from = f.saturating_sub(ORDERS);
-    let mut history = [0i64; ORDERS];
-    for (slot, g) in history.iter_mut().zip(from..f) {
+    let mut before = [0i64; ORDERS];
+    for (slot, g) in before.iter_mut().zip(from..f) {
         *slot = at(g);
     }
-    at(f).wrapping_sub(extrapolate(order, &history[..f - from]))
+    innovation(order, &before[..f - from], at(f))
 }
 
 /// Codes `t`'s choice (`choices[cluster * 12 + coeff]`), then its level at every frame as the
@@ -265,7 +272,7 @@ fn code_trajectory<C: SymbolCoder>(
         };
         let lift = match reference {
             Some((j, order, ratio)) if f > 0 && keep => {
-                scaled(innovation(q, j, t.coeff, order, f), ratio)
+                scaled(level_innovation(q, j, t.coeff, order, f), ratio)
             }
             _ => 0,
         };
@@ -302,25 +309,21 @@ fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
     let (frames, clusters) = (q.frames, q.clusters);
     let step = f64::from(q.step);
     let mut choices = vec![Choice::FIRST; clusters * 12];
-    // innovation[k * 12 + c]: trajectory (k, c)'s, over the frames.
-    let mut innovation: Vec<Vec<i64>> = vec![Vec::new(); clusters * 12];
     for k in 0..clusters {
         let steps = geometry.steps(k, step, q.forms[k]);
-        let references = References::of(geometry, k, &q.forms);
+        let references = References::of(geometry, k, &q.forms, step);
         for coeff in 0..12 {
             let levels: Vec<i64> = (0..frames)
                 .map(|f| q.values[(f * clusters + k) * 12 + coeff])
                 .collect();
-            let lift: Option<Vec<i64>> = references.for_coeff(coeff, q.forms[k]).map(|j| {
-                let ratio = geometry.steps(j, step, q.forms[j])[coeff] / steps[coeff];
-                innovation[j * 12 + coeff]
-                    .iter()
-                    .map(|&x| scaled(x, ratio))
-                    .collect()
-            });
-            let (choice, _) = best_choice(&levels, lift.as_deref());
-            choices[k * 12 + coeff] = choice;
-            innovation[k * 12 + coeff] = innovations(choice.order, &levels);
+            let lift: Option<Vec<i64>> =
+                references.for_coeff(coeff, q.forms[k], &steps).map(|(j, ratio)| {
+                    let order = choices[j * 12 + coeff].order;
+                    (0..frames)
+                        .map(|f| scaled(level_innovation(q, j, coeff, order, f), ratio))
+                        .collect()
+                });
+            choices[k * 12 + coeff] = best_choice(&levels, lift.as_deref()).0;
         }
     }
     choices

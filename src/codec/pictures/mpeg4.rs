@@ -81,8 +81,7 @@ const FINE_P_FRAME_STEP: f64 = 3.1e-4;
 /// explicit step that fine), where the maps' white quantisation noise spoils the prediction
 /// between frames more than finer maps cost (docs/design.md, "Affine precision per codec").
 fn p_frame_affine_precision(rate: &Rate) -> f64 {
-    let fraction = rate.step.unwrap_or_else(|| rate.target_step(1.0));
-    if fraction > FINE_P_FRAME_STEP {
+    if rate.step_fraction() > FINE_P_FRAME_STEP {
         1.0 / 8.0
     } else {
         1.0 / 16.0
