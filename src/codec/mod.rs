@@ -408,6 +408,14 @@ impl CodecConfig {
     }
 }
 
+impl RatePlan {
+    /// A picture codec's own quantiser (JPEG quality, MPEG-4 qscale, HEVC QP or AV1 `crf`);
+    /// `None` for the temporal DCT.
+    pub fn quantiser(&self) -> Option<u8> {
+        self.pictures.as_ref().map(|p| p.quantiser)
+    }
+}
+
 #[cfg(feature = "encode")]
 impl RatePlan {
     /// The residual encoder with this plan's settings.

@@ -142,14 +142,12 @@ pub(crate) fn av1_law_at(scale_percent: f64, depth: u8) -> PictureLaw {
     let floor = av1_log2_step(f64::from(AV1_MIN_QP), depth);
     let ceiling = av1_log2_step(f64::from(AV1_MAX_QP), depth);
     let crf = av1_crf_of(want.clamp(floor, ceiling), depth).round();
-    // Beyond the floor or the ceiling the pixel step takes what the quantiser cannot.
-    let beyond = if (floor..=ceiling).contains(&want) {
-        0.0
-    } else {
-        want - av1_log2_step(crf, depth)
-    };
+    // The pixel step takes what the integer `crf` cannot: the rest beyond the floor or the
+    // ceiling, and within them the rounding, so that the step (hence the error) follows a fine
+    // quality between two `crf`s instead of jumping at each (docs/design.md, "Budgets").
+    let rest = want - av1_log2_step(crf, depth);
     PictureLaw {
-        step_factor: AV1_STEP_FACTOR * 2f64.powf(beyond),
+        step_factor: AV1_STEP_FACTOR * 2f64.powf(rest),
         quantiser: crf as u8,
     }
 }
@@ -257,6 +255,30 @@ mod tests {
         assert_eq!(at(90, None), (12, 12));
         assert_eq!(at(97, Some(10)), (10, 10));
         assert_eq!(at(50, Some(12)), (12, 12));
+    }
+
+    #[test]
+    fn pixel_step_and_crf_together_follow_a_fine_quality_without_jumps() {
+        // log2 of pixel step × AV1's quantiser step at IJG scale `s`: it falls with the step
+        // everywhere, between two `crf`s too (a budget search needs no jump to step over).
+        for depth in [10, 12] {
+            let log2_steps = |s: f64| {
+                let law = av1_law_at(s, depth);
+                (s / 100.0).log2() + law.step_factor.log2()
+                    + av1_log2_step(f64::from(law.quantiser), depth)
+            };
+            let mut s = 200.0f64;
+            let mut last = log2_steps(s);
+            while s > 1.0 {
+                s *= 0.999;
+                let now = log2_steps(s);
+                let fall = last - now;
+                assert!(fall > 0.0 && fall < 0.01, "{fall} at scale {s}, {depth} bits");
+                last = now;
+            }
+        }
+        // Quality 50 sits on its `crf`: its pixel step is the law's factor.
+        assert!((av1_law(50, 10).step_factor - AV1_STEP_FACTOR).abs() < 1e-12);
     }
 
     #[test]

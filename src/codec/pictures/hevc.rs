@@ -73,9 +73,11 @@ pub(crate) fn hevc_law_at(scale_percent: f64, depth: u8) -> PictureLaw {
     let deeper = 6.0 * (f64::from(depth) - 10.0);
     let exact = HEVC_QP_AT_50 + 6.0 * scale.log2() - deeper;
     let qp = exact.round().clamp((HEVC_MIN_QP - deeper).max(0.0), 51.0);
-    let beyond = if exact.round() == qp { 0.0 } else { exact - qp };
+    // The pixel step takes what the integer QP cannot: the rest beyond its bounds, and within
+    // them the rounding, so that the step follows a fine quality between two QPs.
+    let rest = exact - qp;
     PictureLaw {
-        step_factor: HEVC_STEP_FACTOR * 2f64.powf(beyond / 6.0),
+        step_factor: HEVC_STEP_FACTOR * 2f64.powf(rest / 6.0),
         quantiser: qp as u8,
     }
 }
@@ -139,6 +141,32 @@ mod coder {
             dict.set("x265-params", &params);
             dict
         }
+    }
+}
+
+#[cfg(test)]
+mod law_tests {
+    use super::*;
+
+    #[test]
+    fn pixel_step_and_qp_together_follow_a_fine_quality_without_jumps() {
+        for depth in [10, 12] {
+            // log2 of pixel step × HEVC's quantiser step (2^(QP/6)) at IJG scale `s`.
+            let log2_steps = |s: f64| {
+                let law = hevc_law_at(s, depth);
+                (s / 100.0).log2() + law.step_factor.log2() + f64::from(law.quantiser) / 6.0
+            };
+            let mut s = 200.0f64;
+            let mut last = log2_steps(s);
+            while s > 1.0 {
+                s *= 0.999;
+                let now = log2_steps(s);
+                let fall = last - now;
+                assert!(fall > 0.0 && fall < 0.01, "{fall} at scale {s}, {depth} bits");
+                last = now;
+            }
+        }
+        assert!((hevc_law(50, 10).step_factor - HEVC_STEP_FACTOR).abs() < 1e-12);
     }
 }
 

@@ -233,11 +233,9 @@ mod tests {
 
     #[test]
     fn pixel_steps_fall_and_quantisers_do_not_coarsen_with_quality() {
-        let hevc10 = |q| hevc_law(q, 10);
-        let hevc12 = |q| hevc_law(q, 12);
-        let av1_10 = |q| av1_law(q, 10);
-        let av1_12 = |q| av1_law(q, 12);
-        for law in [jpeg_law, mpeg4_law, hevc10, hevc12, av1_10, av1_12] {
+        // HEVC's and AV1's pixel steps take their integer quantisers' rounding, so they may rise
+        // where the quantiser falls: their steps together fall (tests in hevc.rs and av1.rs).
+        for law in [jpeg_law, mpeg4_law] {
             for q in 1..100u8 {
                 let (a, b) = (law(q), law(q + 1));
                 let step = |l: PictureLaw, q| l.step_factor * target_step(q, 1.0);
