@@ -144,32 +144,6 @@ mod coder {
     }
 }
 
-#[cfg(test)]
-mod law_tests {
-    use super::*;
-
-    #[test]
-    fn pixel_step_and_qp_together_follow_a_fine_quality_without_jumps() {
-        for depth in [10, 12] {
-            // log2 of pixel step × HEVC's quantiser step (2^(QP/6)) at IJG scale `s`.
-            let log2_steps = |s: f64| {
-                let law = hevc_law_at(s, depth);
-                (s / 100.0).log2() + law.step_factor.log2() + f64::from(law.quantiser) / 6.0
-            };
-            let mut s = 200.0f64;
-            let mut last = log2_steps(s);
-            while s > 1.0 {
-                s *= 0.999;
-                let now = log2_steps(s);
-                let fall = last - now;
-                assert!(fall > 0.0 && fall < 0.01, "{fall} at scale {s}, {depth} bits");
-                last = now;
-            }
-        }
-        assert!((hevc_law(50, 10).step_factor - HEVC_STEP_FACTOR).abs() < 1e-12);
-    }
-}
-
 #[cfg(all(test, feature = "ffmpeg"))]
 mod tests {
     use super::coder::*;

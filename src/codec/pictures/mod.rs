@@ -225,11 +225,50 @@ pub(crate) trait PictureDecoder: Send {
 
 #[cfg(test)]
 mod tests {
-    use super::av1::{av1_law, AV1_MAX_QP, AV1_QP_AT_50, AV1_STEP_FACTOR};
-    use super::hevc::{hevc_law, HEVC_QP_AT_50};
+    use super::av1::{av1_law, av1_law_at, av1_log2_step, AV1_MAX_QP, AV1_QP_AT_50, AV1_STEP_FACTOR};
+    use super::hevc::{hevc_law, hevc_law_at, HEVC_QP_AT_50, HEVC_STEP_FACTOR};
     use super::jpeg::jpeg_law;
     use super::mpeg4::mpeg4_law;
     use crate::codec::rate::{target_step, PictureLaw};
+
+    /// Fails unless log2 of pixel step × quantiser step, at IJG scales from 200 % down to 1 %,
+    /// falls at every step of 0.1 % and by less than 0.01 (no jump for a budget search to meet).
+    fn falls_without_jumps(log2_steps: impl Fn(f64) -> f64, what: &str) {
+        let mut s = 200.0f64;
+        let mut last = log2_steps(s);
+        while s > 1.0 {
+            s *= 0.999;
+            let now = log2_steps(s);
+            let fall = last - now;
+            assert!(fall > 0.0 && fall < 0.01, "{what}: {fall} at scale {s}");
+            last = now;
+        }
+    }
+
+    #[test]
+    fn pixel_step_and_quantiser_together_follow_a_fine_quality_without_jumps() {
+        for depth in [10, 12] {
+            falls_without_jumps(
+                |s| {
+                    let law = hevc_law_at(s, depth);
+                    let qp = f64::from(law.quantiser);
+                    (s / 100.0).log2() + law.step_factor.log2() + qp / 6.0
+                },
+                &format!("HEVC at {depth} bits"),
+            );
+            falls_without_jumps(
+                |s| {
+                    let law = av1_law_at(s, depth);
+                    let crf = f64::from(law.quantiser);
+                    (s / 100.0).log2() + law.step_factor.log2() + av1_log2_step(crf, depth)
+                },
+                &format!("AV1 at {depth} bits"),
+            );
+        }
+        // Quality 50 sits on its quantisers: the pixel steps are the laws' factors.
+        assert!((hevc_law(50, 10).step_factor - HEVC_STEP_FACTOR).abs() < 1e-12);
+        assert!((av1_law(50, 10).step_factor - AV1_STEP_FACTOR).abs() < 1e-12);
+    }
 
     #[test]
     fn pixel_steps_fall_and_quantisers_do_not_coarsen_with_quality() {
