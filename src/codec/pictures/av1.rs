@@ -28,14 +28,12 @@ pub(crate) fn check(config: &DeepConfig) -> Result<()> {
 }
 
 /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: [`av1_law`]; affine
-/// maps at a quarter of the residual step all-intra, at 1/16 in P-frame groups, whose prediction
-/// coarser maps spoil (1/8 below quality 85, as MPEG-4 takes, would save 1-6 % at quality 50 but
-/// throws the error budgets' searches into AV1's quantiser jumps: docs/design.md, "Affine
-/// precision per codec").
+/// maps at a quarter of the residual step all-intra, finer in P-frame groups, whose prediction
+/// coarser maps spoil ([`super::p_frame_affine_precision`], as MPEG-4's).
 pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
     let affine_precision = match config.gop {
         1 => DEFAULT_AFFINE_PRECISION,
-        _ => 1.0 / 16.0,
+        _ => super::p_frame_affine_precision(rate),
     };
     let law = (av1_law_at as fn(f64, u8) -> PictureLaw, affine_precision);
     config.plan(Codec::Av1, law, rate, diagonal)
@@ -292,8 +290,8 @@ mod tests {
             };
             plan(&config, &rate, 1.0).unwrap().affine_precision
         };
-        // In sixteenths: a quarter all-intra, 1/16 in P-frame groups.
-        assert_eq!((code(1, 50), code(50, 50)), (4, 1));
+        // In sixteenths: a quarter all-intra; 1/8 in P-frame groups, 1/16 from quality 85.
+        assert_eq!((code(1, 50), code(50, 50)), (4, 2));
         assert_eq!((code(1, 90), code(50, 90)), (4, 1));
     }
 }

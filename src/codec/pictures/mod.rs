@@ -32,6 +32,23 @@ pub(crate) use setup::PictureSetup;
 /// pcow and walking_cat 0.3-1.8 % larger; docs/design.md, "Affine precision per codec").
 pub(crate) const AFFINE_PRECISION: f64 = 3.0 / 16.0;
 
+/// The residual step (a fraction of the diagonal) at and below which P-frame groups (MPEG-4, AV1)
+/// take their affine maps at 1/16 of the step instead of 1/8: between quality 84 (3.2e-4) and 85
+/// (3e-4).
+const FINE_P_FRAME_STEP: f64 = 3.1e-4;
+
+/// The affine precision of MPEG-4's and AV1's P-frame groups: 1/8 of the residual step, 1/16 from
+/// quality 85 (or an explicit step that fine), where the maps' white quantisation noise spoils the
+/// prediction between frames more than finer maps cost (docs/design.md, "Affine precision per
+/// codec").
+pub(crate) fn p_frame_affine_precision(rate: &Rate) -> f64 {
+    if rate.step_fraction() > FINE_P_FRAME_STEP {
+        1.0 / 8.0
+    } else {
+        1.0 / 16.0
+    }
+}
+
 /// Frames per group of pictures of the video codecs unless asked otherwise.
 pub const DEFAULT_GOP: usize = 50;
 

@@ -54,7 +54,7 @@ impl Mpeg4Config {
 
     /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: the law's pixel
     /// step and qscale, ranges per group, `biharmonic` padding, affine maps at
-    /// [`p_frame_affine_precision`] (1/16 all-intra, as always, unmeasured).
+    /// [`super::p_frame_affine_precision`] (1/16 all-intra, as always, unmeasured).
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
         let law = read_law(&MPEG4_LAW, rate.level());
         let resolved = Resolved {
@@ -66,25 +66,10 @@ impl Mpeg4Config {
             padding: padding::Method::Biharmonic,
             affine_precision: match self.gop {
                 1 => 1.0 / 16.0,
-                _ => p_frame_affine_precision(rate),
+                _ => super::p_frame_affine_precision(rate),
             },
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
-    }
-}
-
-/// The residual step (a fraction of the diagonal) at and below which P-frame groups take their
-/// affine maps at 1/16 of the step instead of 1/8: between quality 84 (3.2e-4) and 85 (3e-4).
-const FINE_P_FRAME_STEP: f64 = 3.1e-4;
-
-/// The affine precision of P-frame groups: 1/8 of the residual step, 1/16 from quality 85 (or an
-/// explicit step that fine), where the maps' white quantisation noise spoils the prediction
-/// between frames more than finer maps cost (docs/design.md, "Affine precision per codec").
-fn p_frame_affine_precision(rate: &Rate) -> f64 {
-    if rate.step_fraction() > FINE_P_FRAME_STEP {
-        1.0 / 8.0
-    } else {
-        1.0 / 16.0
     }
 }
 
