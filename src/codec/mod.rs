@@ -465,26 +465,26 @@ mod tests {
             (Codec::Hevc, 1, 3),
             (Codec::Hevc, 50, 3),
             (Codec::Av1, 1, 4),
-            (Codec::Av1, 50, 1),
+            (Codec::Av1, 50, 2),
             (Codec::Mpeg4, 50, 2),
             (Codec::Mpeg4, 1, 1),
         ] {
             assert_eq!(code(codec, gop), expected, "{codec:?} gop {gop}");
         }
-        // MPEG-4's P-frame groups take finer maps from quality 85, where their noise costs more.
-        for (quality, expected) in [(84, 2), (85, 1), (97, 1)] {
-            let plan = Codec::Mpeg4.default_config().plan(
-                &Rate {
-                    quality,
-                    ..rate(None)
-                },
-                1.0,
-            );
-            assert_eq!(
-                plan.unwrap().affine_precision,
-                expected,
-                "quality {quality}"
-            );
+        // MPEG-4's and AV1's P-frame groups take finer maps from quality 85, where their noise
+        // costs more.
+        for codec in [Codec::Mpeg4, Codec::Av1] {
+            for (quality, expected) in [(84, 2), (85, 1), (97, 1)] {
+                let plan = codec.default_config().plan(
+                    &Rate {
+                        quality,
+                        ..rate(None)
+                    },
+                    1.0,
+                );
+                let precision = plan.unwrap().affine_precision;
+                assert_eq!(precision, expected, "{codec:?} quality {quality}");
+            }
         }
         let asked = Codec::Av1.default_config().plan(&rate(Some(0.5)), 1.0);
         assert_eq!(asked.unwrap().affine_precision, 8);
