@@ -202,9 +202,9 @@ pub struct EncodeArgs {
     pub e0: Option<f64>,
     /// The affine coefficients' quantiser step as a multiple of the residual step (whose size
     /// --quality or --step sets): smaller = finer maps, more side information (1/16..15.9;
-    /// default 3/16 for tdct, jpeg and hevc, 0.25 for all-intra av1, 1/16 for av1 with --gop
-    /// above 1, whose P-frames suffer from coarser maps; for mpeg4 1/8 below quality 85, 1/16
-    /// from there and all-intra).
+    /// default 3/16 for tdct, jpeg and hevc, 0.25 for all-intra av1; for mpeg4 and av1 with
+    /// --gop above 1, whose P-frames suffer from coarser maps, 1/8 below quality 85 and 1/16 from
+    /// there; 1/16 for all-intra mpeg4).
     #[arg(long)]
     pub affine_precision: Option<f64>,
     /// Geometry-image lattice: WIDTHxHEIGHT (multiples of 16), or `auto` for the smallest square
