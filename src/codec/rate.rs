@@ -187,8 +187,16 @@ pub(crate) const fn anchor(quality: u8, step_factor: f64, quantiser: u8) -> Anch
 }
 
 /// The law given by `anchors` (in rising quality, the first at quality 1) read at `quality`
-/// (between the integers too).
-pub(crate) fn read_law(anchors: &[Anchor], quality: f64) -> PictureLaw {
+/// (between the integers too), for a codec whose quantiser `q` quantises at a step proportional
+/// to `quantiser_step(q)`. Between two anchors the pixel step × that step is interpolated, not
+/// the pixel step alone, so that where the next anchor changes the quantiser the two together
+/// meet it without a jump (JPEG's error halved at quality 75, MPEG-4's at 90, and no error
+/// budget between could be met: docs/design.md, "Quality laws").
+pub(crate) fn read_law(
+    anchors: &[Anchor],
+    quantiser_step: fn(u8) -> f64,
+    quality: f64,
+) -> PictureLaw {
     let q = quality.clamp(1.0, 100.0);
     let i = anchors
         .iter()
@@ -198,7 +206,11 @@ pub(crate) fn read_law(anchors: &[Anchor], quality: f64) -> PictureLaw {
     let step_factor = match anchors.get(i + 1) {
         Some(next) => {
             let t = (q - f64::from(here.quality)) / f64::from(next.quality - here.quality);
-            here.step_factor * (next.step_factor / here.step_factor).powf(t)
+            let (from, to) = (
+                quantiser_step(here.quantiser),
+                quantiser_step(next.quantiser),
+            );
+            here.step_factor * (next.step_factor * to / (here.step_factor * from)).powf(t)
         }
         None => here.step_factor,
     };

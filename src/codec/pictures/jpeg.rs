@@ -11,7 +11,7 @@ use super::{abbreviated, PictureCodec, PictureDecoder, PictureOptions, Plane};
 #[cfg(feature = "encode")]
 use super::PictureEncoder;
 use super::{PicturePlan, PictureSetup, Resolved};
-use crate::codec::rate::{anchor, read_law, Anchor, PictureLaw, Rate, RatePlan};
+use crate::codec::rate::{anchor, ijg_scale_percent, read_law, Anchor, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use super::AFFINE_PRECISION;
 use crate::stream::bytes::{ByteReader, ByteWriter};
@@ -133,7 +133,7 @@ impl JpegConfig {
     /// The plan of `rate` on a first frame of bounding-box diagonal `diagonal`: the law's pixel
     /// step, every frame its own key frame and ranges, `snap` padding at the JPEG quality.
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
-        let law = read_law(&JPEG_LAW, rate.level());
+        let law = jpeg_law_at(rate.level());
         let resolved = Resolved {
             codec: Codec::Jpeg,
             step_factor: law.step_factor,
@@ -158,10 +158,20 @@ const JPEG_LAW: [Anchor; 4] = [
     anchor(90, 0.2, 90),
 ];
 
+/// The step of JPEG quality `q`'s (flat) table, relative: IJG's scale of it.
+pub(crate) fn jpeg_quantiser_step(q: u8) -> f64 {
+    f64::from(ijg_scale_percent(q).max(1))
+}
+
 /// JPEG's pixel step factor and JPEG quality for a user quality 1..100.
 #[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn jpeg_law(quality: u8) -> PictureLaw {
-    read_law(&JPEG_LAW, f64::from(quality))
+    jpeg_law_at(f64::from(quality))
+}
+
+/// [`jpeg_law`] at a quality between the integers too.
+pub(crate) fn jpeg_law_at(quality: f64) -> PictureLaw {
+    read_law(&JPEG_LAW, jpeg_quantiser_step, quality)
 }
 
 /// JPEG as the geometry-video picture codec: every frame a key frame, the tables every frame

@@ -244,28 +244,56 @@ pub(crate) trait PictureDecoder: Send {
 mod tests {
     use super::av1::{av1_law, av1_law_at, av1_log2_step, AV1_MAX_QP, AV1_QP_AT_50, AV1_STEP_FACTOR};
     use super::hevc::{hevc_law, hevc_law_at, HEVC_QP_AT_50, HEVC_STEP_FACTOR};
-    use super::jpeg::jpeg_law;
-    use super::mpeg4::mpeg4_law;
-    use crate::codec::rate::{target_step, PictureLaw};
+    use super::jpeg::{jpeg_law, jpeg_law_at, jpeg_quantiser_step};
+    use super::mpeg4::{mpeg4_law, mpeg4_law_at, mpeg4_quantiser_step};
+    use crate::codec::rate::{fine_scale_percent, target_step, PictureLaw};
 
-    /// Fails unless log2 of pixel step × quantiser step, at IJG scales from 200 % down to 1 %,
-    /// falls at every step of 0.1 % and by less than 0.01 (no jump for a budget search to meet).
-    fn falls_without_jumps(log2_steps: impl Fn(f64) -> f64, what: &str) {
-        let mut s = 200.0f64;
-        let mut last = log2_steps(s);
-        while s > 1.0 {
-            s *= 0.999;
-            let now = log2_steps(s);
+    /// Fails unless log2 of pixel step × quantiser step, read at each of `points` in turn (finer
+    /// and finer), falls at every one and by less than 0.01 (no jump for a budget search to meet).
+    fn falls_without_jumps(
+        mut points: impl Iterator<Item = f64>,
+        log2_steps: impl Fn(f64) -> f64,
+        what: &str,
+    ) {
+        let Some(first) = points.next() else { return };
+        let mut last = log2_steps(first);
+        for x in points {
+            let now = log2_steps(x);
             let fall = last - now;
-            assert!(fall > 0.0 && fall < 0.01, "{what}: {fall} at scale {s}");
+            assert!(fall > 0.0 && fall < 0.01, "{what}: {fall} at {x}");
             last = now;
         }
     }
 
+    /// IJG scales from 200 % down to 1 %, 0.1 % apart.
+    fn scales() -> impl Iterator<Item = f64> {
+        std::iter::successors(Some(200.0f64), |s| Some(s * 0.999)).take_while(|s| *s > 1.0)
+    }
+
     #[test]
     fn pixel_step_and_quantiser_together_follow_a_fine_quality_without_jumps() {
+        // JPEG and MPEG-4 read qualities (1 to 100, 0.005 apart), HEVC and AV1 IJG scales.
+        let qualities = || (0..=19_800).map(|i| 1.0 + f64::from(i) * 0.005);
+        let log2_scale = |q: f64| (fine_scale_percent(q) / 100.0).log2();
+        falls_without_jumps(
+            qualities(),
+            |q| {
+                let law = jpeg_law_at(q);
+                log2_scale(q) + (law.step_factor * jpeg_quantiser_step(law.quantiser)).log2()
+            },
+            "JPEG",
+        );
+        falls_without_jumps(
+            qualities(),
+            |q| {
+                let law = mpeg4_law_at(q);
+                log2_scale(q) + (law.step_factor * mpeg4_quantiser_step(law.quantiser)).log2()
+            },
+            "MPEG-4",
+        );
         for depth in [10, 12] {
             falls_without_jumps(
+                scales(),
                 |s| {
                     let law = hevc_law_at(s, depth);
                     let qp = f64::from(law.quantiser);
@@ -274,6 +302,7 @@ mod tests {
                 &format!("HEVC at {depth} bits"),
             );
             falls_without_jumps(
+                scales(),
                 |s| {
                     let law = av1_law_at(s, depth);
                     let crf = f64::from(law.quantiser);
@@ -289,13 +318,17 @@ mod tests {
 
     #[test]
     fn pixel_steps_fall_and_quantisers_do_not_coarsen_with_quality() {
-        // HEVC's and AV1's pixel steps take their integer quantisers' rounding, so they may rise
-        // where the quantiser falls: their steps together fall (tests in hevc.rs and av1.rs).
-        for law in [jpeg_law, mpeg4_law] {
+        // The pixel step may rise where the quantiser falls (HEVC's and AV1's take their integer
+        // quantisers' rounding, JPEG's and MPEG-4's meet a finer quantiser at an anchor): the
+        // two together fall (above). Where the quantiser holds, the pixel step falls.
+        let hevc10 = |q| hevc_law(q, 10);
+        let av1_10 = |q| av1_law(q, 10);
+        for law in [jpeg_law, mpeg4_law, hevc10, av1_10] {
             for q in 1..100u8 {
                 let (a, b) = (law(q), law(q + 1));
                 let step = |l: PictureLaw, q| l.step_factor * target_step(q, 1.0);
-                assert!(step(b, q + 1) <= step(a, q), "pixel step grows at {q}");
+                let held = a.quantiser == b.quantiser;
+                assert!(!held || step(b, q + 1) <= step(a, q), "pixel step grows at {q}");
             }
         }
         for q in 1..100u8 {

@@ -56,7 +56,7 @@ impl Mpeg4Config {
     /// step and qscale, ranges per group, `biharmonic` padding, affine maps at
     /// [`super::p_frame_affine_precision`] (1/16 all-intra, as always, unmeasured).
     pub(crate) fn plan(&self, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
-        let law = read_law(&MPEG4_LAW, rate.level());
+        let law = mpeg4_law_at(rate.level());
         let resolved = Resolved {
             codec: Codec::Mpeg4,
             step_factor: law.step_factor,
@@ -84,10 +84,20 @@ const MPEG4_LAW: [Anchor; 4] = [
     anchor(90, 0.16, 1),
 ];
 
+/// The step of MPEG-4's qscale `q`, relative: the qscale (its quantiser step is 2 × qscale).
+pub(crate) fn mpeg4_quantiser_step(q: u8) -> f64 {
+    f64::from(q.max(1))
+}
+
 /// MPEG-4's pixel step factor and qscale for a user quality 1..100.
 #[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn mpeg4_law(quality: u8) -> PictureLaw {
-    read_law(&MPEG4_LAW, f64::from(quality))
+    mpeg4_law_at(f64::from(quality))
+}
+
+/// [`mpeg4_law`] at a quality between the integers too.
+pub(crate) fn mpeg4_law_at(quality: f64) -> PictureLaw {
+    read_law(&MPEG4_LAW, mpeg4_quantiser_step, quality)
 }
 
 /// The FFmpeg encoder and decoder, and their geometry-video glue.
