@@ -275,22 +275,18 @@ mod tests {
         // JPEG and MPEG-4 read qualities (1 to 100, 0.005 apart), HEVC and AV1 IJG scales.
         let qualities = || (0..=19_800).map(|i| 1.0 + f64::from(i) * 0.005);
         let log2_scale = |q: f64| (fine_scale_percent(q) / 100.0).log2();
-        falls_without_jumps(
-            qualities(),
-            |q| {
-                let law = jpeg_law_at(q);
-                log2_scale(q) + (law.step_factor * jpeg_quantiser_step(law.quantiser)).log2()
-            },
-            "JPEG",
-        );
-        falls_without_jumps(
-            qualities(),
-            |q| {
-                let law = mpeg4_law_at(q);
-                log2_scale(q) + (law.step_factor * mpeg4_quantiser_step(law.quantiser)).log2()
-            },
-            "MPEG-4",
-        );
+        type Law = (fn(f64) -> PictureLaw, fn(u8) -> f64, &'static str);
+        let anchored: [Law; 2] = [
+            (jpeg_law_at, jpeg_quantiser_step, "JPEG"),
+            (mpeg4_law_at, mpeg4_quantiser_step, "MPEG-4"),
+        ];
+        for (law_at, quantiser_step, name) in anchored {
+            let log2_steps = |q: f64| {
+                let law = law_at(q);
+                log2_scale(q) + (law.step_factor * quantiser_step(law.quantiser)).log2()
+            };
+            falls_without_jumps(qualities(), log2_steps, name);
+        }
         for depth in [10, 12] {
             falls_without_jumps(
                 scales(),
