@@ -390,39 +390,10 @@ impl<'a> Search<'a> {
         Ok(self.modelled(aim.max(self.fixed + 0.5 * room)))
     }
 
-    /// Where the model puts the aim: inside the bracket when there is one (the secant through
-    /// its ends, pulled towards the middle if it would land at an end: regula falsi's fix), else
-    /// along the secant of the last two encodes (its slope kept within a factor of 4 of the prior,
-    /// and of the prior's sign), or the prior's slope after one encode.
+    /// Where the model puts the aim ([`next_log_scale`]) with this budget's prior slope.
     fn next_log_scale(&self, aim: f64) -> f64 {
         let prior = self.budget.prior_slope(self.codec);
-        let points = self.modelled_points();
-        if let Some((below, above)) = bracket(&points, aim) {
-            // The secant through the two encodes nearest the aim when it falls well inside the
-            // bracket: a bracket's far end may lie where the curve bends (pdance AV1's error,
-            // quality 50 against 77), and regula falsi between its ends then lands off.
-            let (lo, hi) = (below.0.min(above.0), below.0.max(above.0));
-            let inside = |u: &f64| *u > lo + 0.02 * (hi - lo) && *u < hi - 0.02 * (hi - lo);
-            if let Some(u) = nearest_secant(&points, aim, prior).filter(inside) {
-                return u;
-            }
-            let t = ((aim - below.1) / (above.1 - below.1)).clamp(0.1, 0.9);
-            return below.0 + t * (above.0 - below.0);
-        }
-        let last = points[points.len() - 1];
-        let slope = match points.len() {
-            n if n >= 2 => {
-                let before = points[n - 2];
-                let s = (last.1 - before.1) / (last.0 - before.0);
-                if s.is_finite() && s * prior > 0.0 {
-                    prior.signum() * s.abs().clamp(prior.abs() / 4.0, prior.abs() * 4.0)
-                } else {
-                    prior
-                }
-            }
-            _ => prior,
-        };
-        last.0 + (aim - last.1) / slope
+        next_log_scale(&self.modelled_points(), aim, prior)
     }
 
     /// The model asks for a quality already coded: the search is at an end of the quality range
@@ -488,6 +459,42 @@ impl<'a> Search<'a> {
     }
 }
 
+/// Where the model puts the aim, from the encodes' (log scale, modelled measure) `points`
+/// (at least one): inside the bracket when there is one (the secant through the two encodes
+/// nearest the aim if it falls well inside, else the secant through the bracket's ends, pulled
+/// towards the middle if it would land at an end: regula falsi's fix), else along the secant of
+/// the last two encodes (its slope kept within a factor of 4 of the `prior`, and of its sign), or
+/// the prior's slope after one encode.
+fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> f64 {
+    if let Some((below, above)) = bracket(points, aim) {
+        // A bracket's far end may lie where the curve bends (pdance AV1's error, quality 50
+        // against 77), and regula falsi between its ends then lands off.
+        let (lo, hi) = (below.0.min(above.0), below.0.max(above.0));
+        let inside = |u: &f64| *u > lo + 0.02 * (hi - lo) && *u < hi - 0.02 * (hi - lo);
+        if let Some(u) = nearest_secant(points, aim, prior).filter(inside) {
+            return u;
+        }
+        let t = ((aim - below.1) / (above.1 - below.1)).clamp(0.1, 0.9);
+        return below.0 + t * (above.0 - below.0);
+    }
+    let Some(&last) = points.last() else {
+        return aim;
+    };
+    let slope = match points.len() {
+        n if n >= 2 => {
+            let before = points[n - 2];
+            let s = (last.1 - before.1) / (last.0 - before.0);
+            if s.is_finite() && s * prior > 0.0 {
+                prior.signum() * s.abs().clamp(prior.abs() / 4.0, prior.abs() * 4.0)
+            } else {
+                prior
+            }
+        }
+        _ => prior,
+    };
+    last.0 + (aim - last.1) / slope
+}
+
 /// Where the secant through the two encodes whose modelled measures are nearest `aim` meets it;
 /// `None` when the secant is flat, not finite, or slopes against the `prior`.
 fn nearest_secant(points: &[(f64, f64)], aim: f64, prior: f64) -> Option<f64> {
@@ -540,4 +547,32 @@ fn vertex_errors(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<(f64, f64)> {
     let diagonal = mesh.bbox_diagonal();
     let count = (mesh.vertex_count() * mesh.frame_count()).max(1) as f64;
     Ok(((sum / count).sqrt() / diagonal, max.sqrt() / diagonal))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bracket_with_a_bent_far_end_is_searched_along_the_nearest_secant() {
+        // pdance AV1's vertex RMSE against ln(IJG scale): quality 50 (scale 100), 86.22 and
+        // 77.01; the aim (1.97e-4, mid-window under 2e-4) lies just above the last encode.
+        let point = |scale: f64, rmse: f64| (scale.ln(), rmse.ln());
+        let points = [
+            point(100.0, 4.27e-4),
+            point(27.56, 1.1825e-4),
+            point(45.98, 1.9234e-4),
+        ];
+        let aim = 1.97e-4f64.ln();
+        let u = next_log_scale(&points, aim, 1.0);
+        // The secant through 77.01 and 86.22 (slope 0.95) puts it at scale 47.1 (quality 76.4,
+        // which codes 1.97e-4); regula falsi's tenth towards quality 50 put it at 49.7 (75.15,
+        // 2.10e-4: over the budget).
+        assert!((u.exp() - 47.1).abs() < 0.3, "scale {}", u.exp());
+        // Without a bracket: the secant of the last two encodes, then the prior alone.
+        let u = next_log_scale(&points[..2], aim, 1.0);
+        assert!(u.exp() > 27.56 && u.exp() < 100.0, "scale {}", u.exp());
+        let u = next_log_scale(&points[..1], aim, 1.0);
+        assert!((u - (100f64.ln() + aim - 4.27e-4f64.ln())).abs() < 1e-12);
+    }
 }
