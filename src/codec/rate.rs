@@ -170,7 +170,8 @@ pub struct PictureLaw {
 }
 
 /// One anchor of a law: from `quality` up (until the next anchor), the codec's quantiser, and the
-/// step factor at `quality` (interpolated log-linearly towards the next anchor's).
+/// step factor at `quality` (towards the next anchor, the pixel step × the quantiser's step is
+/// interpolated log-linearly: [`read_law`]).
 pub(crate) struct Anchor {
     pub quality: u8,
     pub step_factor: f64,
