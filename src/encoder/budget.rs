@@ -337,7 +337,9 @@ impl<'a> Search<'a> {
         if best.is_some_and(|m| self.landed(m)) || self.trials.len() >= MAX_BUDGET_ENCODES {
             return Ok(None);
         }
-        let u = self.next_log_scale(self.aim()?);
+        let Some(u) = self.next_log_scale(self.aim()?) else {
+            return Ok(None);
+        };
         let (lowest, highest) = (log_scale(100.0), log_scale(1.0));
         let mut quality = quality_of(u.clamp(lowest, highest));
         // A quality already coded: step a hundredth at a time towards the budget's side.
@@ -390,8 +392,9 @@ impl<'a> Search<'a> {
         Ok(self.modelled(aim.max(self.fixed + 0.5 * room)))
     }
 
-    /// Where the model puts the aim ([`next_log_scale`]) with this budget's prior slope.
-    fn next_log_scale(&self, aim: f64) -> f64 {
+    /// Where the model puts the aim ([`next_log_scale`]) with this budget's prior slope; `None`
+    /// before the first encode.
+    fn next_log_scale(&self, aim: f64) -> Option<f64> {
         let prior = self.budget.prior_slope(self.codec);
         next_log_scale(&self.modelled_points(), aim, prior)
     }
@@ -460,26 +463,24 @@ impl<'a> Search<'a> {
 }
 
 /// Where the model puts the aim, from the encodes' (log scale, modelled measure) `points`
-/// (at least one): inside the bracket when there is one (the secant through the two encodes
+/// (`None` without one: nothing to model from): inside the bracket when there is one (the secant through the two encodes
 /// nearest the aim if it falls well inside, else the secant through the bracket's ends, pulled
 /// towards the middle if it would land at an end: regula falsi's fix), else along the secant of
 /// the last two encodes (its slope kept within a factor of 4 of the `prior`, and of its sign), or
 /// the prior's slope after one encode.
-fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> f64 {
+fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> Option<f64> {
     if let Some((below, above)) = bracket(points, aim) {
         // A bracket's far end may lie where the curve bends (pdance AV1's error, quality 50
         // against 77), and regula falsi between its ends then lands off.
         let (lo, hi) = (below.0.min(above.0), below.0.max(above.0));
         let inside = |u: &f64| *u > lo + 0.02 * (hi - lo) && *u < hi - 0.02 * (hi - lo);
         if let Some(u) = nearest_secant(points, aim, prior).filter(inside) {
-            return u;
+            return Some(u);
         }
         let t = ((aim - below.1) / (above.1 - below.1)).clamp(0.1, 0.9);
-        return below.0 + t * (above.0 - below.0);
+        return Some(below.0 + t * (above.0 - below.0));
     }
-    let Some(&last) = points.last() else {
-        return aim;
-    };
+    let &last = points.last()?;
     let slope = match points.len() {
         n if n >= 2 => {
             let before = points[n - 2];
@@ -492,7 +493,7 @@ fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> f64 {
         }
         _ => prior,
     };
-    last.0 + (aim - last.1) / slope
+    Some(last.0 + (aim - last.1) / slope)
 }
 
 /// Where the secant through the two encodes whose modelled measures are nearest `aim` meets it;
@@ -564,15 +565,16 @@ mod tests {
             point(45.98, 1.9234e-4),
         ];
         let aim = 1.97e-4f64.ln();
-        let u = next_log_scale(&points, aim, 1.0);
+        let u = next_log_scale(&points, aim, 1.0).unwrap_or(f64::NAN);
         // The secant through 77.01 and 86.22 (slope 0.95) puts it at scale 47.1 (quality 76.4,
         // which codes 1.97e-4); regula falsi's tenth towards quality 50 put it at 49.7 (75.15,
         // 2.10e-4: over the budget).
         assert!((u.exp() - 47.1).abs() < 0.3, "scale {}", u.exp());
         // Without a bracket: the secant of the last two encodes, then the prior alone.
-        let u = next_log_scale(&points[..2], aim, 1.0);
+        let u = next_log_scale(&points[..2], aim, 1.0).unwrap_or(f64::NAN);
         assert!(u.exp() > 27.56 && u.exp() < 100.0, "scale {}", u.exp());
-        let u = next_log_scale(&points[..1], aim, 1.0);
+        let u = next_log_scale(&points[..1], aim, 1.0).unwrap_or(f64::NAN);
         assert!((u - (100f64.ln() + aim - 4.27e-4f64.ln())).abs() < 1e-12);
+        assert_eq!(next_log_scale(&[], aim, 1.0), None, "nothing to model from");
     }
 }
