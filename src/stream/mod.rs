@@ -9,6 +9,7 @@ pub mod container;
 pub mod entropy;
 pub mod frame_index;
 pub mod header;
+pub mod lattice_coding;
 mod part_table;
 pub mod segments;
 pub mod side_info;

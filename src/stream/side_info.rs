@@ -1,10 +1,10 @@
-//! Entropy coding of the side information: the partition, the lattice coordinates, the skinning
-//! weights, and (in [`super::affine_coding`]) the affine coefficients. Each is written once as a
-//! traversal generic over [`SymbolCoder`], so the encoder and the decoder cannot drift apart.
+//! Entropy coding of the side information: the partition, the skinning weights, and (in
+//! [`super::affine_coding`] and [`super::lattice_coding`]) the affine coefficients and the lattice
+//! coordinates. Each is written once as a traversal generic over [`SymbolCoder`], so the encoder
+//! and the decoder cannot drift apart.
 //!
 //! What is exploited: labels are spatially coherent (a vertex usually shares the label most of its
-//! already-coded neighbours have); lattice coordinates of mesh neighbours are near each other;
-//! skinning weights vary smoothly over the surface and are large only near the cluster they blend
+//! already-coded neighbours have); skinning weights vary smoothly over the surface and are large only near the cluster they blend
 //! toward.
 
 use crate::error::{Error, Result};
@@ -16,6 +16,7 @@ pub(crate) use super::affine_coding::decode_checked_affine;
 #[cfg(any(test, feature = "internals"))]
 pub use super::affine_coding::decode_affine;
 pub use super::affine_coding::{check_affine, encode_affine};
+pub use super::lattice_coding::{decode_lattice, encode_lattice};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::entropy::{
     self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel,
@@ -118,71 +119,6 @@ pub fn decode_partition(
     let mut labels = vec![0u32; vertices];
     code_partition(&mut dec, &mut labels, clusters, (&adj, &coincident))?;
     Ok(labels)
-}
-
-fn code_lattice<C: SymbolCoder>(
-    c: &mut C,
-    pixels: &mut [[u16; 2]],
-    size: (u16, u16),
-    adj: &VertexAdjacency,
-) -> Result<()> {
-    let mut near = [IntModel::default(), IntModel::default()];
-    let mut far = [IntModel::default(), IntModel::default()];
-    let limits = [size.0 as i64, size.1 as i64];
-    for v in 0..pixels.len() {
-        let (mut sum, mut n) = ([0i64; 2], 0i64);
-        for &w in adj.neighbours(v).iter().filter(|&&w| (w as usize) < v) {
-            let p = pixels[w as usize];
-            sum[0] += p[0] as i64;
-            sum[1] += p[1] as i64;
-            n += 1;
-        }
-        let (guess, models) = if n > 0 {
-            ([(sum[0] + n / 2) / n, (sum[1] + n / 2) / n], &mut near)
-        } else if v > 0 {
-            ([pixels[v - 1][0] as i64, pixels[v - 1][1] as i64], &mut far)
-        } else {
-            ([0, 0], &mut far)
-        };
-        for a in 0..2 {
-            let d = c.signed(pixels[v][a] as i64 - guess[a], &mut models[a])?;
-            let value = guess[a] + d;
-            if !(0..limits[a]).contains(&value) {
-                return Err(Error::Stream(format!(
-                    "lattice coordinate of vertex {v} is outside the lattice"
-                )));
-            }
-            pixels[v][a] = value as u16;
-        }
-    }
-    Ok(())
-}
-
-/// Codes the lattice pixel of each vertex.
-pub fn encode_lattice(
-    pixels: &[[u16; 2]],
-    size: (u16, u16),
-    triangles: &[Triangle],
-) -> Result<Vec<u8>> {
-    let adj = VertexAdjacency::new(pixels.len(), triangles);
-    let mut enc = Encoder::new();
-    code_lattice(&mut enc, &mut pixels.to_vec(), size, &adj)?;
-    enc.finish()
-}
-
-/// Decodes `vertices` lattice pixels inside a `size` lattice.
-pub fn decode_lattice(
-    bytes: &[u8],
-    vertices: usize,
-    size: (u16, u16),
-    triangles: &[Triangle],
-) -> Result<Vec<[u16; 2]>> {
-    check_capacity(2 * vertices as u64, bytes.len(), "lattice coordinates")?;
-    let adj = VertexAdjacency::new(vertices, triangles);
-    let mut dec = Decoder::new(bytes)?;
-    let mut pixels = vec![[0u16; 2]; vertices];
-    code_lattice(&mut dec, &mut pixels, size, &adj)?;
-    Ok(pixels)
 }
 
 /// Per vertex, the weight toward each neighbouring cluster as a difference from a guess: the same

@@ -11,8 +11,9 @@ use crate::geometry_image::Lattice;
 use crate::stream::bytes::{ByteReader, ByteWriter};
 
 /// The version of the set-up part this build writes and reads (2: the ranges part entropy-coded,
-/// `geometry_image::range_coding`).
-const VERSION: u8 = 2;
+/// `geometry_image::range_coding`; 3: lattice coordinates guessed from the nearest group of
+/// coded neighbours, `stream::lattice_coding`).
+const VERSION: u8 = 3;
 
 /// A geometry-video stream's set-up.
 #[derive(Debug, Clone, PartialEq)]
