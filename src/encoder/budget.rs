@@ -96,14 +96,17 @@ impl Budget {
 
     /// The first guess of d ln(measure) / d ln(target step), a size's measure being its bytes
     /// beyond the fixed ones: the temporal DCT's fall about as the step to the power 0.75, the
-    /// picture codecs' as its power 1.3 (0.6 to 2.1 between qualities 10 and 90); the temporal
-    /// DCT's error follows the step nearly in proportion, and so do HEVC's and AV1's, whose
-    /// quantisers follow it (0.9-1.1 from quality 40 to 75 on pdance and chickenCrossing); JPEG's
-    /// and MPEG-4's, whose laws move the pixel step, about as its power 0.6 (docs/design.md,
-    /// "Budgets").
+    /// picture codecs' as its power 1.3 (JPEG) to 1.9 (MPEG-4), each the median of six searches
+    /// (AV1's ranged 0.7 to 1.9, JPEG's 1.0 to 2.4); the temporal DCT's error follows the step
+    /// nearly in proportion, and so do HEVC's and AV1's, whose quantisers follow it (0.9-1.1
+    /// from quality 40 to 75 on pdance and chickenCrossing); JPEG's and MPEG-4's, whose laws move
+    /// the pixel step, about as its power 0.6 (docs/design.md, "Budgets").
     fn prior_slope(&self, codec: Codec) -> f64 {
         match (self.is_size(), codec) {
             (true, Codec::Tdct) => -0.75,
+            (true, Codec::Av1) => -1.6,
+            (true, Codec::Hevc) => -1.5,
+            (true, Codec::Mpeg4) => -1.9,
             (true, _) => -1.3,
             (false, Codec::Tdct) => 0.9,
             (false, Codec::Hevc | Codec::Av1) => 1.0,
@@ -267,6 +270,8 @@ struct Search<'a> {
     fixed: f64,
     /// Of those, the bytes no quality changes (all but the skinning weights).
     unchanging: f64,
+    /// Each encode's fixed bytes, in the order of `trials` (empty for an error budget).
+    fixed_of: Vec<f64>,
     trials: Vec<BudgetTrial>,
     best: Option<(Encoded, usize)>,
     model: String,
@@ -281,6 +286,7 @@ impl<'a> Search<'a> {
             limit: budget.limit(mesh),
             fixed: 0.0,
             unchanging: 0.0,
+            fixed_of: Vec::new(),
             trials: Vec::new(),
             best: None,
             model: String::new(),
@@ -315,6 +321,7 @@ impl<'a> Search<'a> {
             let weights = encoded.container.bytes_of(|tag| tag == Tag::WEIGHTS) as f64;
             self.fixed = measure - segments;
             self.unchanging = self.fixed - weights;
+            self.fixed_of.push(self.fixed);
         }
         self.trials.push(trial);
         let better = match &self.best {
@@ -337,9 +344,18 @@ impl<'a> Search<'a> {
         if best.is_some_and(|m| self.landed(m)) || self.trials.len() >= MAX_BUDGET_ENCODES {
             return Ok(None);
         }
-        let Some(u) = self.next_log_scale(self.aim()?) else {
+        let Some(mut u) = self.next_log_scale(self.aim(self.fixed)?) else {
             return Ok(None);
         };
+        // A size's fixed bytes move with the quality too (the skinning weights' bits): aim with
+        // those the encodes around the guess put there, twice.
+        if self.fixed_of.len() >= 2 {
+            for _ in 0..2 {
+                if let Some(next) = self.next_log_scale(self.aim(self.fixed_at(u))?) {
+                    u = next;
+                }
+            }
+        }
         let (lowest, highest) = (log_scale(100.0), log_scale(1.0));
         let mut quality = quality_of(u.clamp(lowest, highest));
         // A quality already coded: step a hundredth at a time towards the budget's side.
@@ -355,28 +371,60 @@ impl<'a> Search<'a> {
     }
 
     /// What the model is linear in against the log scale: the log of an error, or of the bytes
-    /// of a size beyond the latest encode's fixed bytes — the segments' parts, which the step
-    /// moves smoothly, while the fixed bytes are the same at every quality or jump (the skinning
-    /// weights' bits follow the affine step), so that a jump moves the aim instead of bending
-    /// the line (docs/design.md, "Budgets").
-    fn modelled(&self, measure: f64) -> f64 {
+    /// of a size beyond `fixed` bytes — the segments' parts, which the step moves smoothly, while
+    /// the fixed bytes change little or jump (the skinning weights' bits follow the affine step),
+    /// so that a jump moves the aim instead of bending the line (docs/design.md, "Budgets").
+    fn modelled(&self, measure: f64, fixed: f64) -> f64 {
         match self.budget.is_size() {
-            true => (measure - self.fixed).max(1.0).ln(),
+            true => (measure - fixed).max(1.0).ln(),
             false => measure.max(1e-300).ln(),
         }
     }
 
-    /// (log scale, modelled measure) of each encode.
+    /// (log scale, modelled measure) of each encode, a size's beyond that encode's own fixed
+    /// bytes.
     fn modelled_points(&self) -> Vec<(f64, f64)> {
-        (self.trials.iter())
-            .map(|t| (log_scale(t.quality), self.modelled(self.budget.measure(t))))
+        (self.trials.iter().enumerate())
+            .map(|(i, t)| {
+                let fixed = self.fixed_of.get(i).copied().unwrap_or(0.0);
+                (
+                    log_scale(t.quality),
+                    self.modelled(self.budget.measure(t), fixed),
+                )
+            })
             .collect()
     }
 
+    /// A size's fixed bytes at log scale `u`: interpolated between the encodes on either side,
+    /// else those of the nearest encode (0 for an error budget).
+    fn fixed_at(&self, u: f64) -> f64 {
+        let mut known: Vec<(f64, f64)> = (self.trials.iter().zip(&self.fixed_of))
+            .map(|(t, &f)| (log_scale(t.quality), f))
+            .collect();
+        known.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (Some(first), Some(last)) = (known.first(), known.last()) else {
+            return 0.0;
+        };
+        if u <= first.0 {
+            return first.1;
+        }
+        if u >= last.0 {
+            return last.1;
+        }
+        known
+            .windows(2)
+            .find(|w| w[0].0 <= u && u <= w[1].0)
+            .map_or(last.1, |w| {
+                let span = w[1].0 - w[0].0;
+                let t = if span > 0.0 { (u - w[0].0) / span } else { 0.0 };
+                w[0].1 + t * (w[1].1 - w[0].1)
+            })
+    }
+
     /// The modelled measure to aim at: the middle of the window, so that a model off by half
-    /// the tolerance lands (a size: at least half of what the fixed bytes leave under the
-    /// limit); fails when the bytes no quality changes fill a size budget alone.
-    fn aim(&self) -> Result<f64> {
+    /// the tolerance lands (a size: beyond `fixed` bytes, at least half of what they leave under
+    /// the limit); fails when the bytes no quality changes fill a size budget alone.
+    fn aim(&self, fixed: f64) -> Result<f64> {
         let aim = self.limit * (1.0 - 0.5 * self.budget.tolerance());
         if self.budget.is_size() && self.unchanging >= self.limit {
             return Err(Error::option(
@@ -388,8 +436,8 @@ impl<'a> Search<'a> {
                 ),
             ));
         }
-        let room = self.limit - self.fixed;
-        Ok(self.modelled(aim.max(self.fixed + 0.5 * room)))
+        let room = self.limit - fixed;
+        Ok(self.modelled(aim.max(fixed + 0.5 * room), fixed))
     }
 
     /// Where the model puts the aim ([`next_log_scale`]) with this budget's prior slope; `None`
