@@ -11,6 +11,7 @@
 //! regula falsi inside the bracket if the model misses. It never returns a stream over the budget
 //! (docs/design.md, "Budgets").
 
+use super::budget_line::{interpolated, next_log_scale};
 use super::{
     encode_reusing, encode_with_progress, EncodeOptions, Encoded, PredictorChoice, Reuse,
     SegmentationChoice,
@@ -398,27 +399,10 @@ impl<'a> Search<'a> {
     /// A size's fixed bytes at log scale `u`: interpolated between the encodes on either side,
     /// else those of the nearest encode (0 for an error budget).
     fn fixed_at(&self, u: f64) -> f64 {
-        let mut known: Vec<(f64, f64)> = (self.trials.iter().zip(&self.fixed_of))
+        let known: Vec<(f64, f64)> = (self.trials.iter().zip(&self.fixed_of))
             .map(|(t, &f)| (log_scale(t.quality), f))
             .collect();
-        known.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let (Some(first), Some(last)) = (known.first(), known.last()) else {
-            return 0.0;
-        };
-        if u <= first.0 {
-            return first.1;
-        }
-        if u >= last.0 {
-            return last.1;
-        }
-        known
-            .windows(2)
-            .find(|w| w[0].0 <= u && u <= w[1].0)
-            .map_or(last.1, |w| {
-                let span = w[1].0 - w[0].0;
-                let t = if span > 0.0 { (u - w[0].0) / span } else { 0.0 };
-                w[0].1 + t * (w[1].1 - w[0].1)
-            })
+        interpolated(&known, u).unwrap_or(0.0)
     }
 
     /// The modelled measure to aim at: the middle of the window, so that a model off by half
@@ -510,72 +494,6 @@ impl<'a> Search<'a> {
     }
 }
 
-/// Where the model puts the aim, from the encodes' (log scale, modelled measure) `points`
-/// (`None` without one: nothing to model from): inside the bracket when there is one (the secant through the two encodes
-/// nearest the aim if it falls well inside, else the secant through the bracket's ends, pulled
-/// towards the middle if it would land at an end: regula falsi's fix), else along the secant of
-/// the last two encodes (its slope kept within a factor of 4 of the `prior`, and of its sign), or
-/// the prior's slope after one encode.
-fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> Option<f64> {
-    if let Some((below, above)) = bracket(points, aim) {
-        // A bracket's far end may lie where the curve bends (pdance AV1's error, quality 50
-        // against 77), and regula falsi between its ends then lands off.
-        let (lo, hi) = (below.0.min(above.0), below.0.max(above.0));
-        let inside = |u: &f64| *u > lo + 0.02 * (hi - lo) && *u < hi - 0.02 * (hi - lo);
-        if let Some(u) = nearest_secant(points, aim, prior).filter(inside) {
-            return Some(u);
-        }
-        let t = ((aim - below.1) / (above.1 - below.1)).clamp(0.1, 0.9);
-        return Some(below.0 + t * (above.0 - below.0));
-    }
-    let &last = points.last()?;
-    let slope = match points.len() {
-        n if n >= 2 => {
-            let before = points[n - 2];
-            let s = (last.1 - before.1) / (last.0 - before.0);
-            if s.is_finite() && s * prior > 0.0 {
-                prior.signum() * s.abs().clamp(prior.abs() / 4.0, prior.abs() * 4.0)
-            } else {
-                prior
-            }
-        }
-        _ => prior,
-    };
-    Some(last.0 + (aim - last.1) / slope)
-}
-
-/// Where the secant through the two encodes whose modelled measures are nearest `aim` meets it;
-/// `None` when the secant is flat, not finite, or slopes against the `prior`.
-fn nearest_secant(points: &[(f64, f64)], aim: f64, prior: f64) -> Option<f64> {
-    let mut by_distance = points.to_vec();
-    by_distance.sort_by(|a, b| (a.1 - aim).abs().total_cmp(&(b.1 - aim).abs()));
-    let (p, q) = (by_distance.first()?, by_distance.get(1)?);
-    let slope = (q.1 - p.1) / (q.0 - p.0);
-    let u = p.0 + (aim - p.1) / slope;
-    (slope * prior > 0.0 && u.is_finite()).then_some(u)
-}
-
-/// Two encodes next to each other in log scale whose measures lie on either side of the aim
-/// (below, above): of such pairs, the one with an end nearest the aim. Adjacent in the step,
-/// not nearest in the measure, so that a measure that is not monotone (the largest vertex
-/// error jumps from one quality to the next) still narrows the bracket at each encode.
-fn bracket(points: &[(f64, f64)], aim: f64) -> Option<((f64, f64), (f64, f64))> {
-    let mut sorted = points.to_vec();
-    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-    sorted
-        .windows(2)
-        .filter(|w| (w[0].1 > aim) != (w[1].1 > aim))
-        .map(|w| match w[0].1 > aim {
-            true => (w[1], w[0]),
-            false => (w[0], w[1]),
-        })
-        .min_by(|x, y| {
-            let near =
-                |p: &((f64, f64), (f64, f64))| (p.0 .1 - aim).abs().min((p.1 .1 - aim).abs());
-            near(x).total_cmp(&near(y))
-        })
-}
-
 /// The vertex RMSE and the largest vertex error of `encoded` against `mesh`, as fractions of the
 /// first frame's bounding-box diagonal (`eval`'s `vertex_rmse`).
 fn vertex_errors(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<(f64, f64)> {
@@ -596,33 +514,4 @@ fn vertex_errors(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<(f64, f64)> {
     let diagonal = mesh.bbox_diagonal();
     let count = (mesh.vertex_count() * mesh.frame_count()).max(1) as f64;
     Ok(((sum / count).sqrt() / diagonal, max.sqrt() / diagonal))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_bracket_with_a_bent_far_end_is_searched_along_the_nearest_secant() {
-        // pdance AV1's vertex RMSE against ln(IJG scale): quality 50 (scale 100), 86.22 and
-        // 77.01; the aim (1.97e-4, mid-window under 2e-4) lies just above the last encode.
-        let point = |scale: f64, rmse: f64| (scale.ln(), rmse.ln());
-        let points = [
-            point(100.0, 4.27e-4),
-            point(27.56, 1.1825e-4),
-            point(45.98, 1.9234e-4),
-        ];
-        let aim = 1.97e-4f64.ln();
-        let u = next_log_scale(&points, aim, 1.0).unwrap_or(f64::NAN);
-        // The secant through 77.01 and 86.22 (slope 0.95) puts it at scale 47.1 (quality 76.4,
-        // which codes 1.97e-4); regula falsi's tenth towards quality 50 put it at 49.7 (75.15,
-        // 2.10e-4: over the budget).
-        assert!((u.exp() - 47.1).abs() < 0.3, "scale {}", u.exp());
-        // Without a bracket: the secant of the last two encodes, then the prior alone.
-        let u = next_log_scale(&points[..2], aim, 1.0).unwrap_or(f64::NAN);
-        assert!(u.exp() > 27.56 && u.exp() < 100.0, "scale {}", u.exp());
-        let u = next_log_scale(&points[..1], aim, 1.0).unwrap_or(f64::NAN);
-        assert!((u - (100f64.ln() + aim - 4.27e-4f64.ln())).abs() < 1e-12);
-        assert_eq!(next_log_scale(&[], aim, 1.0), None, "nothing to model from");
-    }
 }

@@ -10,6 +10,7 @@
 
 mod attributes;
 mod budget;
+mod budget_line;
 mod choice_reason;
 mod options;
 internal! {
