@@ -265,14 +265,13 @@ struct Search<'a> {
     budget: Budget,
     codec: Codec,
     limit: f64,
-    /// A size budget's bytes outside the temporal segments' parts in the latest encode (first
-    /// frame, partition, atlas, skinning weights…), which the model leaves out; 0 for an error
-    /// budget.
-    fixed: f64,
-    /// Of those, the bytes no quality changes (all but the skinning weights).
-    unchanging: f64,
-    /// Each encode's fixed bytes, in the order of `trials` (empty for an error budget).
+    /// Each encode's fixed bytes, in the order of `trials`: a size budget's bytes outside the
+    /// temporal segments' parts (first frame, partition, atlas, skinning weights…), which the
+    /// model leaves out; empty for an error budget.
     fixed_of: Vec<f64>,
+    /// Of the latest encode's fixed bytes, those no quality changes (all but the skinning
+    /// weights).
+    unchanging: f64,
     trials: Vec<BudgetTrial>,
     best: Option<(Encoded, usize)>,
     model: String,
@@ -285,9 +284,8 @@ impl<'a> Search<'a> {
             budget,
             codec: opts.codec.codec(),
             limit: budget.limit(mesh),
-            fixed: 0.0,
-            unchanging: 0.0,
             fixed_of: Vec::new(),
+            unchanging: 0.0,
             trials: Vec::new(),
             best: None,
             model: String::new(),
@@ -320,9 +318,9 @@ impl<'a> Search<'a> {
         if self.budget.is_size() {
             let segments = encoded.container.bytes_of(Tag::per_segment) as f64;
             let weights = encoded.container.bytes_of(|tag| tag == Tag::WEIGHTS) as f64;
-            self.fixed = measure - segments;
-            self.unchanging = self.fixed - weights;
-            self.fixed_of.push(self.fixed);
+            let fixed = measure - segments;
+            self.unchanging = fixed - weights;
+            self.fixed_of.push(fixed);
         }
         self.trials.push(trial);
         let better = match &self.best {
@@ -345,7 +343,8 @@ impl<'a> Search<'a> {
         if best.is_some_and(|m| self.landed(m)) || self.trials.len() >= MAX_BUDGET_ENCODES {
             return Ok(None);
         }
-        let Some(mut u) = self.next_log_scale(self.aim(self.fixed)?) else {
+        let latest = self.fixed_of.last().copied().unwrap_or(0.0);
+        let Some(mut u) = self.next_log_scale(self.aim(latest)?) else {
             return Ok(None);
         };
         // A size's fixed bytes move with the quality too (the skinning weights' bits): aim with

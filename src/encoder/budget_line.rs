@@ -4,11 +4,11 @@
 //! bracket the secant nearest the aim or regula falsi (docs/design.md, "Budgets").
 
 /// Where the model puts the aim, from the encodes' (log scale, modelled measure) `points`
-/// (`None` without one: nothing to model from): inside the bracket when there is one (the secant through the two encodes
-/// nearest the aim if it falls well inside, else the secant through the bracket's ends, pulled
-/// towards the middle if it would land at an end: regula falsi's fix), else along the secant of
-/// the last two encodes (its slope kept within a factor of 4 of the `prior`, and of its sign), or
-/// the prior's slope after one encode.
+/// (`None` without one: nothing to model from): inside the bracket when there is one (the secant
+/// through the two encodes nearest the aim if it falls well inside, else the secant through the
+/// bracket's ends, pulled towards the middle if it would land at an end: regula falsi's fix),
+/// else along the secant of the last two encodes (its slope kept within a factor of 4 of the
+/// `prior`, and of its sign), or the prior's slope after one encode.
 pub(super) fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> Option<f64> {
     if let Some((below, above)) = bracket(points, aim) {
         // A bracket's far end may lie where the curve bends (pdance AV1's error, quality 50

@@ -23,7 +23,7 @@ use crate::stream::entropy::{
 };
 
 /// Refuses a decode that would need more symbols than `bytes` can possibly hold, before allocating.
-fn check_capacity(symbols: u64, bytes: usize, what: &str) -> Result<()> {
+pub(super) fn check_capacity(symbols: u64, bytes: usize, what: &str) -> Result<()> {
     if symbols > entropy::max_symbols(bytes) {
         return Err(Error::Stream(format!(
             "{what}: {symbols} values cannot fit in {bytes} bytes"

@@ -318,8 +318,10 @@ mod tests {
         // quantisers' rounding, JPEG's and MPEG-4's meet a finer quantiser at an anchor): the
         // two together fall (above). Where the quantiser holds, the pixel step falls.
         let hevc10 = |q| hevc_law(q, 10);
+        let hevc12 = |q| hevc_law(q, 12);
         let av1_10 = |q| av1_law(q, 10);
-        for law in [jpeg_law, mpeg4_law, hevc10, av1_10] {
+        let av1_12 = |q| av1_law(q, 12);
+        for law in [jpeg_law, mpeg4_law, hevc10, hevc12, av1_10, av1_12] {
             for q in 1..100u8 {
                 let (a, b) = (law(q), law(q + 1));
                 let step = |l: PictureLaw, q| l.step_factor * target_step(q, 1.0);
