@@ -29,7 +29,7 @@ pub use quantise::{Cell, Grid};
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::{Point, Triangle};
-use crate::stream::entropy::{max_symbols, Decoder, Encoder, SymbolCoder, UIntModel};
+use crate::stream::entropy::{check_capacity, Decoder, Encoder, SymbolCoder, UIntModel};
 use traversal::{Models, Oracle, UNASSIGNED};
 use weld::Weld;
 
@@ -548,11 +548,8 @@ impl Header {
             ),
             (format!("{ordered} vertices"), 4 * ordered, "order", lo),
         ] {
-            if symbols > max_symbols(len as usize) {
-                return Err(Error::Stream(format!(
-                    "first frame: {what} cannot fit in a {stream} stream of {len} bytes"
-                )));
-            }
+            let what = format!("first frame, {what} in the {stream} stream");
+            check_capacity(symbols, len as usize, &what)?;
         }
         Ok(header)
     }

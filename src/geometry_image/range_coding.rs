@@ -187,9 +187,8 @@ pub fn decode_ranges(
     }
     let coded = r.take(r.remaining())?;
     // Every frame codes at least four symbols (three ranges, a correction count).
-    if (frames as u64).saturating_mul(4) > entropy::max_symbols(coded.len()) {
-        return Err(Error::Stream("residual ranges are truncated".into()));
-    }
+    let symbols = (frames as u64).saturating_mul(4);
+    entropy::check_capacity(symbols, coded.len(), "residual ranges")?;
     let mut dec = Decoder::new(coded)?;
     let mut m = Models::default();
     let mut ranges = vec![[AxisRange::at_depth(pixel_step, 0, depth); 3]; frames];

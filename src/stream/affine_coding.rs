@@ -403,12 +403,7 @@ impl<'a> AffinePart<'a> {
         let count = (frames as u64)
             .saturating_mul(clusters as u64)
             .saturating_mul(12);
-        if count > entropy::max_symbols(coded.len()) {
-            return Err(Error::Stream(format!(
-                "affine coefficients: {count} values cannot fit in {} bytes",
-                coded.len()
-            )));
-        }
+        entropy::check_capacity(count, coded.len(), "affine coefficients")?;
         // The step sets the identity's levels below: refuse a forged one first.
         QuantisedAffine::check_step(step)?;
         let geometry = ClusterGeometry::of(reference, partition);

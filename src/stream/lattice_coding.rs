@@ -14,8 +14,7 @@
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
-use crate::stream::entropy::{Decoder, Encoder, IntModel, SymbolCoder, SymbolModel};
-use crate::stream::side_info::check_capacity;
+use crate::stream::entropy::{self, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel};
 
 /// Pixels (along each axis) within which a coded neighbour joins a group's centre.
 const GROUP_RADIUS: i64 = 4;
@@ -155,7 +154,7 @@ pub fn decode_lattice(
     size: (u16, u16),
     triangles: &[Triangle],
 ) -> Result<Vec<[u16; 2]>> {
-    check_capacity(2 * vertices as u64, bytes.len(), "lattice coordinates")?;
+    entropy::check_capacity(2 * vertices as u64, bytes.len(), "lattice coordinates")?;
     let adj = VertexAdjacency::new(vertices, triangles);
     let mut dec = Decoder::new(bytes)?;
     let mut pixels = vec![[0u16; 2]; vertices];

@@ -22,16 +22,6 @@ use crate::stream::entropy::{
     self, BitModel, Decoder, Encoder, IntModel, SymbolCoder, SymbolModel, UIntModel,
 };
 
-/// Refuses a decode that would need more symbols than `bytes` can possibly hold, before allocating.
-pub(super) fn check_capacity(symbols: u64, bytes: usize, what: &str) -> Result<()> {
-    if symbols > entropy::max_symbols(bytes) {
-        return Err(Error::Stream(format!(
-            "{what}: {symbols} values cannot fit in {bytes} bytes"
-        )));
-    }
-    Ok(())
-}
-
 /// The label most common among `v`'s already-coded neighbours (lowest on ties), if any.
 fn predicted_label(
     adj: &VertexAdjacency,
@@ -112,7 +102,7 @@ pub fn decode_partition(
     clusters: usize,
     (triangles, reference): (&[Triangle], &[Point]),
 ) -> Result<Vec<u32>> {
-    check_capacity(vertices as u64, bytes.len(), "partition")?;
+    entropy::check_capacity(vertices as u64, bytes.len(), "partition")?;
     let adj = VertexAdjacency::new(vertices, triangles);
     let coincident = coincident_first(reference);
     let mut dec = Decoder::new(bytes)?;
@@ -245,7 +235,7 @@ pub fn decode_weights(
     let count = SkinningWeights::expected_count(&neighbours, partition.labels())
         .ok_or_else(|| Error::Stream("skinning weights: partition out of range".into()))?;
     let rest = r.take(r.remaining())?;
-    check_capacity(count as u64, rest.len(), "skinning weights")?;
+    entropy::check_capacity(count as u64, rest.len(), "skinning weights")?;
     let mut weights = SkinningWeights {
         bits,
         limit,

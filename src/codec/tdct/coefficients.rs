@@ -272,12 +272,7 @@ impl BandCoder {
         }
         let n = self.previous.len();
         // Refuse before allocating: a band holds one coded symbol or more per coefficient.
-        if n as u64 > entropy::max_symbols(bytes.len()) {
-            return Err(Error::Stream(format!(
-                "temporal-DCT band {k}: {n} coefficients cannot fit in {} bytes",
-                bytes.len()
-            )));
-        }
+        entropy::check_capacity(n as u64, bytes.len(), &format!("temporal-DCT band {k}"))?;
         let mut dec = entropy::Decoder::new(bytes)?;
         let mut levels = vec![0i64; n];
         self.code(&mut dec, k, Spatial::None, &mut levels, None)

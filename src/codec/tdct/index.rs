@@ -118,12 +118,7 @@ impl BandIndex {
             )));
         }
         let candidates = dec.unsigned(&mut UIntModel::default())?;
-        if candidates > entropy::max_symbols(bytes.len()) {
-            return Err(Error::Stream(format!(
-                "temporal-DCT index: {candidates} copy bits cannot fit in its {} bytes",
-                bytes.len()
-            )));
-        }
+        entropy::check_capacity(candidates, bytes.len(), "temporal-DCT index, copy bits")?;
         let mut copy = BitModel::default();
         let copies = (0..candidates)
             .map(|_| dec.bit(&mut copy))

@@ -11,6 +11,7 @@
 
 use std::borrow::Borrow;
 use std::num::NonZeroU32;
+use crate::error::{Error, Result};
 
 use constriction::stream::model::{DecoderModel, EncoderModel, EntropyModel};
 
@@ -35,6 +36,17 @@ const MAX_SYMBOLS_PER_BIT: u64 = 710;
 /// allocating anything.
 pub fn max_symbols(byte_len: usize) -> u64 {
     (byte_len as u64 + 8) * 8 * MAX_SYMBOLS_PER_BIT
+}
+
+/// Refuses, before anything is allocated, a count of `symbols` that a decoder over `bytes` bytes
+/// could never read ([`max_symbols`]): a forged or corrupted count in a header.
+pub fn check_capacity(symbols: u64, bytes: usize, what: &str) -> Result<()> {
+    if symbols > max_symbols(bytes) {
+        return Err(Error::Stream(format!(
+            "{what}: {symbols} values cannot fit in {bytes} bytes"
+        )));
+    }
+    Ok(())
 }
 
 /// An adaptive probability for one binary decision.
