@@ -1,20 +1,53 @@
-//! Where a budget search's next encode goes: a line through the encodes so far, in the modelled
+//! Where a budget search's next encode goes: a curve through the encodes so far, in the modelled
 //! measure (the log of an error, or of a size's bytes beyond its fixed ones) against the log of
-//! the target step — the prior's slope after one encode, the secant of the last two, and inside a
-//! bracket the secant nearest the aim or regula falsi (docs/design.md, "Budgets").
+//! the target step — the prior's slope after one encode, then the secant of the last two (bent by
+//! the codec's prior curvature where it has one), and inside a bracket that curve through its two
+//! ends, the secant nearest the aim, or regula falsi (docs/design.md, "Budgets").
+
+/// A codec's prior curvature of the modelled measure: its second derivative against the log
+/// step, beyond log step `from` (JPEG's bytes flatten below quality 50 as its pictures near their
+/// floor of block headers).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Bend {
+    /// d² measure / d(log step)².
+    pub curvature: f64,
+    /// The log step where the bend starts.
+    pub from: f64,
+}
+
+impl Bend {
+    /// The curvature between log steps `a` and `b`: the prior's when both lie past its start.
+    fn between(bend: Option<Bend>, a: f64, b: f64) -> f64 {
+        bend.filter(|k| a.min(b) >= k.from)
+            .map_or(0.0, |k| k.curvature)
+    }
+}
 
 /// Where the model puts the aim, from the encodes' (log scale, modelled measure) `points`
-/// (`None` without one: nothing to model from): inside the bracket when there is one (the secant
-/// through the two encodes nearest the aim if it falls well inside, else the secant through the
-/// bracket's ends, pulled towards the middle if it would land at an end: regula falsi's fix),
-/// else along the secant of the last two encodes (its slope kept within a factor of 4 of the
-/// `prior`, and of its sign), or the prior's slope after one encode.
-pub(super) fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> Option<f64> {
+/// (`None` without one: nothing to model from). Inside a bracket (encodes on either side of the
+/// aim): when it is the only two encodes and the prior `bend` applies, the curve of that
+/// curvature through them; else the secant through the two encodes nearest the aim if it falls
+/// well inside, else the secant through the bracket's ends, pulled towards the middle if it
+/// would land at an end (regula falsi's fix). Without a bracket:
+/// along the slope at the last encode of the curve through the last two (its slope kept within a
+/// factor of 4 of the `prior`, and of its sign), or the prior's slope after one encode.
+pub(super) fn next_log_scale(
+    points: &[(f64, f64)],
+    aim: f64,
+    prior: f64,
+    bend: Option<Bend>,
+) -> Option<f64> {
     if let Some((below, above)) = bracket(points, aim) {
-        // A bracket's far end may lie where the curve bends (pdance AV1's error, quality 50
-        // against 77), and regula falsi between its ends then lands off.
         let (lo, hi) = (below.0.min(above.0), below.0.max(above.0));
         let inside = |u: &f64| *u > lo + 0.02 * (hi - lo) && *u < hi - 0.02 * (hi - lo);
+        let c = Bend::between(bend, lo, hi);
+        if points.len() == 2 && c != 0.0 {
+            if let Some(u) = bent_root(below, above, aim, c).filter(inside) {
+                return Some(u);
+            }
+        }
+        // A bracket's far end may lie where the curve bends (pdance AV1's error, quality 50
+        // against 77), and regula falsi between its ends then lands off.
         if let Some(u) = nearest_secant(points, aim, prior).filter(inside) {
             return Some(u);
         }
@@ -25,7 +58,10 @@ pub(super) fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> Opt
     let slope = match points.len() {
         n if n >= 2 => {
             let before = points[n - 2];
-            let s = (last.1 - before.1) / (last.0 - before.0);
+            let secant = (last.1 - before.1) / (last.0 - before.0);
+            // The parabola of the prior curvature through both has this slope at the last.
+            let c = Bend::between(bend, last.0, before.0);
+            let s = secant + 0.5 * c * (last.0 - before.0);
             if s.is_finite() && s * prior > 0.0 {
                 prior.signum() * s.abs().clamp(prior.abs() / 4.0, prior.abs() * 4.0)
             } else {
@@ -35,6 +71,35 @@ pub(super) fn next_log_scale(points: &[(f64, f64)], aim: f64, prior: f64) -> Opt
         _ => prior,
     };
     Some(last.0 + (aim - last.1) / slope)
+}
+
+/// Where `f`, of opposite signs at `lo` and `hi`, is zero (bisection to the last bits);
+/// `None` without a change of sign.
+fn root(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> Option<f64> {
+    let (mut a, mut b) = (lo, hi);
+    let fa = f(a);
+    // NaN is no change of sign either.
+    (fa * f(b) < 0.0).then_some(())?;
+    for _ in 0..100 {
+        let m = 0.5 * (a + b);
+        if (f(m) < 0.0) == (fa < 0.0) {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    Some(0.5 * (a + b))
+}
+
+/// Where the parabola of curvature `c` through `p` and `q` meets `aim` between them.
+fn bent_root(p: (f64, f64), q: (f64, f64), aim: f64, c: f64) -> Option<f64> {
+    let slope = (q.1 - p.1) / (q.0 - p.0);
+    let (lo, hi) = (p.0.min(q.0), p.0.max(q.0));
+    root(
+        |u| p.1 + slope * (u - p.0) + 0.5 * c * (u - p.0) * (u - q.0) - aim,
+        lo,
+        hi,
+    )
 }
 
 /// Where the secant through the two encodes whose modelled measures are nearest `aim` meets it;
@@ -102,17 +167,46 @@ mod tests {
             point(45.98, 1.9234e-4),
         ];
         let aim = 1.97e-4f64.ln();
-        let u = next_log_scale(&points, aim, 1.0).unwrap_or(f64::NAN);
+        let u = next_log_scale(&points, aim, 1.0, None).unwrap_or(f64::NAN);
         // The secant through 77.01 and 86.22 (slope 0.95) puts it at scale 47.1 (quality 76.4,
         // which codes 1.97e-4); regula falsi's tenth towards quality 50 put it at 49.7 (75.15,
         // 2.10e-4: over the budget).
         assert!((u.exp() - 47.1).abs() < 0.3, "scale {}", u.exp());
         // Without a bracket: the secant of the last two encodes, then the prior alone.
-        let u = next_log_scale(&points[..2], aim, 1.0).unwrap_or(f64::NAN);
+        let u = next_log_scale(&points[..2], aim, 1.0, None).unwrap_or(f64::NAN);
         assert!(u.exp() > 27.56 && u.exp() < 100.0, "scale {}", u.exp());
-        let u = next_log_scale(&points[..1], aim, 1.0).unwrap_or(f64::NAN);
+        let u = next_log_scale(&points[..1], aim, 1.0, None).unwrap_or(f64::NAN);
         assert!((u - (100f64.ln() + aim - 4.27e-4f64.ln())).abs() < 1e-12);
-        assert_eq!(next_log_scale(&[], aim, 1.0), None, "nothing to model from");
+        assert_eq!(
+            next_log_scale(&[], aim, 1.0, None),
+            None,
+            "nothing to model from"
+        );
+    }
+
+    #[test]
+    fn a_bend_follows_jpegs_flattening_bytes() {
+        // pdance JPEG (skinning, K 20), ln(bytes beyond the fixed ones) against ln(IJG scale):
+        // quality 50 and 15 coded; quality 12 (ln scale 6.032) codes 11.198.
+        let points = [(4.605, 12.772), (5.809, 11.282)];
+        let jpeg = Some(Bend {
+            curvature: 1.5,
+            from: 4.605,
+        });
+        let straight = next_log_scale(&points, 11.198, -1.3, None).unwrap_or(f64::NAN);
+        let bent = next_log_scale(&points, 11.198, -1.3, jpeg).unwrap_or(f64::NAN);
+        assert!((straight - 6.032).abs() > 0.1, "{straight}");
+        assert!((bent - 6.032).abs() < 0.05, "{bent}");
+        // Before the bend's start the curve is the straight one.
+        let early = [(3.0, 14.0), (3.5, 13.4)];
+        assert_eq!(
+            next_log_scale(&early, 13.0, -1.3, jpeg),
+            next_log_scale(&early, 13.0, -1.3, None)
+        );
+        // A bracket of two encodes: the bent curve through them, between them.
+        let u = next_log_scale(&[(4.605, 12.772), (6.032, 11.198)], 11.282, -1.3, jpeg);
+        let u = u.unwrap_or(f64::NAN);
+        assert!(u > 5.7 && u < 6.032, "{u}");
     }
 
     #[test]
