@@ -257,6 +257,9 @@ impl TriangleGrid {
         let buckets = self.spans.len();
         let exact = |t: u32, best: &mut (f64, u32)| {
             if let Some(tri) = triangles.get(t as usize) {
+                if tri.plane_beyond(p, best.0) {
+                    return;
+                }
                 let d2 = tri.distance_squared(p);
                 if d2 < best.0 {
                     *best = (d2, t);

@@ -86,6 +86,18 @@ impl PreparedTriangle {
         }
     }
 
+    /// Whether the triangle's plane alone puts `p` beyond `bound` (a squared distance), so that
+    /// the triangle is no nearer: a dozen multiplications against the Voronoi walk. The margin
+    /// covers the rounding of both computations; a degenerate triangle is never judged so.
+    pub fn plane_beyond(&self, p: Vec3, bound: f64) -> bool {
+        if self.degenerate {
+            return false;
+        }
+        let n = cross(self.ab, self.ac);
+        let d = dot(n, sub(p, self.corners[0]));
+        d * d * (1.0 - 1e-6) > bound * dot(n, n)
+    }
+
     /// Squared distance from `p` to the triangle.
     pub fn distance_squared(&self, p: Vec3) -> f64 {
         distance_squared(p, self.closest_point(p))
