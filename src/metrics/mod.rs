@@ -266,6 +266,34 @@ mod tests {
     }
 
     #[test]
+    fn a_comparison_tells_its_progress_frame_by_frame() {
+        struct Count(std::sync::atomic::AtomicU64);
+        impl crate::progress::Progress for Count {
+            fn frames(&self, count: u64) {
+                self.0
+                    .fetch_add(count, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+        let (a, b) = (patch(5), moved(&patch(5), [0.0, 0.0, 0.01]));
+        fn surface(m: &AnimatedMesh) -> Surface<'_> {
+            Surface {
+                triangles: m.triangles(),
+                positions: m.frame(0),
+            }
+        }
+        let start = || Comparison::new(surface(&a), surface(&b)).unwrap_or_else(|e| panic!("{e}"));
+        let (mut told, mut silent) = (start(), start());
+        let count = Count(std::sync::atomic::AtomicU64::new(0));
+        told.add_with_progress(a.frames(), b.frames(), &count)
+            .unwrap_or_else(|e| panic!("{e}"));
+        silent
+            .add(a.frames(), b.frames())
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(count.0.load(std::sync::atomic::Ordering::Relaxed), 5);
+        assert_eq!(told.finish(), silent.finish());
+    }
+
+    #[test]
     fn kg_error_follows_its_definition() {
         // Two vertices at ±1 on x (centroid 0, spread² = 2 per frame); the copy moves one by 0.1.
         let a = AnimatedMesh::new(

@@ -6,6 +6,7 @@ use super::surface::{frame_distance_planned, FrameDistance, IndexCache, Surface,
 use super::{sampling, Measures, VertexSums};
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
+use crate::progress::{Progress, Silent};
 use rayon::prelude::*;
 
 /// Measures of a decoded animation against its original, fed frames in order.
@@ -47,6 +48,16 @@ impl Comparison {
 
     /// Measures the next frames: `original[i]` against `decoded[i]` (each run on several threads).
     pub fn add(&mut self, original: &[Vec<Point>], decoded: &[Vec<Point>]) -> Result<()> {
+        self.add_with_progress(original, decoded, &Silent)
+    }
+
+    /// [`Self::add`], telling `progress` of each frame measured (from the threads measuring).
+    pub fn add_with_progress(
+        &mut self,
+        original: &[Vec<Point>],
+        decoded: &[Vec<Point>],
+        progress: &dyn Progress,
+    ) -> Result<()> {
         if original.len() != decoded.len() {
             return Err(Error::Usage(format!(
                 "{} original frames against {} decoded ones",
@@ -74,6 +85,7 @@ impl Comparison {
                     Error::Mesh(m) => Error::Mesh(format!("frame {}: {m}", first + i)),
                     other => other,
                 })
+                .inspect(|_| progress.frames(1))
             })
             .collect::<Result<_>>()?;
         for d in &per_frame {
