@@ -11,9 +11,10 @@
 
 use std::borrow::Borrow;
 use std::num::NonZeroU32;
-use crate::error::{Error, Result};
 
 use constriction::stream::model::{DecoderModel, EncoderModel, EntropyModel};
+
+use crate::error::{Error, Result};
 
 mod coder;
 
