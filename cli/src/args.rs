@@ -151,7 +151,8 @@ pub struct EncodeArgs {
     #[arg(long, value_parser = parse_quality)]
     pub quality: Option<f64>,
     /// Budget: the stream's bytes at most; the encoder searches the quality whose stream lands
-    /// within 2 % under it (at most 10 encodes, usually 2 or 3; docs/design.md, "Budgets").
+    /// within 3 % under it, within 2 % when its first two encodes can (at most 10 encodes,
+    /// usually 2 or 3; docs/design.md, "Budgets").
     #[arg(long, value_name = "BYTES", group = "target", conflicts_with = "step",
           value_parser = clap::value_parser!(u64).range(1..))]
     pub target_size: Option<u64>,

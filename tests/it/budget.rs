@@ -333,7 +333,13 @@ fn pdance_lands_under_100_kb_and_under_2e_4() {
                 "pdance {codec:?} {budget:?}: quality {} in {} encodes, {} bytes, {:?}",
                 search.quality, search.encodes, found.encoded.report.bytes, search.achieved
             );
-            assert_within(&mesh, &found, budget, budget.tolerance());
+            // The size window is 98 000–100 000 bytes: 2 %, narrower than the 3 % a
+            // search accepts from its third encode on.
+            let tolerance = match budget {
+                Budget::Bytes(_) => 0.02,
+                _ => budget.tolerance(),
+            };
+            assert_within(&mesh, &found, budget, tolerance);
             assert!(search.encodes <= 3, "{search:?}");
         }
     }
