@@ -131,7 +131,44 @@ pub fn encode_options(
     };
     let clusters = k.int::<usize>("clusters")?;
     let e0 = k.float("e0")?;
-    let segmentation = match k.string("segmentation")?.as_deref().unwrap_or("auto") {
+    let segmentation = segmentation_choice(&k, clusters, e0)?;
+    let predictor = predictor_choice(&k)?;
+    let segment_frames = match k.dict.as_ref().map(|d| d.get_item("segment_frames")) {
+        None | Some(Ok(None)) => defaults.segment_frames,
+        // None, as the command line's 0, never cuts the clip.
+        Some(Ok(Some(v))) if v.is_none() => None,
+        Some(Ok(Some(_))) => match k.int::<usize>("segment_frames")? {
+            Some(0) => None,
+            n => n,
+        },
+        Some(Err(e)) => return Err(e),
+    };
+    Ok(EncodeOptions {
+        codec: codec_config(&k, codec)?,
+        quality: k.int::<u8>("quality")?.unwrap_or(defaults.quality),
+        step: k.float("step")?,
+        affine_precision: k.float("affine_precision")?,
+        clusters: clusters.unwrap_or(defaults.clusters),
+        segmentation,
+        predictor,
+        weight_bits: k.int::<u8>("weight_bits")?.unwrap_or(defaults.weight_bits),
+        first_frame_bits: k.int::<u8>("first_frame_bits")?,
+        reorder: k.typed::<bool>("reorder", "a bool")?.unwrap_or(false),
+        uv_bits: k.int::<u8>("uv_bits")?.unwrap_or(defaults.uv_bits),
+        segment_frames,
+        parallel_segments: threads.unwrap_or(defaults.parallel_segments),
+        fine_quality: None,
+    })
+}
+
+/// The segmentation of `k` (`auto` when not given), checked against the `clusters` and `e0`
+/// given.
+fn segmentation_choice(
+    k: &Keywords<'_>,
+    clusters: Option<usize>,
+    e0: Option<f64>,
+) -> PyResult<SegmentationChoice> {
+    let choice = match k.string("segmentation")?.as_deref().unwrap_or("auto") {
         "auto" => SegmentationChoice::Auto {
             e0: e0.unwrap_or(mcgv_video::encoder::DEFAULT_E0),
         },
@@ -162,7 +199,12 @@ pub fn encode_options(
             ))
         }
     };
-    let predictor = match k.string("predictor")?.as_deref().unwrap_or("auto") {
+    Ok(choice)
+}
+
+/// The predictor of `k` (`auto` when not given).
+fn predictor_choice(k: &Keywords<'_>) -> PyResult<PredictorChoice> {
+    let choice = match k.string("predictor")?.as_deref().unwrap_or("auto") {
         "auto" => PredictorChoice::Auto,
         "affine" => PredictorChoice::Fixed(PredictorKind::Affine),
         "skinning" => PredictorChoice::Fixed(PredictorKind::Skinning),
@@ -173,32 +215,7 @@ pub fn encode_options(
             ))
         }
     };
-    let segment_frames = match k.dict.as_ref().map(|d| d.get_item("segment_frames")) {
-        None | Some(Ok(None)) => defaults.segment_frames,
-        // None, as the command line's 0, never cuts the clip.
-        Some(Ok(Some(v))) if v.is_none() => None,
-        Some(Ok(Some(_))) => match k.int::<usize>("segment_frames")? {
-            Some(0) => None,
-            n => n,
-        },
-        Some(Err(e)) => return Err(e),
-    };
-    Ok(EncodeOptions {
-        codec: codec_config(&k, codec)?,
-        quality: k.int::<u8>("quality")?.unwrap_or(defaults.quality),
-        step: k.float("step")?,
-        affine_precision: k.float("affine_precision")?,
-        clusters: clusters.unwrap_or(defaults.clusters),
-        segmentation,
-        predictor,
-        weight_bits: k.int::<u8>("weight_bits")?.unwrap_or(defaults.weight_bits),
-        first_frame_bits: k.int::<u8>("first_frame_bits")?,
-        reorder: k.typed::<bool>("reorder", "a bool")?.unwrap_or(false),
-        uv_bits: k.int::<u8>("uv_bits")?.unwrap_or(defaults.uv_bits),
-        segment_frames,
-        parallel_segments: threads.unwrap_or(defaults.parallel_segments),
-        fine_quality: None,
-    })
+    Ok(choice)
 }
 
 /// The codec's configuration with the codec options of `k` set.

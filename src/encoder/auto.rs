@@ -129,22 +129,12 @@ pub(super) fn choose(
     };
     let (frames, trial_frames) = (mesh.frame_count(), shared.trial_frames());
     let estimated = sample.is_some() || settings.opts.codec.codec().estimated_trials();
-    let final_frames = if estimated { frames } else { 0 };
-    let total = (models.len() * trial_frames + final_frames) as u64;
+    let total = (models.len() * trial_frames + if estimated { frames } else { 0 }) as u64;
     progress.total(total);
     let segmenter = analysis::Segmenter::new(mesh);
     let segmentations = segmentations(models);
-    let largest = segmentations.iter().filter(|(s, _)| *s == Segmentation::KMeans);
-    if let Some(&(_, k)) = largest.max_by_key(|(_, k)| *k) {
-        let start = Instant::now();
-        segmenter.prepare_kmeans(k);
-        let seconds = start.elapsed().as_secs_f64();
-        clock.stages.push(("motion descriptors and seeds".into(), seconds));
-    }
-    let atlases: Vec<AtlasCache> = segmentations
-        .iter()
-        .map(|_| AtlasCache::default())
-        .collect();
+    prepare_kmeans(&segmenter, &segmentations, &mut clock);
+    let atlases: Vec<AtlasCache> = segmentations.iter().map(|_| AtlasCache::default()).collect();
     // The ladder's stop reads tdct's estimates of every frame (`ladder`).
     let gates = match estimated && sample.is_none() {
         true => ladder::gates(&segmentations),
@@ -166,10 +156,7 @@ pub(super) fn choose(
     let (best, at) = (podium.best)
         .ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
     let mut reason = reason(&candidates, &costs, at, (trial_frames, frames));
-    for s in skipped {
-        reason.push_str("; ");
-        reason.push_str(&s);
-    }
+    reason.extend(skipped.iter().map(|s| format!("; {s}")));
     // A sample too close to call: both coded whole (a segmented encoding's analysis clip is
     // coded on its first frame alone, so its sample decides).
     let whole_streams = sample.is_some() && settings.keep == Keep::Whole;
@@ -191,9 +178,10 @@ pub(super) fn choose(
     };
     // The kept one's size is its stream's now, not an estimate (unless the stream is the analysis
     // clip's first frame alone).
-    if sample.is_none() && candidates[at].estimated && settings.keep == Keep::Whole {
-        candidates[at].bytes = encoded.report.bytes;
-        candidates[at].estimated = false;
+    let measured = sample.is_none() && settings.keep == Keep::Whole;
+    if let Some(kept) = candidates.get_mut(at).filter(|c| measured && c.estimated) {
+        kept.bytes = encoded.report.bytes;
+        kept.estimated = false;
     }
     encoded.report.choice = Some(ChoiceReport {
         chosen: model.name(),
@@ -202,6 +190,22 @@ pub(super) fn choose(
         candidates,
     });
     Ok(encoded)
+}
+
+/// Prepares the k-means descriptors and seeds for the largest K of `segmentations` (shared by
+/// the smaller ones), timed in `clock`.
+fn prepare_kmeans(
+    segmenter: &analysis::Segmenter,
+    segmentations: &[(Segmentation, usize)],
+    clock: &mut Stopwatch,
+) {
+    let largest = segmentations.iter().filter(|(s, _)| *s == Segmentation::KMeans);
+    if let Some(&(_, k)) = largest.max_by_key(|(_, k)| *k) {
+        let start = Instant::now();
+        segmenter.prepare_kmeans(k);
+        let seconds = start.elapsed().as_secs_f64();
+        clock.stages.push(("motion descriptors and seeds".into(), seconds));
+    }
 }
 
 /// One job per segmentation of `models` (each with its atlas cache and gate), its candidates

@@ -47,144 +47,211 @@ pub(super) fn choose(
     settings: Settings,
     progress: &dyn Progress,
 ) -> Result<Encoded> {
-    let opts = settings.opts;
     let [default, others @ ..] = FIRST_FRAME_BITS_TRIED;
-    let frames = mesh.frame_count() as u64;
     let progress = Ahead {
         inner: progress,
-        extra: others.len() as u64 * frames,
+        extra: others.len() as u64 * mesh.frame_count() as u64,
         first: AtomicU64::new(0),
         grown: AtomicU64::new(0),
         told: AtomicBool::new(false),
     };
-    let at = |bits: u8, base: &EncodeOptions| EncodeOptions {
-        first_frame_bits: Some(bits),
-        ..base.clone()
-    };
-    let first = at(default, opts);
-    let plan = settings.plan;
-    // A segmented encoding's analysis clip keeps its shared parts alone, unless precisions are
-    // compared by whole streams: a fixed model has no estimate to compare them by.
-    let estimated = opts.motion_models().len() > 1 && opts.codec.codec().estimated_trials();
-    let mut partial = settings.keep == Keep::SharedParts && estimated;
-    let keep = if partial { Keep::SharedParts } else { Keep::Whole };
-    let settings_first = Settings {
-        opts: &first,
-        plan,
-        keep,
-    };
-    let mut best = encode_once(mesh, settings_first, &progress, None, None)?;
-    let model = EncodeOptions {
-        predictor: PredictorChoice::Fixed(best.model.predictor),
-        segmentation: best.model.segmentation.into(),
-        clusters: best.model.clusters,
-        ..opts.clone()
-    };
-    // The segmentation runs on the animation alone, so the trials keep the first one's, unless
-    // the first-frame coder reorders the vertices (its order may change with the precision).
-    let known = (!opts.reorder).then(|| (best.partition.clone(), best.report.segmentation.clone()));
-    // With a codec that estimates (tdct), precisions are compared by their estimates, and only
-    // one that beats the kept one's is coded in full. The kept one's is the least (a stopped one
-    // passed the least so far).
-    let chosen = best.report.choice.as_ref().and_then(|c| {
-        c.candidates.iter().filter_map(|k| k.estimate).min()
-    });
-    let mut trials = vec![FirstFrameTrial {
-        bits: default,
-        bytes: chosen.filter(|_| partial).unwrap_or(best.report.bytes),
-        estimated: partial,
-        stopped: false,
-    }];
-    if partial && chosen.is_none() {
-        // No estimate to compare by after all: compared by whole streams.
-        let whole = at(default, &model);
-        recode_whole(mesh, (&mut best, &mut trials[0]), &whole, plan, &progress, &known)?;
-        partial = false;
-    }
-    // A fixed model has no estimate to compare with: its precisions are coded in full.
-    let mut best_estimate = chosen;
+    let mut search = Search::start(mesh, settings, default, &progress)?;
     for bits in others {
         progress.stage(&format!("first frame at {bits} bits"));
-        let opts = at(bits, &model);
-        let settings = Settings::whole(&opts, plan);
-        let encoded = match best_estimate {
-            Some(estimate_before) => {
-                let fixed = (best.model, known.clone());
-                // Its estimate stops once it is sure not to be below the kept one's.
-                let limit = estimate_before.saturating_sub(1);
-                let Some((estimate, analysis)) =
-                    estimate_once(mesh, settings, &progress, fixed, limit)?
-                else {
-                    break;
-                };
-                // A stopped estimate is at least `estimate_before`.
-                let (estimate, stopped) = (estimate.bytes, estimate.stopped);
-                if estimate >= estimate_before {
-                    trials.push(FirstFrameTrial {
-                        bits,
-                        bytes: estimate,
-                        estimated: true,
-                        stopped,
-                    });
-                    progress.retell(trials.len() as u64 - 1, frames);
-                    break;
-                }
-                best_estimate = Some(estimate);
-                if partial {
-                    // The finer stream is compared whole: coded whole now, as it would have been.
-                    let whole = at(default, &model);
-                    recode_whole(mesh, (&mut best, &mut trials[0]), &whole, plan, &progress, &known)?;
-                    partial = false;
-                }
-                // Coded in full after its estimate: its frames count twice.
-                progress.grow(frames);
-                analysis.code(settings, &progress)?
-            }
-            None => encode_once(mesh, settings, &progress, known.clone(), None)?,
+        if !search.try_bits(bits)? {
+            break;
+        }
+    }
+    search.best.report.first_frame_trials = search.trials;
+    Ok(search.best)
+}
+
+/// `base` at first-frame precision `bits`.
+fn at(bits: u8, base: &EncodeOptions) -> EncodeOptions {
+    EncodeOptions {
+        first_frame_bits: Some(bits),
+        ..base.clone()
+    }
+}
+
+/// The precisions tried so far and the smallest stream among them.
+struct Search<'a> {
+    mesh: &'a AnimatedMesh,
+    plan: &'a RatePlan,
+    progress: &'a Ahead<'a>,
+    /// The caller's options with the first encoding's motion model fixed.
+    model: EncodeOptions,
+    /// The default precision, coded first.
+    default: u8,
+    /// The first encoding's partition, reused unless the first-frame coder reorders vertices.
+    known: Option<(Partition, SegmentationReport)>,
+    best: Encoded,
+    trials: Vec<FirstFrameTrial>,
+    /// Whether `best` is a segmented encoding's analysis clip kept as its shared parts alone.
+    partial: bool,
+    /// The kept precision's estimate, when precisions are compared by estimates (tdct).
+    best_estimate: Option<u64>,
+}
+
+impl<'a> Search<'a> {
+    /// Codes the default precision `default` with the caller's choices.
+    fn start(
+        mesh: &'a AnimatedMesh,
+        settings: Settings<'a>,
+        default: u8,
+        progress: &'a Ahead<'a>,
+    ) -> Result<Self> {
+        let (opts, plan) = (settings.opts, settings.plan);
+        let first = at(default, opts);
+        // A segmented encoding's analysis clip keeps its shared parts alone, unless precisions
+        // are compared by whole streams: a fixed model has no estimate to compare them by.
+        let estimated = opts.motion_models().len() > 1 && opts.codec.codec().estimated_trials();
+        let partial = settings.keep == Keep::SharedParts && estimated;
+        let keep = if partial { Keep::SharedParts } else { Keep::Whole };
+        let settings_first = Settings {
+            opts: &first,
+            plan,
+            keep,
         };
-        trials.push(FirstFrameTrial {
+        let best = encode_once(mesh, settings_first, progress, None, None)?;
+        let model = EncodeOptions {
+            predictor: PredictorChoice::Fixed(best.model.predictor),
+            segmentation: best.model.segmentation.into(),
+            clusters: best.model.clusters,
+            ..opts.clone()
+        };
+        // The segmentation runs on the animation alone, so the trials keep the first one's,
+        // unless the first-frame coder reorders the vertices (its order may change with the
+        // precision).
+        let known =
+            (!opts.reorder).then(|| (best.partition.clone(), best.report.segmentation.clone()));
+        // With a codec that estimates (tdct), precisions are compared by their estimates, and
+        // only one that beats the kept one's is coded in full. The kept one's is the least (a
+        // stopped one passed the least so far).
+        let chosen = best.report.choice.as_ref().and_then(|c| {
+            c.candidates.iter().filter_map(|k| k.estimate).min()
+        });
+        let trials = vec![FirstFrameTrial {
+            bits: default,
+            bytes: chosen.filter(|_| partial).unwrap_or(best.report.bytes),
+            estimated: partial,
+            stopped: false,
+        }];
+        let mut search = Self {
+            mesh,
+            plan,
+            progress,
+            model,
+            default,
+            known,
+            best,
+            trials,
+            partial,
+            // A fixed model has no estimate to compare with: its precisions are coded in full.
+            best_estimate: chosen,
+        };
+        if partial && chosen.is_none() {
+            // No estimate to compare by after all: compared by whole streams.
+            search.recode_whole()?;
+        }
+        Ok(search)
+    }
+
+    /// Tries precision `bits`; returns whether a coarser one is worth trying.
+    fn try_bits(&mut self, bits: u8) -> Result<bool> {
+        let opts = at(bits, &self.model);
+        let settings = Settings::whole(&opts, self.plan);
+        let encoded = match self.best_estimate {
+            Some(before) => match self.estimate_then_code(bits, settings, before)? {
+                Some(encoded) => encoded,
+                None => return Ok(false),
+            },
+            None => encode_once(self.mesh, settings, self.progress, self.known.clone(), None)?,
+        };
+        self.trials.push(FirstFrameTrial {
             bits,
             bytes: encoded.report.bytes,
             estimated: false,
             stopped: false,
         });
-        if encoded.report.bytes >= best.report.bytes {
+        if encoded.report.bytes >= self.best.report.bytes {
             // Coarser has not helped where this did not
             // (docs/design.md, "First-frame bits trials and k-means ladder").
-            progress.retell(trials.len() as u64 - 1, frames);
-            break;
+            self.retell();
+            return Ok(false);
         }
-        let choice = best.report.choice.take();
-        best = encoded;
-        best.report.choice = choice;
+        let choice = self.best.report.choice.take();
+        self.best = encoded;
+        self.best.report.choice = choice;
+        Ok(true)
     }
-    best.report.first_frame_trials = trials;
-    Ok(best)
-}
 
-/// Codes `best`, kept as its shared parts alone, whole with `opts` (its model fixed, its partition
-/// `known` unless reordered), as the automatic choice had kept it; `trial` is its precision's.
-fn recode_whole(
-    mesh: &AnimatedMesh,
-    (best, trial): (&mut Encoded, &mut FirstFrameTrial),
-    opts: &EncodeOptions,
-    plan: &RatePlan,
-    progress: &Ahead,
-    known: &Option<(Partition, SegmentationReport)>,
-) -> Result<()> {
-    progress.grow(mesh.frame_count() as u64);
-    let mut choice = best.report.choice.take();
-    *best = encode_once(mesh, Settings::whole(opts, plan), progress, known.clone(), None)?;
-    // The kept candidate (the least estimate, the first on a tie) is measured now.
-    let candidates = choice.iter_mut().flat_map(|c| c.candidates.iter_mut());
-    if let Some(kept) = candidates.min_by_key(|c| c.bytes) {
-        kept.bytes = best.report.bytes;
-        kept.estimated = false;
+    /// Estimates precision `bits`, stopping once sure not to be below the kept one's estimate
+    /// `before`, and codes it in full if it is below (`None` when it is not).
+    fn estimate_then_code(
+        &mut self,
+        bits: u8,
+        settings: Settings,
+        before: u64,
+    ) -> Result<Option<Encoded>> {
+        let fixed = (self.best.model, self.known.clone());
+        let limit = before.saturating_sub(1);
+        let Some((estimate, analysis)) =
+            estimate_once(self.mesh, settings, self.progress, fixed, limit)?
+        else {
+            return Ok(None);
+        };
+        // A stopped estimate is at least `before`.
+        if estimate.bytes >= before {
+            self.trials.push(FirstFrameTrial {
+                bits,
+                bytes: estimate.bytes,
+                estimated: true,
+                stopped: estimate.stopped,
+            });
+            self.retell();
+            return Ok(None);
+        }
+        self.best_estimate = Some(estimate.bytes);
+        if self.partial {
+            // The finer stream is compared whole: coded whole now, as it would have been.
+            self.recode_whole()?;
+        }
+        // Coded in full after its estimate: its frames count twice.
+        self.progress.grow(self.mesh.frame_count() as u64);
+        analysis.code(settings, self.progress).map(Some)
     }
-    best.report.choice = choice;
-    trial.bytes = best.report.bytes;
-    trial.estimated = false;
-    Ok(())
+
+    /// Tells the progress the work's total now that the trials stop.
+    fn retell(&self) {
+        let frames = self.mesh.frame_count() as u64;
+        self.progress.retell(self.trials.len() as u64 - 1, frames);
+    }
+
+    /// Codes the default precision, kept as its shared parts alone, whole (its model fixed, its
+    /// partition `known` unless reordered), as the automatic choice had kept it.
+    fn recode_whole(&mut self) -> Result<()> {
+        let (mesh, progress) = (self.mesh, self.progress);
+        let whole = at(self.default, &self.model);
+        progress.grow(mesh.frame_count() as u64);
+        let best = &mut self.best;
+        let mut choice = best.report.choice.take();
+        let settings = Settings::whole(&whole, self.plan);
+        *best = encode_once(mesh, settings, progress, self.known.clone(), None)?;
+        // The kept candidate (the least estimate, the first on a tie) is measured now.
+        let candidates = choice.iter_mut().flat_map(|c| c.candidates.iter_mut());
+        if let Some(kept) = candidates.min_by_key(|c| c.bytes) {
+            kept.bytes = best.report.bytes;
+            kept.estimated = false;
+        }
+        best.report.choice = choice;
+        if let Some(trial) = self.trials.first_mut() {
+            trial.bytes = best.report.bytes;
+            trial.estimated = false;
+        }
+        self.partial = false;
+        Ok(())
+    }
 }
 
 /// Passes progress on, telling the whole work ahead once: the first encoding's total plus the

@@ -115,25 +115,9 @@ pub fn encode(
     check_encode_input(triangles, vertex_count)?;
     let grid = Grid::fit(positions, opts.bits)?;
     let cells: Vec<Cell> = positions.iter().map(|&p| grid.quantise(p)).collect();
-    // Welded by exact position, not by cell: distinct vertices that only share a cell at low bits
-    // would weld into degenerate and non-manifold triangles (horse-gallop at 10 bits: 129 of
-    // 8 431, connectivity 2.2 -> 3.5 bits a vertex). Equal positions have equal cells.
-    let keys: Vec<[u32; 3]> = positions
-        .iter()
-        .map(|p| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() }))
-        .collect();
-    let weld = Weld::new(&keys);
+    let weld = weld_exact(positions);
     let welded_count = weld.first.len();
-    let (mut traversable, mut sources, mut degenerate) = (Vec::new(), Vec::new(), Vec::new());
-    for tri in triangles {
-        let w = tri.map(|v| weld.welded_of[v as usize]);
-        if w[0] != w[1] && w[1] != w[2] && w[0] != w[2] {
-            traversable.push(w);
-            sources.push(*tri);
-        } else {
-            degenerate.push(*tri);
-        }
-    }
+    let (traversable, sources, mut degenerate) = split_welded(triangles, &weld);
 
     let mut connectivity = Encoder::new();
     let mut geometry = Encoder::new();
@@ -170,18 +154,8 @@ pub fn encode(
             vertex_count,
         )?
     };
-    let output_cells: Vec<Cell> = numbering
-        .welded
-        .iter()
-        .map(|&w| decoded_cells[w as usize])
-        .collect();
-    let (decoded_positions, permutation) = place_decoded_positions(
-        &grid,
-        &output_cells,
-        &numbering.inputs,
-        vertex_count,
-        opts.reorder,
-    );
+    let (decoded_positions, permutation) =
+        decoded_output(&grid, &numbering, &decoded_cells, vertex_count, opts.reorder);
 
     let connectivity = connectivity.finish()?;
     let geometry = geometry.finish()?;
@@ -210,6 +184,59 @@ pub fn encode(
             order: order_stream.len(),
         },
     })
+}
+
+/// What the decoder will hold: the positions of `decoded_cells` (per welded vertex) in output
+/// order, and the permutation to it when `reorder` (see [`place_decoded_positions`]).
+fn decoded_output(
+    grid: &Grid,
+    numbering: &weld::Numbering,
+    decoded_cells: &[Cell],
+    vertex_count: usize,
+    reorder: bool,
+) -> (Vec<Point>, Option<Vec<u32>>) {
+    let output_cells: Vec<Cell> = numbering
+        .welded
+        .iter()
+        .map(|&w| decoded_cells[w as usize])
+        .collect();
+    place_decoded_positions(
+        grid,
+        &output_cells,
+        &numbering.inputs,
+        vertex_count,
+        reorder,
+    )
+}
+
+/// The input vertices welded by exact position, not by cell: distinct vertices that only share a
+/// cell at low bits would weld into degenerate and non-manifold triangles (horse-gallop at 10
+/// bits: 129 of 8 431, connectivity 2.2 -> 3.5 bits a vertex). Equal positions have equal cells.
+fn weld_exact(positions: &[Point]) -> Weld {
+    let keys: Vec<[u32; 3]> = positions
+        .iter()
+        .map(|p| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() }))
+        .collect();
+    Weld::new(&keys)
+}
+
+/// The triangles the traversal codes (on three distinct welded vertices, as welded vertices), the
+/// input triangles they come from, and the input triangles degenerate once welded.
+fn split_welded(
+    triangles: &[Triangle],
+    weld: &Weld,
+) -> (Vec<[u32; 3]>, Vec<Triangle>, Vec<Triangle>) {
+    let (mut traversable, mut sources, mut degenerate) = (Vec::new(), Vec::new(), Vec::new());
+    for tri in triangles {
+        let w = tri.map(|v| weld.welded_of[v as usize]);
+        if w[0] != w[1] && w[1] != w[2] && w[0] != w[2] {
+            traversable.push(w);
+            sources.push(*tri);
+        } else {
+            degenerate.push(*tri);
+        }
+    }
+    (traversable, sources, degenerate)
 }
 
 /// Codes which input vertex (copy of a welded vertex) each corner of the coded triangles uses.

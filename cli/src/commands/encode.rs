@@ -1,9 +1,11 @@
 //! `mcgv-video encode`.
 
+use super::achieved::Achieved;
 use crate::args::{BitDepth, EncodeArgs, PredictorChoice, SegmentationChoice};
 use crate::output::count;
 use crate::progress;
 use mcgv_video::codec::{Codec, CodecConfig, PictureOptions};
+use mcgv_video::encoder::EncodeReport;
 use mcgv_video::encoder::DEFAULT_PARALLEL_SEGMENTS;
 use mcgv_video::encoder::{self, Budget, BudgetReport, EncodeOptions, Encoded, Segmentation};
 use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
@@ -358,23 +360,54 @@ fn write_and_report(
     };
     let r = &encoded.report;
     if args.json {
-        let mut value = serde_json::to_value(r).map_err(|e| Error::Usage(e.to_string()))?;
-        value["seconds"] = serde_json::json!(seconds);
-        value["vertices"] = serde_json::json!(r.header.vertices);
-        value["frames"] = serde_json::json!(r.header.frames);
-        value["achieved"] = serde_json::json!(achieved);
-        if let Some(search) = &search {
-            value["budget"] =
-                serde_json::to_value(search).map_err(|e| Error::Usage(e.to_string()))?;
-        }
-        return outln!("{value}");
+        return outln!("{}", report_json(r, seconds, achieved, search.as_ref())?);
     }
     if quiet {
         return Ok(());
     }
+    let place = match to_stdout {
+        true => "stdout".to_string(),
+        false => output.display().to_string(),
+    };
+    let line = report_text(r, (&place, seconds), search.as_ref(), achieved);
+    // With `-o -` stdout carries the stream: the report goes to stderr.
+    if to_stdout {
+        eprintln!("{line}");
+        Ok(())
+    } else {
+        outln!("{line}")
+    }
+}
+
+/// `encode --json`'s object: the report, the seconds taken, the error of the file written and
+/// the budget search.
+fn report_json(
+    r: &EncodeReport,
+    seconds: f64,
+    achieved: Option<Achieved>,
+    search: Option<&BudgetReport>,
+) -> Result<serde_json::Value> {
+    let mut value = serde_json::to_value(r).map_err(|e| Error::Usage(e.to_string()))?;
+    value["seconds"] = serde_json::json!(seconds);
+    value["vertices"] = serde_json::json!(r.header.vertices);
+    value["frames"] = serde_json::json!(r.header.frames);
+    value["achieved"] = serde_json::json!(achieved);
+    if let Some(search) = search {
+        value["budget"] = serde_json::to_value(search).map_err(|e| Error::Usage(e.to_string()))?;
+    }
+    Ok(value)
+}
+
+/// `encode`'s plain report of the stream written to `place` in `seconds`.
+fn report_text(
+    r: &EncodeReport,
+    (place, seconds): (&str, f64),
+    search: Option<&BudgetReport>,
+    achieved: Option<Achieved>,
+) -> String {
     let line = format!(
         "{}: {} bytes, {:.3} bpvf ({} vertices x {}, {} by {} in {:.2} s, {} predictor, {}), {:.1} s ({:.1} frames/s)",
-        if to_stdout { "stdout".into() } else { output.display().to_string() },
+        place,
         r.bytes,
         r.bpvf,
         r.header.vertices,
@@ -387,7 +420,7 @@ fn write_and_report(
         seconds,
         r.header.frames as f64 / seconds.max(1e-9)
     );
-    let line = match &search {
+    let line = match search {
         Some(search) => format!("{line}\n{}", budget_line(search)),
         None => line,
     };
@@ -409,7 +442,7 @@ fn write_and_report(
         1 => line,
         n => format!("{line}\nsegments: {n}, coded with the first segment's choices"),
     };
-    let line = match r.first_frame_trials.as_slice() {
+    match r.first_frame_trials.as_slice() {
         [] => line,
         trials => {
             let tried: Vec<String> = trials
@@ -417,19 +450,11 @@ fn write_and_report(
                 .map(|t| format!("{} bits {} bytes", t.bits, t.bytes))
                 .collect();
             format!(
-                "{line}
-first frame: kept {} bits of {}",
+                "{line}\nfirst frame: kept {} bits of {}",
                 r.header.first_frame_bits,
                 tried.join(", ")
             )
         }
-    };
-    // With `-o -` stdout carries the stream: the report goes to stderr.
-    if to_stdout {
-        eprintln!("{line}");
-        Ok(())
-    } else {
-        outln!("{line}")
     }
 }
 

@@ -27,8 +27,6 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
     let header = decoder.header().clone();
     let total = decoder.file_len();
     let parts = decoder.part_bytes();
-    let vf = header.vertices as f64 * header.frames as f64;
-    let bpvf = total as f64 * 8.0 / vf;
     if let Some(dir) = &args.png {
         let Some(pictures) = &stored.pictures else {
             return Err(Error::option(
@@ -42,13 +40,46 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
         };
         write_pngs(&mut decoder, pictures.lattice, args, dir, quiet)?;
     }
-    let bands = stored.bands.as_ref();
+    let report = Report {
+        header: &header,
+        stored: &stored,
+        parts: &parts,
+        total,
+        segments: &segments,
+    };
     if args.json {
-        let parts_obj: serde_json::Map<String, serde_json::Value> = parts
-            .iter()
+        return outln!("{}", report.json(decoder.weights().map(|w| w.bits)));
+    }
+    outln!("{}", summary(&header, &stored, &args.input))?;
+    report.print_table()
+}
+
+/// What `inspect` prints of a stream: its header, what its codec stored, the bytes of each part.
+struct Report<'a> {
+    header: &'a Header,
+    stored: &'a Description,
+    parts: &'a [(String, u64)],
+    total: u64,
+    segments: &'a [std::ops::Range<usize>],
+}
+
+impl Report<'_> {
+    fn bpvf(&self) -> f64 {
+        self.total as f64 * 8.0 / self.vertex_frames()
+    }
+
+    fn vertex_frames(&self) -> f64 {
+        self.header.vertices as f64 * self.header.frames as f64
+    }
+
+    /// The `--json` object; `weight_bits` those of the skinning weights, if any.
+    fn json(&self, weight_bits: Option<u8>) -> serde_json::Value {
+        let (header, stored) = (self.header, self.stored);
+        let parts_obj: serde_json::Map<String, serde_json::Value> = (self.parts.iter())
             .map(|(n, b)| (n.clone(), serde_json::json!(b * 8)))
             .collect();
         let pictures = stored.pictures.as_ref();
+        let bands = stored.bands.as_ref();
         let mut value = serde_json::json!({
             "vertices": header.vertices,
             "frames": header.frames,
@@ -58,61 +89,65 @@ pub fn run(args: &InspectArgs, quiet: bool) -> Result<()> {
             "bit_depth": pictures.map(|p| p.bit_depth),
             "clusters": header.clusters,
             "predictor": header.predictor.name(),
-            "weight_bits": decoder.weights().map(|w| w.bits),
+            "weight_bits": weight_bits,
             "charts": pictures.map_or(0, |p| p.charts),
             "lattice": pictures.map_or((0, 0), |p| p.lattice),
             "packing_efficiency": pictures.map_or(0.0, |p| p.packing_efficiency),
             "padding": pictures.map(|p| p.padding),
-            "bytes": total,
-            "bpvf": bpvf,
+            "bytes": self.total,
+            "bpvf": self.bpvf(),
             "parts": parts_obj,
-            "segments": segments.len(),
+            "segments": self.segments.len(),
             "band_bytes": bands.map(|b| &b.lengths),
             "step": bands.map(|b| b.step),
         });
         for (name, setting) in &stored.settings {
             value[*name] = serde_json::json!(setting);
         }
-        return outln!("{value}");
+        value
     }
-    outln!("{}", summary(&header, &stored, &args.input))?;
-    if segments.len() > 1 {
+
+    /// The plain output after the summary line: segments, the parts' table, the bands.
+    fn print_table(&self) -> Result<()> {
+        let (segments, total, vf) = (self.segments, self.total, self.vertex_frames());
+        if segments.len() > 1 {
+            outln!(
+                "{} temporal segments of up to {} frames (parts of a kind summed; bands of the first)",
+                segments.len(),
+                segments[0].len()
+            )?;
+        }
         outln!(
-            "{} temporal segments of up to {} frames (parts of a kind summed; bands of the first)",
-            segments.len(),
-            segments[0].len()
+            "{:<22} {:>12} {:>14} {:>7} {:>8}",
+            "part",
+            "bytes",
+            "bits",
+            "%",
+            "bpvf"
         )?;
-    }
-    outln!(
-        "{:<22} {:>12} {:>14} {:>7} {:>8}",
-        "part",
-        "bytes",
-        "bits",
-        "%",
-        "bpvf"
-    )?;
-    for (name, bytes) in &parts {
+        for (name, bytes) in self.parts {
+            outln!(
+                "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
+                name,
+                bytes,
+                bytes * 8,
+                100.0 * *bytes as f64 / total as f64,
+                *bytes as f64 * 8.0 / vf
+            )?;
+        }
         outln!(
             "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
-            name,
-            bytes,
-            bytes * 8,
-            100.0 * *bytes as f64 / total as f64,
-            *bytes as f64 * 8.0 / vf
+            "total",
+            total,
+            total * 8,
+            100.0,
+            self.bpvf()
         )?;
+        if let Some(bands) = &self.stored.bands {
+            out!("{}", band_table(&bands.lengths, bands.decoded))?;
+        }
+        Ok(())
     }
-    outln!(
-        "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
-        "total",
-        total,
-        total * 8,
-        100.0,
-        bpvf
-    )?;
-    if let Some(bands) = bands {
-        out!("{}", band_table(&bands.lengths, bands.decoded))?;
-    }
-    Ok(())
 }
 
 /// Bands shown one by one in the plain `inspect` output; the rest are summed.

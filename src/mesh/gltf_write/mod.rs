@@ -151,46 +151,10 @@ fn document(
         set(&mut vertex, &format!("TEXCOORD_{s}"), accessor);
     }
     let targets = morph_targets(mesh, &welding, &base_normals, buf);
-    let groups = material_groups(mesh, attributes);
     // Groups (one per source primitive) may share a material name: each distinct name is one
     // material, the source's of that name when there is a source to look like.
     let names = distinct_names(&attributes.material_names);
-    let material_of = |m: u32| {
-        let name = attributes.material_names.get(m as usize)?;
-        match look {
-            Some(look) => look.material_index(name),
-            None => names.iter().position(|n| *n == name),
-        }
-    };
-    let primitives: Vec<Value> = groups
-        .iter()
-        .map(|(material, indices)| {
-            let mut p = object([
-                ("attributes", vertex.clone()),
-                ("indices", buf.indices(indices).into()),
-                ("mode", 4.into()),
-            ]);
-            if let Some(m) = material.and_then(material_of) {
-                set(&mut p, "material", m);
-            }
-            if !targets.is_empty() {
-                set(&mut p, "targets", targets.clone());
-            }
-            p
-        })
-        .collect();
-    let mut gltf_mesh = object([("primitives", primitives.into())]);
-    if !targets.is_empty() {
-        let names: Vec<Value> = (1..mesh.frame_count())
-            .map(|f| format!("frame_{f:04}").into())
-            .collect();
-        set(&mut gltf_mesh, "weights", vec![0.0f32; targets.len()]);
-        set(
-            &mut gltf_mesh,
-            "extras",
-            object([("targetNames", names.into())]),
-        );
-    }
+    let gltf_mesh = mesh_object(mesh, attributes, (&names, look), (&vertex, &targets), buf);
     let node_name = (options.node_name.as_deref())
         .or(look.and_then(Look::node_name))
         .unwrap_or("mcgv-video");
@@ -229,6 +193,56 @@ fn document(
     set(&mut root, "bufferViews", std::mem::take(&mut buf.views));
     set(&mut root, "accessors", std::mem::take(&mut buf.accessors));
     root
+}
+
+/// The glTF mesh: one primitive per material group, each with the `vertex` attributes and the
+/// morph `targets`; `names` the distinct material names, in the order of the materials written
+/// when there is no source `look`.
+fn mesh_object(
+    mesh: &AnimatedMesh,
+    attributes: &Attributes,
+    (names, look): (&[&String], Option<&Look>),
+    (vertex, targets): (&Value, &[Value]),
+    buf: &mut BufferBuilder,
+) -> Value {
+    let groups = material_groups(mesh, attributes);
+    let material_of = |m: u32| {
+        let name = attributes.material_names.get(m as usize)?;
+        match look {
+            Some(look) => look.material_index(name),
+            None => names.iter().position(|n| *n == name),
+        }
+    };
+    let primitives: Vec<Value> = groups
+        .iter()
+        .map(|(material, indices)| {
+            let mut p = object([
+                ("attributes", vertex.clone()),
+                ("indices", buf.indices(indices).into()),
+                ("mode", 4.into()),
+            ]);
+            if let Some(m) = material.and_then(material_of) {
+                set(&mut p, "material", m);
+            }
+            if !targets.is_empty() {
+                set(&mut p, "targets", targets.to_vec());
+            }
+            p
+        })
+        .collect();
+    let mut gltf_mesh = object([("primitives", primitives.into())]);
+    if !targets.is_empty() {
+        let names: Vec<Value> = (1..mesh.frame_count())
+            .map(|f| format!("frame_{f:04}").into())
+            .collect();
+        set(&mut gltf_mesh, "weights", vec![0.0f32; targets.len()]);
+        set(
+            &mut gltf_mesh,
+            "extras",
+            object([("targetNames", names.into())]),
+        );
+    }
+    gltf_mesh
 }
 
 /// One morph target per frame after the first: position and normal differences from frame 0.
