@@ -117,8 +117,10 @@ impl Report<'_> {
                 segments[0].len()
             )?;
         }
+        // As wide as the longest part's name ("temporal DCT coefficients" overflowed 22).
+        let w = (self.parts.iter().map(|(n, _)| n.chars().count())).fold(22, usize::max);
         outln!(
-            "{:<22} {:>12} {:>14} {:>7} {:>8}",
+            "{:<w$} {:>12} {:>14} {:>7} {:>8}",
             "part",
             "bytes",
             "bits",
@@ -127,7 +129,7 @@ impl Report<'_> {
         )?;
         for (name, bytes) in self.parts {
             outln!(
-                "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
+                "{:<w$} {:>12} {:>14} {:>6.2}% {:>8.4}",
                 name,
                 bytes,
                 bytes * 8,
@@ -136,7 +138,7 @@ impl Report<'_> {
             )?;
         }
         outln!(
-            "{:<22} {:>12} {:>14} {:>6.2}% {:>8.4}",
+            "{:<w$} {:>12} {:>14} {:>6.2}% {:>8.4}",
             "total",
             total,
             total * 8,

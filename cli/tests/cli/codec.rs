@@ -258,6 +258,21 @@ fn tdct_encode_inspect_decode_eval_and_truncation() {
         text.contains("temporal DCT: 38 bands") && text.contains("% of the bytes"),
         "{text}"
     );
+    // The parts' table is aligned: each row's bytes end where the heading's do, however long
+    // the part's name ("temporal DCT coefficients").
+    let rows: Vec<&str> = (text.lines())
+        .skip_while(|l| !l.starts_with("part "))
+        .take_while(|l| !l.starts_with("temporal DCT:"))
+        .collect();
+    assert!(rows.len() > 3, "{text}");
+    let end = rows[0].find("bytes").map_or(0, |i| i + "bytes".len());
+    for row in &rows[1..] {
+        let (last, next) = (row.as_bytes().get(end - 1), row.as_bytes().get(end));
+        assert!(
+            last.is_some_and(u8::is_ascii_digit) && next == Some(&b' '),
+            "{row:?} in {text}"
+        );
+    }
     let png = run(&[
         "inspect",
         s,
