@@ -5,6 +5,7 @@ An animation is one connectivity (``faces``, triangles) and a position per verte
 
     import mcgv_video
     stream = mcgv_video.encode(positions, faces, quality=60)       # bytes of a .mcgv file
+    small, report = mcgv_video.encode_to_budget(positions, faces, target_size=200_000)
     decoder = mcgv_video.Decoder(stream)
     frame_37 = decoder.frame(37)                                    # (vertices, 3)
     every = decoder.all()                                           # (frames, vertices, 3)
@@ -26,6 +27,7 @@ from ._native import (
     analysis_frames,
     codecs,
     encode,
+    encode_to_budget,
     eval,
     read_animation,
     segment_ranges,
@@ -52,6 +54,7 @@ __all__ = [
     "analysis_frames",
     "codecs",
     "encode",
+    "encode_to_budget",
     "eval",
     "read_animation",
     "segment_ranges",

@@ -104,6 +104,45 @@ def encode(
     """Encodes an animation into the bytes of a ``.mcgv`` stream (same options, same bytes as
     ``mcgv-video encode``); the interpreter's lock is released while coding."""
 
+def encode_to_budget(
+    positions: Union[Positions, Animation],
+    faces: Optional[Faces] = None,
+    *,
+    target_size: Optional[int] = None,
+    target_bpvf: Optional[float] = None,
+    target_error: Optional[float] = None,
+    target_max_error: Optional[float] = None,
+    codec: Codec = "tdct",
+    quality: int = 50,
+    fps: Optional[float] = None,
+    uvs: Optional[npt.NDArray[np.float32]] = None,
+    progress: Optional[Progress] = None,
+    threads: Optional[int] = None,
+    clusters: int = 20,
+    segmentation: Literal["auto", "kmeans", "decimation"] = "auto",
+    e0: Optional[float] = None,
+    predictor: Literal["auto", "affine", "skinning"] = "auto",
+    weight_bits: int = 16,
+    affine_precision: Optional[float] = None,
+    first_frame_bits: Optional[int] = None,
+    reorder: bool = False,
+    uv_bits: int = 12,
+    segment_frames: Optional[int] = 128,
+    qscale: Optional[int] = None,
+    qp: Optional[int] = None,
+    jpeg_quality: Optional[int] = None,
+    gop: Optional[int] = None,
+    bit_depth: Union[int, Literal["auto"], None] = None,
+    lattice: Union[str, Tuple[int, int], None] = None,
+    padding: Optional[str] = None,
+) -> Tuple[bytes, dict[str, object]]:
+    """Encodes an animation at the quality whose stream fits one budget (``target_size`` bytes,
+    ``target_bpvf``, ``target_error`` vertex RMSE or ``target_max_error``, errors over the first
+    frame's bounding-box diagonal): never over it, within 3 % under it when the qualities allow.
+    Returns the stream and the search's report (the command line's ``--json`` ``budget``: the
+    ``quality`` found, ``achieved``, ``encodes``, ``trials``, …); same options, same bytes as
+    ``mcgv-video encode --target-*``."""
+
 def read_animation(
     path: Union[str, os.PathLike[str]],
     clip: Union[str, int, None] = None,

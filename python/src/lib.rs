@@ -5,6 +5,7 @@
 //! below and in `mcgv_video/__init__.pyi`.
 
 mod arrays;
+mod budget;
 mod decoder;
 mod errors;
 mod options;
@@ -204,7 +205,7 @@ fn mesh_from_arrays(
 }
 
 /// The animation `encode` and `eval` are given: an ``Animation``, or arrays with their faces.
-fn mesh_argument(
+pub(crate) fn mesh_argument(
     name: &str,
     value: &Bound<'_, PyAny>,
     faces: Option<&Bound<'_, PyAny>>,
@@ -408,6 +409,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<segments::SegmentedEncoder>()?;
     m.add_class::<segments::FrameSource>()?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
+    m.add_function(wrap_pyfunction!(budget::encode_to_budget, m)?)?;
     m.add_function(wrap_pyfunction!(read_animation, m)?)?;
     m.add_function(wrap_pyfunction!(eval, m)?)?;
     m.add_function(wrap_pyfunction!(segments::analysis_frames, m)?)?;

@@ -4,7 +4,9 @@ the interpreter's lock released while coding."""
 
 from __future__ import annotations
 
+import json
 import pickle
+import subprocess
 import threading
 import time
 
@@ -68,6 +70,31 @@ def test_a_read_animation_encodes_to_the_bytes_the_cli_writes(tmp_path, cli):
     assert mcgv_video.encode(animation, **options) == expected
     # A pickled animation (as a cluster ships it) still gives the same stream.
     assert mcgv_video.encode(pickle.loads(pickle.dumps(animation)), **options) == expected
+
+
+def test_a_budget_is_met_with_the_bytes_and_report_the_cli_gives(tmp_path, cli):
+    positions, faces = cloth(n=16, frames=40)
+    cache = write_pc2(tmp_path, positions, faces)
+    limit = int(len(mcgv_video.encode(positions, faces)) * 0.7)
+    stream, report = mcgv_video.encode_to_budget(positions, faces, target_size=limit)
+    assert len(stream) <= limit and report["achieved"] == len(stream)
+    assert report["quality"] < 50 and report["encodes"] == len(report["trials"]) >= 2
+    assert report["within_tolerance"] == (len(stream) >= limit * 0.97)
+    out = tmp_path / "cli.mcgv"
+    printed = subprocess.run(
+        [cli, "encode", str(cache), "-o", str(out), "--quiet", "--json", "--target-size", str(limit)],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    assert out.read_bytes() == stream and json.loads(printed)["budget"] == report
+    # An error bound: eval's vertex RMSE of the stream is within it.
+    stream, report = mcgv_video.encode_to_budget(positions, faces, target_error=2e-4)
+    measured = mcgv_video.eval(Animation(positions, faces), stream)["vertex_rmse"]
+    assert measured <= 2e-4 and measured == pytest.approx(report["achieved"], rel=1e-6)
+    for budgets, name in [({}, "target_size"), (dict(target_size=limit, target_error=1e-4), "target_size"),
+                          (dict(target_size=limit, step=1e-3), "step"), (dict(target_size=0), "target_size")]:
+        with pytest.raises(InvalidOptionError) as caught:
+            mcgv_video.encode_to_budget(positions, faces, **budgets)
+        assert caught.value.option == name, (budgets, caught.value)
 
 
 def test_segments_coded_out_of_order_join_into_encode_s_stream():
