@@ -13,6 +13,7 @@ mod budget;
 mod budget_line;
 mod choice_reason;
 mod options;
+mod report;
 internal! {
     analysis;
     auto;
@@ -41,10 +42,11 @@ pub use options::{
     EncodeOptions, PredictorChoice, Segmentation, SegmentationChoice, DEFAULT_FIRST_FRAME_BITS,
     DEFAULT_PARALLEL_SEGMENTS, DEFAULT_QUALITY, DEFAULT_SEGMENT_FRAMES, FIRST_FRAME_BITS_TRIED,
 };
+pub use report::{EncodeReport, Encoded};
 pub use segment_runs::{analysis_clip, analysis_frames, encode_source, segment_ranges};
 pub use segments::{CodedSegment, SegmentedEncoder};
 
-use crate::codec::{Codec, Estimate, Limit, RatePlan, ResidualInput};
+use crate::codec::{Estimate, Limit, RatePlan, ResidualInput};
 use crate::error::{Error, Result};
 use crate::first_frame::EncodedFirstFrame;
 use crate::geometry_image::lattice::AtlasCache;
@@ -54,73 +56,8 @@ use crate::progress::{Progress, Silent};
 use crate::stream::container::{ContainerWriter, Part, Tag};
 use crate::stream::header::Header;
 use crate::stream::side_info;
-use std::path::Path;
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
-
-/// What an encoding produced, for reports.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct EncodeReport {
-    /// The stream header.
-    pub header: Header,
-    /// The residual codec.
-    pub codec: Codec,
-    /// Bytes per part, in file order.
-    pub parts: Vec<(String, u64)>,
-    /// Total file bytes.
-    pub bytes: u64,
-    /// Bits per vertex per frame.
-    pub bpvf: f64,
-    /// Charts in the atlas (0 for codecs without an atlas).
-    pub charts: usize,
-    /// Chart pixels / lattice pixels (0 without an atlas).
-    pub packing_efficiency: f64,
-    /// Vertices moved to resolve lattice collisions (0 without an atlas).
-    pub moved_vertices: usize,
-    /// Area-weighted L2 stretch of the charts (1 = none; 0 without an atlas).
-    pub l2_stretch: f64,
-    /// Seconds per stage.
-    pub stage_seconds: Vec<(String, f64)>,
-    /// The segmentation: method, K found, its time (and for decimation, the error reached).
-    pub segmentation: SegmentationReport,
-    /// With an automatic predictor or segmentation: the candidates measured and the one kept.
-    pub choice: Option<ChoiceReport>,
-    /// tdct with the first frame's precision left open: each precision tried and its stream's
-    /// bytes (empty otherwise); the header says which was kept.
-    pub first_frame_trials: Vec<FirstFrameTrial>,
-    /// Temporal segments the stream is cut into (1: not cut). The choices above were made on the
-    /// first segment.
-    pub segments: usize,
-    /// If the first-frame coder reordered vertices: new index → input index.
-    #[serde(skip)]
-    pub permutation: Option<Vec<u32>>,
-}
-
-/// An encoded stream in memory, and what it took.
-pub struct Encoded {
-    /// The container, ready to be written.
-    pub container: ContainerWriter,
-    /// The figures of the encoding.
-    pub report: EncodeReport,
-    /// The motion model and clusters it was coded with, for trials that keep them.
-    pub(crate) model: MotionModel,
-    pub(crate) partition: Partition,
-    /// The atlas the pictures were laid on (picture codecs), which a segmented encoding's
-    /// segments reuse instead of building it again.
-    pub(crate) atlas: Option<((u16, u16), atlas::Atlas)>,
-}
-
-impl Encoded {
-    /// The `.mcgv` file's bytes.
-    pub fn to_bytes(&self) -> Vec<u8> {
-        self.container.to_bytes()
-    }
-
-    /// Writes the `.mcgv` file so that a failure never leaves half of one; returns its size.
-    pub fn write(&self, path: &Path) -> Result<u64> {
-        self.container.write_atomic(path)
-    }
-}
 
 /// Encodes an animation.
 pub fn encode(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Result<Encoded> {
