@@ -2,7 +2,7 @@
 
 Export writes the active object's *evaluated* animation — armature, modifiers, shape keys,
 simulations, as the viewport shows it — over the scene's frame range into a ``.mcgv`` stream,
-with the codec and quality chosen in the export panel. Import reads a ``.mcgv`` back as a mesh
+with the codec and quality (or a size or error budget) chosen in the export panel. Import reads a ``.mcgv`` back as a mesh
 whose frames play on the timeline through a Mesh Cache modifier fed from a PC2 point cache of
 the decoded frames (``NAME.pc2`` beside the ``.mcgv``).
 
@@ -25,7 +25,7 @@ from typing import Optional
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 bl_info = {
@@ -117,19 +117,32 @@ def export_mcgv(
     *,
     codec: str = "tdct",
     quality: int = 50,
+    target_size: Optional[int] = None,
+    target_error: Optional[float] = None,
     world_space: bool = True,
     frame_start: Optional[int] = None,
     frame_end: Optional[int] = None,
 ) -> dict:
     """Writes ``obj``'s evaluated animation over the scene's frame range (or the one given) to
-    ``filepath``; returns what it wrote: ``bytes``, ``frames``, ``vertices``, ``bpvf``."""
+    ``filepath``; returns what it wrote: ``bytes``, ``frames``, ``vertices``, ``bpvf``, the
+    ``quality`` coded and the ``encodes`` it took. With a budget (``target_size`` bytes or
+    ``target_error``, the vertex RMSE over the bounding-box diagonal; not both) the quality is the
+    one found by ``mcgv_video.encode_to_budget``, starting from ``quality``."""
     mcgv_video = _mcgv()
     scene = context.scene
     start = scene.frame_start if frame_start is None else frame_start
     end = scene.frame_end if frame_end is None else frame_end
     positions, faces = evaluated_animation(context, obj, start, end, world_space)
     fps = scene.render.fps / scene.render.fps_base
-    stream = mcgv_video.encode(positions, faces, codec=codec, quality=quality, fps=fps)
+    options = dict(codec=codec, quality=quality, fps=fps)
+    if target_size is None and target_error is None:
+        stream = mcgv_video.encode(positions, faces, **options)
+        found = {"quality": quality, "encodes": 1}
+    else:
+        stream, search = mcgv_video.encode_to_budget(
+            positions, faces, target_size=target_size, target_error=target_error, **options
+        )
+        found = {"quality": search["quality"], "encodes": search["encodes"]}
     folder = os.path.dirname(os.path.abspath(filepath))
     os.makedirs(folder, exist_ok=True)
     partial = filepath + ".part"
@@ -142,6 +155,7 @@ def export_mcgv(
         "frames": frames,
         "vertices": vertices,
         "bpvf": len(stream) * 8 / (frames * vertices),
+        **found,
     }
 
 
@@ -235,24 +249,47 @@ class EXPORT_SCENE_OT_mcgv(bpy.types.Operator, ExportHelper):
         name="Quality", description="1..100, higher is better (50: 1/1000 of the diagonal)",
         default=50, min=1, max=100,
     )
+    budget: EnumProperty(
+        name="Budget",
+        items=[
+            ("QUALITY", "Quality", "Code at the quality above"),
+            ("SIZE", "Size", "The quality whose file fits the size below (a few encodes)"),
+            ("ERROR", "Error", "The quality whose vertex error stays under the bound below"),
+        ],
+        default="QUALITY",
+    )
+    target_kb: FloatProperty(
+        name="Size (kB)", description="Largest file, in kilobytes (1000 bytes)", default=200.0,
+        min=0.001,
+    )
+    target_error: FloatProperty(
+        name="Error", description="Largest vertex RMSE, as a fraction of the bounding-box diagonal",
+        default=2e-4, min=1e-8, max=1.0, precision=6,
+    )
     world_space: BoolProperty(
         name="World Space", description="Positions with the object's transform applied", default=True
     )
 
     def execute(self, context):
         obj = context.active_object
+        budget = {
+            "QUALITY": {},
+            "SIZE": {"target_size": int(self.target_kb * 1000)},
+            "ERROR": {"target_error": self.target_error},
+        }[self.budget]
         try:
             written = export_mcgv(
                 context, obj, self.filepath, codec=self.codec, quality=self.quality,
-                world_space=self.world_space,
+                world_space=self.world_space, **budget,
             )
         except Exception as e:  # every failure is reported in the UI, none crashes Blender
             self.report({"ERROR"}, f"mcgv-video: {e}")
             return {"CANCELLED"}
+        searched = f", quality {written['quality']} in {written['encodes']} encodes" if budget else ""
         self.report(
             {"INFO"},
             f"mcgv-video: {written['bytes']} bytes, {written['bpvf']:.3f} bpvf "
-            f"({written['vertices']} vertices x {written['frames']} frames)",
+            f"({written['vertices']} vertices x {written['frames']} frames{searched})",
         )
         return {"FINISHED"}
 

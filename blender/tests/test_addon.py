@@ -134,6 +134,26 @@ def test_export_codec_and_quality_come_from_the_panel(tmp_path, addon):
     assert low.stat().st_size < high.stat().st_size
 
 
+def test_export_to_a_size_or_an_error_budget(tmp_path, addon):
+    rigged_tube()
+    full, small, bounded = tmp_path / "full.mcgv", tmp_path / "small.mcgv", tmp_path / "bound.mcgv"
+    bpy.ops.export_scene.mcgv(filepath=str(full))
+    kb = full.stat().st_size * 0.7 / 1000
+    assert bpy.ops.export_scene.mcgv(filepath=str(small), budget="SIZE", target_kb=kb) == {"FINISHED"}
+    assert small.stat().st_size <= int(kb * 1000)
+    assert mcgv_video.Decoder(small.read_bytes()).header["quality"] < 50
+    written = io_mesh_mcgv.export_mcgv(
+        bpy.context, bpy.context.active_object, str(bounded), target_error=2e-4
+    )
+    assert written["encodes"] >= 2 and written["quality"] != 50
+    positions, _ = io_mesh_mcgv.evaluated_animation(bpy.context, bpy.context.active_object, *FRAMES, True)
+    positions = positions.astype(np.float64)
+    decoded = mcgv_video.Decoder(bounded.read_bytes()).all().astype(np.float64)
+    diagonal = np.linalg.norm(positions[0].max(axis=0) - positions[0].min(axis=0))
+    rmse = np.sqrt(np.mean(np.sum((decoded - positions) ** 2, axis=2))) / diagonal
+    assert rmse <= 2e-4 * (1 + 1e-6), rmse
+
+
 def test_nothing_to_export_is_reported_not_raised(tmp_path, addon):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     with pytest.raises(RuntimeError, match="select a mesh"):
