@@ -430,8 +430,9 @@ impl<'a> Search<'a> {
     }
 
     /// The modelled measure to aim at: the middle of the first encodes' window (a size's 2 %),
-    /// so that a model off by half of it lands (a size: beyond `fixed` bytes, at least half of what they leave under
-    /// the limit); fails when the bytes no quality changes fill a size budget alone.
+    /// so that a model off by half of it lands (a size: beyond `fixed` bytes, at least half of
+    /// what they leave under the limit); fails when the bytes no quality changes fill a size
+    /// budget alone.
     fn aim(&self, fixed: f64) -> Result<f64> {
         let aim = self.limit * (1.0 - 0.5 * self.budget.window(0));
         if self.budget.is_size() && self.unchanging >= self.limit {
