@@ -4,8 +4,10 @@ the interpreter's lock released while coding."""
 
 from __future__ import annotations
 
+import ast
 import json
 import pickle
+import re
 import subprocess
 import threading
 import time
@@ -24,7 +26,7 @@ from mcgv_video import (
     UsageError,
 )
 
-from conftest import cli_encode, cloth, media, write_pc2
+from conftest import REPO, cli_encode, cloth, media, write_pc2
 
 
 def canonical(faces):
@@ -95,6 +97,25 @@ def test_a_budget_is_met_with_the_bytes_and_report_the_cli_gives(tmp_path, cli):
         with pytest.raises(InvalidOptionError) as caught:
             mcgv_video.encode_to_budget(positions, faces, **budgets)
         assert caught.value.option == name, (budgets, caught.value)
+
+
+def test_the_type_stubs_name_the_keywords_the_binding_takes():
+    # `encode`'s options are checked against `KEYWORDS` in python/src/options.rs; the stub lists
+    # them again for editors and type checkers: the two must not drift apart.
+    source = (REPO / "python" / "src" / "options.rs").read_text()
+    listed = re.search(r"pub const KEYWORDS: \[&str; \d+\] = \[(.*?)\];", source, re.S)
+    keywords = set(re.findall(r'"(\w+)"', listed.group(1)))
+    stub = ast.parse((REPO / "python" / "mcgv_video" / "_native.pyi").read_text())
+    functions = {f.name: f for f in stub.body if isinstance(f, ast.FunctionDef)}
+
+    def keyword_names(name):
+        return {a.arg for a in functions[name].args.kwonlyargs}
+
+    call = {"fps", "uvs", "progress", "threads"}
+    assert keyword_names("encode") - call == keywords
+    targets = {"target_size", "target_bpvf", "target_error", "target_max_error"}
+    # No `step`: the search chooses it.
+    assert keyword_names("encode_to_budget") - call == (keywords - {"step"}) | targets
 
 
 def test_segments_coded_out_of_order_join_into_encode_s_stream():
