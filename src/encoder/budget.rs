@@ -319,9 +319,9 @@ impl<'a> Search<'a> {
         }
     }
 
-    /// Whether `measure` lies in the window of a search that has made `encodes` encodes.
-    fn landed(&self, measure: f64, encodes: usize) -> bool {
-        let floor = self.limit * (1.0 - self.budget.window(encodes));
+    /// Whether `measure` lies at most `window` (a share of the limit) under the limit.
+    fn landed(&self, measure: f64, window: f64) -> bool {
+        let floor = self.limit * (1.0 - window);
         (floor..=self.limit).contains(&measure)
     }
 
@@ -365,7 +365,8 @@ impl<'a> Search<'a> {
             .as_ref()
             .map(|(_, i)| self.budget.measure(&self.trials[*i]));
         let encodes = self.trials.len();
-        if best.is_some_and(|m| self.landed(m, encodes)) || encodes >= MAX_BUDGET_ENCODES {
+        let window = self.budget.window(encodes);
+        if best.is_some_and(|m| self.landed(m, window)) || encodes >= MAX_BUDGET_ENCODES {
             return Ok(None);
         }
         let latest = self.fixed_of.last().copied().unwrap_or(0.0);
@@ -511,7 +512,7 @@ impl<'a> Search<'a> {
             limit: self.limit,
             quality: self.trials[i].quality,
             achieved,
-            within_tolerance: self.landed(achieved, usize::MAX),
+            within_tolerance: self.landed(achieved, self.budget.tolerance()),
             encodes: self.trials.len(),
             trials: self.trials,
             model: self.model,
