@@ -28,7 +28,7 @@ pub use quantise::{Cell, Grid};
 
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
-use crate::mesh::{Point, Triangle};
+use crate::mesh::{position_key, Point, Triangle};
 use crate::stream::entropy::{check_capacity, Decoder, Encoder, SymbolCoder, UIntModel};
 use traversal::{Models, Oracle, UNASSIGNED};
 use weld::Weld;
@@ -213,10 +213,7 @@ fn decoded_output(
 /// cell at low bits would weld into degenerate and non-manifold triangles (horse-gallop at 10
 /// bits: 129 of 8 431, connectivity 2.2 -> 3.5 bits a vertex). Equal positions have equal cells.
 fn weld_exact(positions: &[Point]) -> Weld {
-    let keys: Vec<[u32; 3]> = positions
-        .iter()
-        .map(|p| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() }))
-        .collect();
+    let keys: Vec<[u32; 3]> = positions.iter().map(position_key).collect();
     Weld::new(&keys)
 }
 

@@ -54,6 +54,12 @@ use crate::error::{Error, Result};
 /// A 3D position.
 pub type Point = [f32; 3];
 
+/// A key equal for two positions exactly when their coordinates are equal (the bits, with −0
+/// and +0 one key), for welding vertices that share a position.
+pub(crate) fn position_key(p: &Point) -> [u32; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
 /// A triangle: three vertex indices.
 pub type Triangle = [u32; 3];
 

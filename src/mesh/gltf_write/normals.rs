@@ -5,7 +5,7 @@
 //! each side — stays smooth, as the sources' seams are. Hard edges of a source are smoothed: the
 //! stream does not say which split vertices were hard edges.
 
-use crate::mesh::{Point, Triangle};
+use crate::mesh::{position_key, Point, Triangle};
 use crate::mesh::vector::{cross, sub};
 use rustc_hash::FxHashMap;
 
@@ -22,7 +22,7 @@ impl Welding {
         let group = frame0
             .iter()
             .map(|p| {
-                let key = p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+                let key = position_key(p);
                 let next = seen.len() as u32;
                 *seen.entry(key).or_insert(next)
             })
