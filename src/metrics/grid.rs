@@ -10,7 +10,9 @@
 //! the hint's). The grid is rebuilt per frame in O(triangles). Cells are hashed into a table of
 //! about two buckets per triangle, so empty space costs nothing; a collision only adds candidates.
 //! The buckets' lists lie in memory in the order the triangles first join them, so that
-//! neighbouring cells share cache lines.
+//! neighbouring cells share cache lines. A triangle too large for 64 cells is tested by every
+//! query; past 32 of them (meshes of small and large triangles) they get a coarser grid of their
+//! own, sized by their extents, up to four levels deep.
 //!
 //! Written here rather than taken from a crate: the spatial crates (`parry3d-f64`'s QBVH, `rstar`,
 //! `kiddo`) answer unbounded nearest queries over their own shapes and distance code; this one
@@ -22,8 +24,12 @@ use super::triangle::{PreparedTriangle, Vec3};
 /// Cells one triangle may span before it is kept aside and tested by every query instead.
 const MAX_CELLS_PER_TRIANGLE: usize = 64;
 
-/// Triangles kept aside beyond which the grid gives up (every query would test them all).
+/// Triangles kept aside beyond which they get a coarser grid of their own (every query would
+/// test them all).
 const MAX_OVERSIZED: usize = 32;
+
+/// Coarser grids under the first at most, before the grid gives up (every query to the tree).
+const MAX_COARSER: u8 = 4;
 
 /// Cells a query may visit before it is left to the tree.
 const MAX_QUERY_CELLS: usize = 27;
@@ -32,6 +38,12 @@ const MAX_QUERY_CELLS: usize = 27;
 /// triangle joins more cells and a query crosses more cell walls. On pdance 1 took 7.0-7.4 CPU-s
 /// for `eval`; 0.7 and 0.5 took 9-11 (with 2 to 8 buckets per triangle), 1.5 and 2 took 7.6-8.
 const CELL_OVER_EXTENT: f64 = 1.0;
+
+/// Cell edge over the mean extent in the coarser grids: their triangles are large and overlap
+/// (BrainStem's coarser grid listed 46 of them a query at 1, 28 at 0.5; 0.25 and below were
+/// slower, their triangles joining too many cells). BrainStem at 1 frame/s, `--threads 1`: 8.34-8.40
+/// CPU-s at 1, 7.73-7.77 at 0.5.
+const COARSER_CELL_OVER_EXTENT: f64 = 0.5;
 
 /// The grid; empty (every query left to the tree) until built over finite triangles.
 #[derive(Debug, Clone, Default)]
@@ -47,6 +59,10 @@ pub struct TriangleGrid {
     entries: Vec<Entry>,
     /// Triangles too large for cells, tested by every query.
     oversized: Vec<u32>,
+    /// Past [`MAX_OVERSIZED`] of them, a grid of the triangles too large for this one's cells:
+    /// a mesh of small and large triangles (BrainStem: 61 666 faces, 500-900 of them over 64
+    /// cells) is then still queried by grid instead of by the tree (25× slower there).
+    coarser: Option<Box<TriangleGrid>>,
     /// Bounding box (low, high corner) of each triangle.
     boxes: Vec<[Vec3; 2]>,
     /// (bucket, triangle) of each entry, in triangle order: kept for its memory.
@@ -125,12 +141,27 @@ type CellRange = ([i64; 3], [i64; 3]);
 impl TriangleGrid {
     /// Rebuilds the grid over `triangles`, reusing its memory.
     pub fn rebuild(&mut self, triangles: &[PreparedTriangle]) {
+        self.build(triangles, None, 0);
+    }
+
+    /// Builds the grid over `triangles`, or only those numbered in `subset`; `level` grids lie
+    /// above this one.
+    fn build(&mut self, triangles: &[PreparedTriangle], subset: Option<&[u32]>, level: u8) {
         self.spans.clear();
         self.entries.clear();
         self.oversized.clear();
         self.boxes.clear();
-        self.boxes
-            .extend(triangles.iter().map(|t| corner_box(&t.corners)));
+        match subset {
+            None => self
+                .boxes
+                .extend(triangles.iter().map(|t| corner_box(&t.corners))),
+            Some(ids) => self.boxes.extend(
+                ids.iter()
+                    .filter_map(|&t| triangles.get(t as usize))
+                    .map(|t| corner_box(&t.corners)),
+            ),
+        }
+        let count = self.boxes.len();
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         let mut extent = 0.0;
         for b in &self.boxes {
@@ -140,7 +171,12 @@ impl TriangleGrid {
             }
             extent += (0..3).map(|a| b[1][a] - b[0][a]).fold(0.0, f64::max);
         }
-        let cell = CELL_OVER_EXTENT * extent / triangles.len().max(1) as f64;
+        let over_extent = if level == 0 {
+            CELL_OVER_EXTENT
+        } else {
+            COARSER_CELL_OVER_EXTENT
+        };
+        let cell = over_extent * extent / count.max(1) as f64;
         if !(cell > 0.0 && cell.is_finite() && lo.iter().chain(&hi).all(|x| x.is_finite())) {
             return;
         }
@@ -153,11 +189,28 @@ impl TriangleGrid {
             return;
         }
         self.dims = dims;
-        self.fill(triangles.len());
+        let number = |t: usize| subset.and_then(|ids| ids.get(t).copied()).unwrap_or(t as u32);
+        self.fill(count, number);
+        if self.oversized.len() > MAX_OVERSIZED && level < MAX_COARSER && !self.spans.is_empty() {
+            let ids = std::mem::take(&mut self.oversized);
+            let coarser = self.coarser.get_or_insert_with(Box::default);
+            coarser.build(triangles, Some(&ids), level + 1);
+            if coarser.spans.is_empty() {
+                self.spans.clear();
+            }
+        } else {
+            self.coarser = None;
+            if self.oversized.len() > MAX_OVERSIZED {
+                self.oversized.clear();
+                self.spans.clear();
+            }
+        }
     }
 
-    /// Lists each triangle in the buckets of its cells (counting pass, then placing pass).
-    fn fill(&mut self, triangles: usize) {
+    /// Lists each triangle in the buckets of its cells (counting pass, then placing pass);
+    /// `number` gives the number of the `t`-th box's triangle. Leaves the triangles too large for
+    /// cells in `oversized`.
+    fn fill(&mut self, triangles: usize, number: impl Fn(usize) -> u32) {
         let buckets = (2 * triangles).next_power_of_two();
         let mut count = vec![0u32; buckets + 1];
         // Each (bucket, triangle) listing, found once: placing then needs no cell arithmetic.
@@ -166,7 +219,7 @@ impl TriangleGrid {
         for (t, b) in self.boxes.iter().enumerate() {
             let range = self.cells(b[0], b[1]);
             if cell_count(&range) > MAX_CELLS_PER_TRIANGLE {
-                self.oversized.push(t as u32);
+                self.oversized.push(number(t));
                 continue;
             }
             for_each_cell(&range, |c| {
@@ -176,11 +229,6 @@ impl TriangleGrid {
                     listed.push((k as u32, t as u32));
                 }
             });
-        }
-        if self.oversized.len() > MAX_OVERSIZED {
-            self.oversized.clear();
-            self.listed = listed;
-            return;
         }
         // Bucket b's entries are `entries[spans[b][0]..spans[b][1]]`, laid out in the order the
         // triangles first list them: neighbouring triangles' cells lie near each other in memory,
@@ -202,7 +250,7 @@ impl TriangleGrid {
         for &(k, t) in &listed {
             if current.0 != t {
                 let b = self.boxes.get(t as usize).copied().unwrap_or_default();
-                current = (t, Entry::new(&b, t));
+                current = (t, Entry::new(&b, number(t as usize)));
             }
             if let Some(slot) = placed.get_mut(k as usize) {
                 if let Some(e) = self.entries.get_mut(*slot as usize) {
@@ -253,6 +301,12 @@ impl TriangleGrid {
         );
         if cell_count(&range) > MAX_QUERY_CELLS {
             return false;
+        }
+        // The coarser grid first: when it cannot tell, nothing has changed yet.
+        if let Some(coarser) = &self.coarser {
+            if !coarser.improve(p, triangles, best) {
+                return false;
+            }
         }
         let buckets = self.spans.len();
         let exact = |t: u32, best: &mut (f64, u32)| {
@@ -366,33 +420,20 @@ mod tests {
         corners.iter().map(|c| PreparedTriangle::new(*c)).collect()
     }
 
-    #[test]
-    fn a_settled_query_is_the_linear_scan() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
-        let corners = soup(&mut rng);
-        let triangles = prepare(&corners);
-        let mut grid = TriangleGrid::default();
-        grid.rebuild(&triangles);
-        assert_eq!(grid.oversized.len(), 1, "the spanning triangle is kept aside");
-        let longest = grid.spans.iter().map(|s| s[1] - s[0]).max();
-        assert!(longest >= Some(60), "the clump shares a bucket: {longest:?}");
+    /// Queries `grid` at each (hint, point): a settled query must give the linear scan's minimum,
+    /// an unsettled one change nothing. Returns how many were settled.
+    fn check_queries(
+        grid: &TriangleGrid,
+        corners: &[[Vec3; 3]],
+        queries: impl Iterator<Item = (usize, Vec3)>,
+    ) -> usize {
+        let triangles = prepare(corners);
         let distance = |t: usize, p: Vec3| {
             let c = corners[t];
             point_triangle_distance_squared(p, c[0], c[1], c[2])
         };
         let mut settled = 0;
-        for k in 0..3000 {
-            let hint = k % corners.len();
-            // Most queries lie near their hint, as the measures' do (some in the clump); a third
-            // anywhere.
-            let p = if k % 3 == 0 {
-                corners[hint][0].map(|x| x + 0.01 * uniform(&mut rng))
-            } else if k % 3 == 1 {
-                let hint = corners.len() - 2 - k % 60;
-                corners[hint][1].map(|x| x + 0.0001 * uniform(&mut rng))
-            } else {
-                [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)]
-            };
+        for (k, (hint, p)) in queries.enumerate() {
             let want = (0..corners.len())
                 .map(|t| distance(t, p))
                 .fold(f64::INFINITY, f64::min);
@@ -405,8 +446,61 @@ mod tests {
                 assert_eq!(best, (distance(hint, p), hint as u32), "unchanged when unsure");
             }
         }
+        settled
+    }
+
+    #[test]
+    fn a_settled_query_is_the_linear_scan() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+        let corners = soup(&mut rng);
+        let mut grid = TriangleGrid::default();
+        grid.rebuild(&prepare(&corners));
+        assert_eq!(grid.oversized.len(), 1, "the spanning triangle is kept aside");
+        let longest = grid.spans.iter().map(|s| s[1] - s[0]).max();
+        assert!(longest >= Some(60), "the clump shares a bucket: {longest:?}");
+        let n = corners.len();
+        let queries = (0..3000).map(|k| {
+            let hint = k % n;
+            // Most queries lie near their hint, as the measures' do (some in the clump); a third
+            // anywhere.
+            if k % 3 == 0 {
+                (hint, corners[hint][0].map(|x| x + 0.01 * uniform(&mut rng)))
+            } else if k % 3 == 1 {
+                let clump = n - 2 - k % 60;
+                (hint, corners[clump][1].map(|x| x + 0.0001 * uniform(&mut rng)))
+            } else {
+                let p = [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)];
+                (hint, p)
+            }
+        });
         // Far hints span too many cells and are left to the tree; near ones are settled.
+        let settled = check_queries(&grid, &corners, queries);
         assert!(settled > 1000, "{settled}");
+    }
+
+    #[test]
+    fn many_large_triangles_get_a_coarser_grid_of_their_own() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+        let mut corners = soup(&mut rng);
+        // Forty large triangles, each over more cells than one triangle may join.
+        for _ in 0..40 {
+            let o = [uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)];
+            corners.push(near(&mut rng, o, 1.5));
+        }
+        let triangles = prepare(&corners);
+        let mut grid = TriangleGrid::default();
+        grid.rebuild(&triangles);
+        assert!(grid.coarser.is_some(), "{} kept aside", grid.oversized.len());
+        let n = corners.len();
+        let queries = (0..2000).map(|k| {
+            let hint = k % n;
+            (hint, corners[hint][k % 3].map(|x| x + 0.003 * uniform(&mut rng)))
+        });
+        let settled = check_queries(&grid, &corners, queries);
+        assert!(settled > 1000, "{settled}");
+        // Back to few large triangles: the coarser grid goes.
+        grid.rebuild(&triangles[..n - 40]);
+        assert!(grid.coarser.is_none() && !grid.spans.is_empty());
     }
 
     #[test]
