@@ -73,6 +73,25 @@ pub(super) fn next_log_scale(
     Some(last.0 + (aim - last.1) / slope)
 }
 
+/// Whether the measure jumps across the aim: the two encodes next to each other in the step that
+/// straddle it lie less than `JUMP_WIDTH` apart in log scale, yet the measure changes across them
+/// more than `JUMP_FACTOR` times as fast as the `prior` slope says. No quality between them lands
+/// then (chickenCrossing HEVC's vertex RMSE: 3.03e-4 at quality 73.49, 2.79e-4 at 73.52, the
+/// budget 3e-4), and narrowing the bracket further only spends encodes.
+pub(super) fn jumps(points: &[(f64, f64)], aim: f64, prior: f64) -> bool {
+    bracket(points, aim).is_some_and(|(below, above)| {
+        let width = (above.0 - below.0).abs();
+        let rise = (above.1 - below.1).abs();
+        width > 0.0 && width < JUMP_WIDTH && rise > JUMP_FACTOR * prior.abs() * width
+    })
+}
+
+/// A bracket this narrow in log scale (about one quality point at 75, two at 50) that still jumps
+/// ([`jumps`]) ends a search.
+const JUMP_WIDTH: f64 = 0.04;
+/// How many times the prior's slope the measure must change by across it.
+const JUMP_FACTOR: f64 = 3.0;
+
 /// Where `f`, of opposite signs at `lo` and `hi`, is zero (bisection to the last bits);
 /// `None` without a change of sign.
 fn root(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> Option<f64> {
@@ -207,6 +226,33 @@ mod tests {
         let u = next_log_scale(&[(4.605, 12.772), (6.032, 11.198)], 11.282, -1.3, jpeg);
         let u = u.unwrap_or(f64::NAN);
         assert!(u > 5.7 && u < 6.032, "{u}");
+    }
+
+    #[test]
+    fn a_measure_that_jumps_across_a_narrow_bracket_ends_the_search() {
+        // chickenCrossing HEVC's vertex RMSE against ln(IJG scale), the budget 3e-4 (aim
+        // 2.955e-4): qualities 50, 68.56, 72.38 and 73.7 coded; 72.87 codes 3.03e-4, and every
+        // quality up to 73.49 stays over the budget, 73.52 under (2.79e-4).
+        let point = |quality: f64, rmse: f64| {
+            let scale = crate::codec::fine_scale_percent(quality);
+            (scale.ln(), f64::ln(rmse))
+        };
+        let aim = 2.955e-4f64.ln();
+        let mut points = vec![
+            point(50.0, 5.402e-4),
+            point(68.56, 3.371e-4),
+            point(72.38, 3.064e-4),
+            point(73.7, 2.775e-4),
+        ];
+        // 1.3 quality points apart: a steep stretch, not yet a jump.
+        assert!(!jumps(&points, aim, 1.3));
+        points.push(point(72.87, 3.032e-4));
+        points.push(point(73.12, 3.049e-4));
+        assert!(jumps(&points, aim, 1.3));
+        // The same bracket with the measure changing as the prior says is searched on.
+        let smooth = [point(73.12, 3.0e-4), point(73.7, 2.98e-4)];
+        assert!(!jumps(&smooth, 2.99e-4f64.ln(), 1.3));
+        assert!(!jumps(&points[..1], aim, 1.3), "no bracket");
     }
 
     #[test]
