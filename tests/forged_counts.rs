@@ -84,9 +84,9 @@ const SMALL: usize = 1 << 20;
 const VERTEX_COUNT: usize = 4;
 const TRAVERSED: usize = 8;
 const WELDED: usize = 16;
-const CONNECTIVITY_LEN: usize = 44;
-const GEOMETRY_LEN: usize = 48;
-const FIRST_FRAME_HEADER_LEN: usize = 60;
+const CONNECTIVITY_LEN: usize = 36;
+const GEOMETRY_LEN: usize = 40;
+const FIRST_FRAME_HEADER_LEN: usize = first_frame::HEADER_LEN;
 
 fn word(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(bytes[at..at + 4].try_into().expect("four bytes"))

@@ -11,7 +11,7 @@ use mcgv_video::Result;
 use std::path::Path;
 
 /// Bytes of the first-frame coder's own header; its CRC-32 is the header's last four bytes.
-const FIRST_FRAME_HEADER_LEN: usize = 60;
+const FIRST_FRAME_HEADER_LEN: usize = first_frame::HEADER_LEN;
 
 /// Meshes larger than this skip the static mesh coder round trip: it would slow every execution
 /// down without covering anything a small mesh does not.

@@ -2,7 +2,7 @@
 //!
 //! Layout of [`EncodedFirstFrame::bytes`] (little endian):
 //! `version u8, bits u8, flags u8, 0u8, vertices u32, traversed triangles u32,
-//! degenerate triangles u32, welded vertices u32, bbox lo 3×f32, bbox hi 3×f32,
+//! degenerate triangles u32, welded vertices u32, bbox lo 3×f32, largest extent f32,
 //! connectivity length u32, geometry length u32, order length u32, crc32 u32` then the three
 //! range-coded streams, all over the *welded* mesh, whose vertices are the distinct positions (see
 //! `weld`: seam copies and triangle soups become one connected surface):
@@ -33,8 +33,10 @@ use crate::stream::entropy::{check_capacity, Decoder, Encoder, SymbolCoder, UInt
 use traversal::{Models, Oracle, UNASSIGNED};
 use weld::Weld;
 
-const VERSION: u8 = 2;
-const HEADER_LEN: usize = 60;
+const VERSION: u8 = 3;
+/// Bytes of the header in front of the streams; its last four are the CRC-32 of the rest of the
+/// header and of the streams (tools that damage a first frame on purpose repair it there).
+pub const HEADER_LEN: usize = 52;
 const FLAG_ORDER: u8 = 1;
 /// Refuses headers past this many vertices or triangles whatever the input length.
 const MAX_ELEMENTS: u64 = 1 << 28;
@@ -494,7 +496,7 @@ impl Header {
         for v in [self.vertex_count, self.traversed, self.degenerate, self.welded] {
             out.extend_from_slice(&v.to_le_bytes());
         }
-        for c in self.grid.lo.iter().chain(&self.grid.hi) {
+        for c in self.grid.lo.iter().chain([&self.grid.extent]) {
             out.extend_from_slice(&c.to_le_bytes());
         }
         for l in self.lengths {
@@ -525,9 +527,9 @@ impl Header {
             return Err(Error::Stream(format!("first frame: {bits} position bits")));
         }
         let lo = [float(20), float(24), float(28)];
-        let hi = [float(32), float(36), float(40)];
-        if lo.iter().chain(&hi).any(|c| !c.is_finite()) {
-            return Err(Error::Stream("first frame: non-finite bounding box".into()));
+        let extent = float(32);
+        if lo.iter().any(|c| !c.is_finite()) || !(extent.is_finite() && extent >= 0.0) {
+            return Err(Error::Stream("first frame: bad bounding box".into()));
         }
         let header = Self {
             bits,
@@ -536,12 +538,13 @@ impl Header {
             traversed: word(8),
             degenerate: word(12),
             welded: word(16),
-            grid: Grid { bits, lo, hi },
-            lengths: [word(44), word(48), word(52)],
+            grid: Grid { bits, lo, extent },
+            lengths: [word(36), word(40), word(44)],
         };
         // What each stream must hold, in adaptive-coded symbols (each at least 1/710 bit, see
         // `max_symbols`): every welded vertex is three coded residuals in the geometry stream;
-        // every vertex is one "another copy?" decision and every triangle at least three in the
+        // every vertex is one "a copy per corner?" or "another copy?" decision (a welded vertex
+        // of n copies, n of its corners' decisions or more) and every triangle at least three in the
         // connectivity stream (a seed: three new/old bits; a gate: more, flipped and the 5-way kind
         // of its third vertex; a degenerate one: three indices); when the order is stored, every
         // vertex is a choice among 8 guesses (3 binary decisions) and a difference in the order

@@ -6,15 +6,16 @@ use crate::mesh::Point;
 /// Quantised coordinates: each axis in `0..=max_level()`.
 pub type Cell = [i32; 3];
 
-/// The grid positions are snapped to: 2^`bits` levels over the largest extent of `lo`..`hi`.
+/// The grid positions are snapped to: 2^`bits` levels from `lo` over `extent` on every axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
     /// Bits per coordinate (1..=24, so every level is exact in f32 arithmetic).
     pub bits: u8,
     /// Lower corner of the bounding box.
     pub lo: Point,
-    /// Upper corner of the bounding box.
-    pub hi: Point,
+    /// The bounding box's largest extent (the step is the same on every axis, so the other
+    /// corner is not needed).
+    pub extent: f32,
 }
 
 impl Grid {
@@ -46,7 +47,8 @@ impl Grid {
                 }
             }
         }
-        Ok(Self { bits, lo, hi })
+        let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0f32, f32::max);
+        Ok(Self { bits, lo, extent })
     }
 
     /// The largest level on an axis.
@@ -57,10 +59,7 @@ impl Grid {
     /// One step for every axis (the largest extent over the levels), as Draco does: the error
     /// is isotropic, and short axes do not pay for precision nobody asked for.
     fn step(&self) -> f32 {
-        let extent = (0..3)
-            .map(|a| self.hi[a] - self.lo[a])
-            .fold(0.0f32, f32::max);
-        extent / self.max_level() as f32
+        self.extent / self.max_level() as f32
     }
 
     /// The cell nearest to `p`.

@@ -67,10 +67,15 @@ pub(super) struct Numbering {
 
 #[derive(Default)]
 struct Models {
+    /// "a copy for each of its corners?" (a triangle soup), asked of vertices in two or more
+    /// triangles, by how many coded neighbours had one (0, 1, 2+).
+    own_copies: [BitModel; 3],
     /// "another copy?", by how many coded neighbours have copies (0, 1, 2+) and how many copies
     /// there are already (1, 2, 3, 4+): seams are lines, copies come in runs along them.
     more: [[BitModel; 4]; 3],
-    same_as_neighbour: BitModel,
+    /// "the copy the neighbour across the edge uses?", by what the edge's other end did in this
+    /// triangle ([`Seam`]): a seam cuts both ends of an edge.
+    same_as_neighbour: [BitModel; 3],
     /// "a copy not used yet?", by whether a neighbour's copy was offered first.
     fresh: [BitModel; 2],
     which: UIntModel,
@@ -91,11 +96,16 @@ pub(super) fn code_copies<C: SymbolCoder>(
 ) -> Result<Numbering> {
     let mut models = Models::default();
     let adjacency = VertexAdjacency::new(welded_count, triangles);
+    let mut corners_of = vec![0usize; welded_count];
+    for &w in triangles.iter().flatten() {
+        if let Some(n) = corners_of.get_mut(w as usize) {
+            *n += 1;
+        }
+    }
     let counts = code_counts(
         coder,
         &mut models,
-        &adjacency,
-        welded_count,
+        (&adjacency, &corners_of),
         vertex_count,
         actual,
     )?;
@@ -121,8 +131,13 @@ pub(super) fn code_copies<C: SymbolCoder>(
                     None => state.fresh(w, input),
                 }
             } else {
-                let pred = neighbour_copy(tri, k, &first_on_edge, triangles, &state.out);
-                choose(coder, &mut models, &mut state, w, count, pred, input)?
+                let across = neighbour_copy(tri, k, &first_on_edge, triangles, &state.out);
+                let seam = across.map_or(Seam::Unknown, |a| {
+                    Seam::at_other_end(a, (tri, k, &corners), &counts, triangles, &state.out)
+                });
+                let pred = across.map(|a| a.copy);
+                let corner = Corner { w, count, pred, seam };
+                choose(coder, &mut models, &mut state, corner, input)?
             };
         }
         state.out.triangles.push(corners);
@@ -146,25 +161,37 @@ pub(super) fn code_copies<C: SymbolCoder>(
     Ok(state.out)
 }
 
-/// The number of copies of each welded vertex, checked to add up to `vertex_count`.
+/// The number of copies of each welded vertex, checked to add up to `vertex_count`: first, for a
+/// vertex of two or more corners (`corners_of`, from the triangles), whether it has one copy per
+/// corner, as every vertex of a triangle soup has; else the count in unary.
 fn code_counts<C: SymbolCoder>(
     coder: &mut C,
     models: &mut Models,
-    adjacency: &VertexAdjacency,
-    welded_count: usize,
+    (adjacency, corners_of): (&VertexAdjacency, &[usize]),
     vertex_count: usize,
     actual: Option<Actual>,
 ) -> Result<Vec<usize>> {
+    let welded_count = corners_of.len();
     let mut counts = Vec::with_capacity(welded_count);
     let mut total = 0usize;
-    for w in 0..welded_count {
+    for (w, &corners) in corners_of.iter().enumerate() {
         let want = actual.map_or(1, |a| a.copies_of[w].len());
-        let seamed = adjacency
-            .neighbours(w)
-            .iter()
-            .filter(|&&n| counts.get(n as usize).is_some_and(|&c| c > 1))
-            .count()
-            .min(2);
+        let coded = |n: &u32| counts.get(*n as usize).map(|&c| (c, corners_of[*n as usize]));
+        let neighbours = adjacency.neighbours(w).iter().filter_map(coded);
+        let (mut seamed, mut soup) = (0usize, 0usize);
+        for (count, corners) in neighbours {
+            seamed += usize::from(count > 1);
+            soup += usize::from(corners > 1 && count == corners);
+        }
+        let (seamed, soup) = (seamed.min(2), soup.min(2));
+        if corners > 1 && coder.bit(want == corners, &mut models.own_copies[soup])? {
+            if total + corners > vertex_count {
+                return Err(corrupt("more copies than vertices"));
+            }
+            total += corners;
+            counts.push(corners);
+            continue;
+        }
         let mut count = 1;
         while coder.bit(count < want, &mut models.more[seamed][(count - 1).min(3)])? {
             count += 1;
@@ -203,6 +230,15 @@ impl State {
     }
 }
 
+/// A corner's neighbour across an edge: the copy it uses there, the corner of this triangle at
+/// the edge's other end, and the coded triangle across.
+#[derive(Clone, Copy)]
+struct Across {
+    copy: u32,
+    other: usize,
+    triangle: usize,
+}
+
 /// The copy that corner `k` of `tri` uses in the first coded triangle sharing one of its edges
 /// (the entry edge, corners 0 and 1, first).
 fn neighbour_copy(
@@ -211,29 +247,83 @@ fn neighbour_copy(
     first_on_edge: &HashMap<u64, u32>,
     triangles: &[Triangle],
     out: &Numbering,
-) -> Option<u32> {
+) -> Option<Across> {
     (0..3).filter(|&j| j != k).find_map(|j| {
         let t = *first_on_edge.get(&undirected(tri[k], tri[j]))? as usize;
         let pos = triangles.get(t)?.iter().position(|&x| x == tri[k])?;
-        out.triangles.get(t).map(|c| c[pos])
+        let copy = out.triangles.get(t).map(|c| c[pos])?;
+        Some(Across {
+            copy,
+            other: j,
+            triangle: t,
+        })
     })
 }
 
-/// Codes which of `count` copies of welded vertex `w` a corner uses.
+/// What the other end of the edge a corner's prediction comes across did in this triangle.
+#[derive(Clone, Copy)]
+enum Seam {
+    /// Not coded yet, or it has one copy.
+    Unknown,
+    /// It uses the copy it uses across the edge: most likely no seam on the edge.
+    Kept,
+    /// It changed copy: most likely a seam on the edge.
+    Cut,
+}
+
+impl Seam {
+    /// For corner `k` of `tri`, predicted `across` an edge, with the `corners` of this triangle
+    /// below `k` decided.
+    fn at_other_end(
+        across: Across,
+        (tri, k, corners): (&Triangle, usize, &[u32; 3]),
+        counts: &[usize],
+        triangles: &[Triangle],
+        out: &Numbering,
+    ) -> Seam {
+        let j = across.other;
+        let w = tri[j];
+        if j >= k || counts.get(w as usize).is_none_or(|&c| c < 2) {
+            return Seam::Unknown;
+        }
+        let there = (triangles.get(across.triangle))
+            .and_then(|t| t.iter().position(|&x| x == w))
+            .and_then(|pos| out.triangles.get(across.triangle).map(|c| c[pos]));
+        match there {
+            Some(copy) if copy == corners[j] => Seam::Kept,
+            Some(_) => Seam::Cut,
+            None => Seam::Unknown,
+        }
+    }
+}
+
+/// A corner of a welded vertex with copies, as [`choose`] codes it.
+struct Corner {
+    w: usize,
+    count: usize,
+    pred: Option<u32>,
+    seam: Seam,
+}
+
+/// Codes which of the copies of a welded vertex a corner uses.
 fn choose<C: SymbolCoder>(
     coder: &mut C,
     models: &mut Models,
     state: &mut State,
-    w: usize,
-    count: usize,
-    pred: Option<u32>,
+    corner: Corner,
     input: Option<u32>,
 ) -> Result<u32> {
+    let Corner {
+        w,
+        count,
+        pred,
+        seam,
+    } = corner;
     let known = input
         .and_then(|v| state.output_of.get(v as usize).copied())
         .filter(|&o| o != UNASSIGNED);
     if let Some(p) = pred {
-        if coder.bit(known == Some(p), &mut models.same_as_neighbour)? {
+        if coder.bit(known == Some(p), &mut models.same_as_neighbour[seam as usize])? {
             return Ok(p);
         }
     }

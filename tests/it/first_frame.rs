@@ -1,10 +1,24 @@
 //! Round trips of the first-frame mesh coder on meshes built in code, random soups and damage.
 
 use crate::common::canonical;
-use mcgv_video::first_frame::{decode, encode, FirstFrameOptions};
+use mcgv_video::first_frame::{decode, encode, FirstFrameOptions, HEADER_LEN};
 use mcgv_video::mesh::{Point, Triangle};
 use mcgv_video::Error;
 use proptest::prelude::*;
+
+const CRC_AT: usize = HEADER_LEN - 4;
+
+/// Recomputes the checksum so that only the other checks can refuse the bytes.
+fn with_valid_checksum(mut bytes: Vec<u8>) -> Vec<u8> {
+    if bytes.len() >= HEADER_LEN {
+        let mut h = crc32fast::Hasher::new();
+        h.update(&bytes[..CRC_AT]);
+        h.update(&bytes[HEADER_LEN..]);
+        let crc = h.finalize();
+        bytes[CRC_AT..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
+    }
+    bytes
+}
 
 /// Encodes and decodes with and without `reorder`; checks connectivity, positions and closed loop.
 fn round_trip(positions: &[Point], triangles: &[Triangle]) -> usize {
@@ -250,11 +264,7 @@ fn huge_vertex_count_is_refused_before_allocating() {
     let mut bytes = encode(&p, &t, &FirstFrameOptions::default()).unwrap().bytes;
     bytes[4..8].copy_from_slice(&1_000_000_000u32.to_le_bytes());
     // Fix the checksum so that only the count check can refuse it.
-    let mut h = crc32fast::Hasher::new();
-    h.update(&bytes[..56]);
-    h.update(&bytes[60..]);
-    let crc = h.finalize();
-    bytes[56..60].copy_from_slice(&crc.to_le_bytes());
+    let bytes = with_valid_checksum(bytes);
     // Past the coder's own limit, whatever the bytes (tests/forged_counts.rs forges counts under it).
     let err = decode(&bytes).unwrap_err();
     assert!(err.to_string().contains("1000000000 vertices"), "{err}");
@@ -279,18 +289,6 @@ proptest! {
     }
 }
 
-/// Recomputes the checksum so that damage reaches the entropy decoders.
-fn with_valid_checksum(mut bytes: Vec<u8>) -> Vec<u8> {
-    if bytes.len() >= 56 {
-        let mut h = crc32fast::Hasher::new();
-        h.update(&bytes[..52]);
-        h.update(&bytes[56..]);
-        let crc = h.finalize();
-        bytes[52..56].copy_from_slice(&crc.to_le_bytes());
-    }
-    bytes
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     #[test]
@@ -301,7 +299,7 @@ proptest! {
         let bytes = encode(&p, &t, &FirstFrameOptions::default()).unwrap().bytes;
         let mut bad = bytes.clone();
         for (at, mask) in flips {
-            let k = 56 + at % (bad.len() - 56);
+            let k = HEADER_LEN + at % (bad.len() - HEADER_LEN);
             bad[k] ^= mask;
         }
         let bad = with_valid_checksum(bad);
