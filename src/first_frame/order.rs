@@ -1,26 +1,100 @@
 //! The traversal → input vertex permutation, when the input's vertex order is kept.
 //!
-//! Each traversal vertex's input index is coded as a small correction to one of a few guesses,
-//! the guess named by an adaptive symbol: one past the largest index so far (input orders often
-//! follow face order), one past the previous vertex's, a coded neighbour's (modellers tend
-//! to number neighbours close together), or one past the newest earlier copy of the same
-//! position (see `weld`).
-
-use std::collections::HashMap;
+//! Coded in the input's order: for input vertex i, which decoded (traversal) vertex it is. Input
+//! orders follow faces — on every mesh of `../shared/media` but the three.js Horse, the vertices
+//! are numbered exactly in order of first use by the input's triangles — so input vertex i is most
+//! often a neighbour of input vertex i − 1, or of one a few before it, or another copy of the same
+//! position (a soup, a seam). Each vertex names one of those candidates (those not yet numbered,
+//! in a fixed order the decoder rebuilds) with an adaptive symbol, or escapes to a signed
+//! difference from the traversal vertex after i − 1's. Version 2 coded the traversal vertices in
+//! turn against guesses of their input index (one past the largest so far, a neighbour's): 18–47 %
+//! more bytes (docs/history.md).
 
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
 use crate::stream::entropy::{IntModel, SymbolCoder, SymbolModel};
 
-/// Guesses per vertex: the two sequential ones and up to this many minus two neighbours.
-const GUESSES: usize = 8;
+/// Candidates a vertex may name; the symbol after them is the escape.
+const CANDIDATES: usize = 15;
+/// Earlier input vertices whose neighbours are candidates, the latest first.
+const RECENT: usize = 4;
 
 fn corrupt(what: &str) -> Error {
     Error::Stream(format!("first frame vertex order: {what}"))
 }
 
+/// The traversal vertices input vertex i is likely to be, not numbered yet: the other copies of
+/// the previous input vertex's position, then the neighbours of the last [`RECENT`] input
+/// vertices, the latest first, each list by increasing traversal index.
+struct Candidates<'a> {
+    adjacency: &'a VertexAdjacency,
+    /// Traversal vertices of each welded vertex, increasing.
+    copies: Vec<Vec<u32>>,
+    /// Per welded vertex, how many of its first copies are numbered: skipped at once, so that a
+    /// position with thousands of copies is not scanned from its start for each of them.
+    numbered_copies: Vec<usize>,
+    welded: &'a [u32],
+    list: Vec<u32>,
+}
+
+impl<'a> Candidates<'a> {
+    fn new(adjacency: &'a VertexAdjacency, welded: &'a [u32]) -> Self {
+        let count = welded.iter().max().map_or(0, |&w| w as usize + 1);
+        let mut copies = vec![Vec::new(); count];
+        for (t, &w) in welded.iter().enumerate() {
+            copies[w as usize].push(t as u32);
+        }
+        Self {
+            adjacency,
+            numbered_copies: vec![0; copies.len()],
+            copies,
+            welded,
+            list: Vec::with_capacity(CANDIDATES),
+        }
+    }
+
+    /// Fills the list for the vertex after `recent` (traversal indices, the latest last).
+    fn fill(&mut self, recent: &[u32], numbered: &[bool]) {
+        self.list.clear();
+        let Some(&last) = recent.last() else {
+            return;
+        };
+        let latest = recent.iter().rev().take(RECENT);
+        let mut siblings: Vec<&[u32]> = Vec::with_capacity(RECENT);
+        for &p in latest.clone() {
+            let Some(&w) = self.welded.get(p as usize) else {
+                continue;
+            };
+            let (copies, skip) = (&self.copies[w as usize], &mut self.numbered_copies[w as usize]);
+            while copies.get(*skip).is_some_and(|&t| numbered[t as usize]) {
+                *skip += 1;
+            }
+            // Bounded: copies numbered out of order after the first free one are scanned again.
+            let end = copies.len().min(*skip + 2 * CANDIDATES);
+            siblings.push(&copies[*skip..end]);
+        }
+        // The previous vertex's neighbours (its triangle's other corners), the copies of the
+        // recent ones' positions (a soup's next triangle shares a position), then the recent
+        // ones' neighbours. Each vertex is among the recent ones RECENT times: its neighbours are
+        // read as often.
+        let first = self.adjacency.neighbours(last as usize).iter();
+        let copies = siblings.into_iter().flatten();
+        let others = latest.skip(1).flat_map(|&p| self.adjacency.neighbours(p as usize));
+        let (siblings, neighbours) = (first.chain(copies), others);
+        for &t in siblings.chain(neighbours) {
+            if self.list.len() == CANDIDATES {
+                break;
+            }
+            if !numbered[t as usize] && !self.list.contains(&t) {
+                self.list.push(t);
+            }
+        }
+    }
+}
+
 /// Codes `order[t]` (the input index of traversal vertex t) for every t; `adjacency` is over
-/// traversal indices. On the decoder `order` is filled in and checked to be a permutation.
+/// traversal indices, `welded` gives each traversal vertex's welded vertex. On the decoder
+/// `order` is filled in and checked to be a permutation.
 pub(super) fn code_order<C: SymbolCoder>(
     coder: &mut C,
     order: &mut [u32],
@@ -28,55 +102,43 @@ pub(super) fn code_order<C: SymbolCoder>(
     welded: &[u32],
 ) -> Result<()> {
     let vertex_count = order.len();
-    if adjacency.vertex_count() != vertex_count {
+    if adjacency.vertex_count() != vertex_count || welded.len() != vertex_count {
         return Err(corrupt("adjacency does not match"));
     }
-    let mut choice = SymbolModel::new(GUESSES);
-    let mut deltas: [IntModel; 4] = Default::default();
-    let mut seen = vec![false; vertex_count];
-    let (mut previous, mut largest) = (-1i64, -1i64);
-    let mut guesses = Vec::with_capacity(GUESSES);
-    let mut newest_copy: HashMap<u32, u32> = HashMap::new();
-    for t in 0..vertex_count {
-        guesses.clear();
-        guesses.extend([largest + 1, previous + 1]);
-        for &n in adjacency.neighbours(t) {
-            if (n as usize) < t && guesses.len() < GUESSES - 1 {
-                guesses.push(i64::from(order[n as usize]));
+    // Input vertex → traversal vertex (the encoder's from `order`; the decoder's decoded).
+    let mut traversal_of = vec![0u32; vertex_count];
+    for (t, &input) in order.iter().enumerate() {
+        if let Some(slot) = traversal_of.get_mut(input as usize) {
+            *slot = t as u32;
+        }
+    }
+    let mut choice = SymbolModel::new(CANDIDATES + 1);
+    let mut jump = IntModel::default();
+    let mut candidates = Candidates::new(adjacency, welded);
+    let mut numbered = vec![false; vertex_count];
+    for i in 0..vertex_count {
+        candidates.fill(&traversal_of[..i], &numbered);
+        let actual = traversal_of[i];
+        let named = candidates.list.iter().position(|&t| t == actual);
+        let pick = coder.symbol(named.unwrap_or(CANDIDATES), &mut choice)?;
+        let t = match candidates.list.get(pick) {
+            Some(&t) => i64::from(t),
+            None if pick == CANDIDATES => {
+                let after = i.checked_sub(1).map_or(0, |p| i64::from(traversal_of[p]) + 1);
+                let delta = coder.signed(i64::from(actual) - after, &mut jump)?;
+                after.checked_add(delta).ok_or_else(|| corrupt("index out of range"))?
             }
-        }
-        // Last, the newest earlier copy of the same welded vertex: copies of a soup's or a seam's
-        // vertex are often numbered near each other in the input, across the traversal's jumps.
-        let w = welded.get(t).copied();
-        let sibling = w.and_then(|w| newest_copy.get(&w).copied());
-        if let Some(copy) = sibling {
-            guesses.push(i64::from(order[copy as usize]) + 1);
-        }
-        if let Some(w) = w {
-            newest_copy.insert(w, t as u32);
-        }
-        let actual = i64::from(order[t]);
-        let best = (0..guesses.len())
-            .min_by_key(|&g| (actual - guesses[g]).abs())
-            .unwrap_or(0);
-        let pick = coder.symbol(best, &mut choice)?;
-        let base = *guesses.get(pick).ok_or_else(|| corrupt("no such guess"))?;
-        let class = if sibling.is_some() && pick + 1 == guesses.len() {
-            3
-        } else {
-            pick.min(2)
+            None => return Err(corrupt("no such candidate")),
         };
-        let value = base + coder.signed(actual - base, &mut deltas[class])?;
-        let index = usize::try_from(value)
+        let t = usize::try_from(t)
             .ok()
-            .filter(|&v| v < vertex_count)
+            .filter(|&t| t < vertex_count)
             .ok_or_else(|| corrupt("index out of range"))?;
-        if std::mem::replace(&mut seen[index], true) {
+        if std::mem::replace(&mut numbered[t], true) {
             return Err(corrupt("repeated index"));
         }
-        order[t] = index as u32;
-        previous = value;
-        largest = largest.max(value);
+        traversal_of[i] = t as u32;
+        order[t] = i as u32;
     }
     Ok(())
 }

@@ -18,7 +18,8 @@ use std::path::Path;
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
 /// The container version this build writes and reads: 9, the first frame's version 3 (a copy per
-/// corner said at once, seams cut both ends of an edge, a smaller header; issue 35; 8: each affine
+/// corner said at once, seams cut both ends of an edge, a smaller header, the vertex order coded in
+/// the input's order; issue 35; 8: each affine
 /// trajectory may add the innovation of a nearby cluster's; 7: the affine maps' linear part stored as a
 /// rotation and a symmetric stretch; 6: per entry, quantised per column by the
 /// cluster's extent along that axis, the temporal DCT's copies, the welded first frame; 5: the

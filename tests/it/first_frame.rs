@@ -90,6 +90,58 @@ fn grid(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
     (pos, tris)
 }
 
+/// `positions` and `triangles` renumbered so that vertex `v` becomes `new[v]`.
+fn renumbered(
+    positions: &[Point],
+    triangles: &[Triangle],
+    new: &[u32],
+) -> (Vec<Point>, Vec<Triangle>) {
+    let mut p = vec![[0.0; 3]; positions.len()];
+    for (v, &n) in new.iter().enumerate() {
+        p[n as usize] = positions[v];
+    }
+    let t = triangles
+        .iter()
+        .map(|tri| tri.map(|v| new[v as usize]))
+        .collect();
+    (p, t)
+}
+
+#[test]
+fn an_input_order_that_follows_the_triangles_costs_little_to_keep() {
+    // Exporters number vertices in order of first use by the triangles (every mesh of the shared
+    // media but one): the order stream names a neighbour of a recent vertex nearly every time
+    // (1.64 bits a vertex here; first-frame version 2's guesses of each traversal vertex's input
+    // index took 2.87, a random numbering 11.2).
+    let (p, t) = grid(40, 30);
+    let mut new = vec![u32::MAX; p.len()];
+    let mut next = 0;
+    for &v in t.iter().flatten() {
+        if new[v as usize] == u32::MAX {
+            new[v as usize] = next;
+            next += 1;
+        }
+    }
+    let (p, t) = renumbered(&p, &t, &new);
+    let order_bits = |p: &[Point], t: &[Triangle]| {
+        let coded = encode(p, t, &FirstFrameOptions::default()).unwrap();
+        8.0 * coded.sizes.order as f64 / p.len() as f64
+    };
+    let follows = order_bits(&p, &t);
+    // The same mesh numbered at random costs about log2(V) bits a vertex.
+    let mut shuffled: Vec<u32> = (0..p.len() as u32).collect();
+    for k in (1..shuffled.len()).rev() {
+        let j = (k as u64 * 2_654_435_761 % (k as u64 + 1)) as usize;
+        shuffled.swap(k, j);
+    }
+    let (q, u) = renumbered(&p, &t, &shuffled);
+    let random = order_bits(&q, &u);
+    assert!(follows < 2.0, "{follows} bits a vertex");
+    assert!(random > 6.0, "{random} bits a vertex");
+    round_trip(&p, &t);
+    round_trip(&q, &u);
+}
+
 /// A torus: a grid whose both directions wrap around.
 fn torus(n: usize, m: usize) -> (Vec<Point>, Vec<Triangle>) {
     let mut pos = Vec::new();
