@@ -18,6 +18,7 @@
 //! Triangles come back in traversal order (face order is not kept: coding it would cost
 //! log2(F!) bits) with the input's vertex indices and orientation, possibly rotated.
 
+mod creases;
 mod geometry;
 mod order;
 mod quantise;
@@ -136,7 +137,13 @@ pub fn encode(
         welded_count,
         &traversal_cells,
     )?;
-    let numbering = encode_copies(&mut connectivity, &state, &oracle, &weld, &sources)?;
+    let numbering = encode_copies(
+        &mut connectivity,
+        (&state, &decoded_cells),
+        &oracle,
+        &weld,
+        &sources,
+    )?;
     let mut to_output = vec![0u32; vertex_count];
     for (o, &input) in numbering.inputs.iter().enumerate() {
         to_output[input as usize] = o as u32;
@@ -241,7 +248,7 @@ fn split_welded(
 /// Codes which input vertex (copy of a welded vertex) each corner of the coded triangles uses.
 fn encode_copies(
     connectivity: &mut Encoder,
-    state: &traversal::Traversal,
+    (state, cells): (&traversal::Traversal, &[Cell]),
     oracle: &Oracle,
     weld: &Weld,
     sources: &[Triangle],
@@ -273,7 +280,7 @@ fn encode_copies(
     };
     weld::code_copies(
         connectivity,
-        &state.triangles,
+        (&state.triangles, cells),
         welded_count,
         weld.welded_of.len(),
         Some(actual),
@@ -412,7 +419,7 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
         geometry::code_positions(&mut geometry, &grid, &state.triangles, welded_count, &[])?;
     let numbering = weld::code_copies(
         &mut connectivity,
-        &state.triangles,
+        (&state.triangles, &cells),
         welded_count,
         vertex_count,
         None,

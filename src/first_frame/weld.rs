@@ -13,6 +13,8 @@
 
 use std::collections::HashMap;
 
+use super::creases;
+use super::quantise::Cell;
 use super::traversal::{undirected, UNASSIGNED};
 use crate::error::{Error, Result};
 use crate::mesh::topology::VertexAdjacency;
@@ -70,12 +72,13 @@ struct Models {
     /// "a copy for each of its corners?" (a triangle soup), asked of vertices in two or more
     /// triangles, by how many coded neighbours had one (0, 1, 2+).
     own_copies: [BitModel; 3],
-    /// "another copy?", by how many coded neighbours have copies (0, 1, 2+) and how many copies
-    /// there are already (1, 2, 3, 4+): seams are lines, copies come in runs along them.
-    more: [[BitModel; 4]; 3],
+    /// "another copy?", by how many coded neighbours have copies (0, 1, 2+), the sharpest fold of
+    /// the vertex's edges ([`creases`]) and how many copies there are already (1, 2, 3, 4+):
+    /// seams are lines, copies come in runs along them, and hard edges split normals.
+    more: [[[BitModel; 4]; creases::CLASSES]; 3],
     /// "the copy the neighbour across the edge uses?", by what the edge's other end did in this
-    /// triangle ([`Seam`]): a seam cuts both ends of an edge.
-    same_as_neighbour: [BitModel; 3],
+    /// triangle ([`Seam`]: a seam cuts both ends of an edge) and how sharply the edge folds.
+    same_as_neighbour: [[BitModel; creases::CLASSES]; 3],
     /// "a copy not used yet?", by whether a neighbour's copy was offered first.
     fresh: [BitModel; 2],
     which: UIntModel,
@@ -89,23 +92,36 @@ fn corrupt(what: &str) -> Error {
 /// each corner of `triangles` (welded traversal indices) uses.
 pub(super) fn code_copies<C: SymbolCoder>(
     coder: &mut C,
-    triangles: &[Triangle],
+    (triangles, cells): (&[Triangle], &[Cell]),
     welded_count: usize,
     vertex_count: usize,
     actual: Option<Actual>,
 ) -> Result<Numbering> {
     let mut models = Models::default();
     let adjacency = VertexAdjacency::new(welded_count, triangles);
+    // Only a mesh with copies reads the folds (the others' counts are all 1).
+    let folds = if vertex_count > welded_count {
+        creases::classify(triangles, cells)
+    } else {
+        HashMap::new()
+    };
+    let fold = |a: u32, b: u32| folds.get(&undirected(a, b)).map_or(0, |&c| usize::from(c));
     let mut corners_of = vec![0usize; welded_count];
     for &w in triangles.iter().flatten() {
         if let Some(n) = corners_of.get_mut(w as usize) {
             *n += 1;
         }
     }
+    let sharpest: Vec<usize> = (0..welded_count)
+        .map(|w| {
+            let around = adjacency.neighbours(w).iter();
+            around.map(|&n| fold(w as u32, n)).max().unwrap_or(0)
+        })
+        .collect();
     let counts = code_counts(
         coder,
         &mut models,
-        (&adjacency, &corners_of),
+        (&adjacency, &corners_of, &sharpest),
         vertex_count,
         actual,
     )?;
@@ -136,7 +152,13 @@ pub(super) fn code_copies<C: SymbolCoder>(
                     Seam::at_other_end(a, (tri, k, &corners), &counts, triangles, &state.out)
                 });
                 let pred = across.map(|a| a.copy);
-                let corner = Corner { w, count, pred, seam };
+                let crease = across.map_or(0, |a| fold(tri[k], tri[a.other]));
+                let corner = Corner {
+                    w,
+                    count,
+                    pred,
+                    context: (seam, crease),
+                };
                 choose(coder, &mut models, &mut state, corner, input)?
             };
         }
@@ -167,7 +189,7 @@ pub(super) fn code_copies<C: SymbolCoder>(
 fn code_counts<C: SymbolCoder>(
     coder: &mut C,
     models: &mut Models,
-    (adjacency, corners_of): (&VertexAdjacency, &[usize]),
+    (adjacency, corners_of, sharpest): (&VertexAdjacency, &[usize], &[usize]),
     vertex_count: usize,
     actual: Option<Actual>,
 ) -> Result<Vec<usize>> {
@@ -193,7 +215,8 @@ fn code_counts<C: SymbolCoder>(
             continue;
         }
         let mut count = 1;
-        while coder.bit(count < want, &mut models.more[seamed][(count - 1).min(3)])? {
+        let more = &mut models.more[seamed][sharpest[w].min(creases::CLASSES - 1)];
+        while coder.bit(count < want, &mut more[(count - 1).min(3)])? {
             count += 1;
             if total + count > vertex_count {
                 return Err(corrupt("more copies than vertices"));
@@ -302,7 +325,8 @@ struct Corner {
     w: usize,
     count: usize,
     pred: Option<u32>,
-    seam: Seam,
+    /// What the edge's other end did, and the edge's fold class.
+    context: (Seam, usize),
 }
 
 /// Codes which of the copies of a welded vertex a corner uses.
@@ -317,13 +341,14 @@ fn choose<C: SymbolCoder>(
         w,
         count,
         pred,
-        seam,
+        context: (seam, crease),
     } = corner;
     let known = input
         .and_then(|v| state.output_of.get(v as usize).copied())
         .filter(|&o| o != UNASSIGNED);
     if let Some(p) = pred {
-        if coder.bit(known == Some(p), &mut models.same_as_neighbour[seam as usize])? {
+        let model = &mut models.same_as_neighbour[seam as usize][crease.min(creases::CLASSES - 1)];
+        if coder.bit(known == Some(p), model)? {
             return Ok(p);
         }
     }
