@@ -4,11 +4,12 @@
 //! soups (every triangle with its own three vertices): coded as they are, each copy is a new
 //! vertex of a new component, predicted from nothing. So the traversal and the geometry run on
 //! the *welded* mesh (one vertex per distinct position), and this module codes how the input's
-//! vertices sit on it: the number of copies of each welded vertex (a unary count, one decision
-//! per copy), then, for each corner of each triangle in coding order, which copy it uses. A
-//! corner most often uses the copy its neighbour across an edge uses (the seam is elsewhere),
-//! else a copy not used yet (a soup), else one named among those used. Copies no triangle uses
-//! come last. Output vertices are numbered in order of first use, which is what the vertex
+//! vertices sit on it: the number of copies of each welded vertex ("one per corner?", which a
+//! soup answers yes everywhere, else a unary count, one decision per copy), then, for each corner
+//! of each triangle in coding order, which copy it uses. A corner most often uses the copy its
+//! neighbour across an edge uses (the seam is elsewhere: asked knowing whether the edge's other
+//! end changed copy, and how sharply the surface folds there, see `creases`), else a copy not
+//! used yet (a soup), else one named among those used. Copies no triangle uses come last. Output vertices are numbered in order of first use, which is what the vertex
 //! order stream and `reorder` see.
 
 use std::collections::HashMap;
