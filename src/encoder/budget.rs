@@ -372,12 +372,12 @@ impl<'a> Search<'a> {
         if best.is_some_and(|m| self.landed(m, window)) || encodes >= MAX_BUDGET_ENCODES {
             return Ok(None);
         }
-        let latest = self.fixed_of.last().copied().unwrap_or(0.0);
+        let aim = self.aim(self.fixed_of.last().copied().unwrap_or(0.0))?;
         let prior = self.budget.prior_slope(self.codec);
-        if best.is_some() && jumps(&self.modelled_points(), self.aim(latest)?, prior) {
+        if best.is_some() && jumps(&self.modelled_points(), aim, prior) {
             return Ok(None);
         }
-        let Some(mut u) = self.next_log_scale(self.aim(latest)?) else {
+        let Some(mut u) = self.next_log_scale(aim) else {
             return Ok(None);
         };
         // A size's fixed bytes move with the quality too (the skinning weights' bits): aim with

@@ -40,6 +40,10 @@ struct Candidates<'a> {
     numbered_copies: Vec<usize>,
     welded: &'a [u32],
     list: Vec<u32>,
+    /// Per traversal vertex, the fill that last listed it (fills are counted from 1): whether a
+    /// vertex is listed already, without searching the list.
+    listed_in: Vec<u32>,
+    fills: u32,
 }
 
 impl<'a> Candidates<'a> {
@@ -53,14 +57,17 @@ impl<'a> Candidates<'a> {
             adjacency,
             numbered_copies: vec![0; copies.len()],
             copies,
+            listed_in: vec![0; welded.len()],
             welded,
             list: Vec::with_capacity(CANDIDATES),
+            fills: 0,
         }
     }
 
     /// Fills the list for the vertex after `recent` (traversal indices, the latest last).
     fn fill(&mut self, recent: &[u32], numbered: &[bool]) {
         self.list.clear();
+        self.fills += 1;
         let Some(&last) = recent.last() else {
             return;
         };
@@ -90,7 +97,9 @@ impl<'a> Candidates<'a> {
             if self.list.len() == CANDIDATES {
                 break;
             }
-            if !numbered[t as usize] && !self.list.contains(&t) {
+            let listed = &mut self.listed_in[t as usize];
+            if !numbered[t as usize] && *listed != self.fills {
+                *listed = self.fills;
                 self.list.push(t);
             }
         }

@@ -9,8 +9,9 @@
 //! of each triangle in coding order, which copy it uses. A corner most often uses the copy its
 //! neighbour across an edge uses (the seam is elsewhere: asked knowing whether the edge's other
 //! end changed copy, and how sharply the surface folds there, see `creases`), else a copy not
-//! used yet (a soup), else one named among those used. Copies no triangle uses come last. Output vertices are numbered in order of first use, which is what the vertex
-//! order stream and `reorder` see.
+//! used yet (a soup), else one named among those used. Copies no triangle uses come last. Output
+//! vertices are numbered in order of first use, which is what the vertex order stream and
+//! `reorder` see.
 
 use std::collections::HashMap;
 
@@ -150,7 +151,7 @@ pub(super) fn code_copies<C: SymbolCoder>(
             } else {
                 let across = neighbour_copy(tri, k, &first_on_edge, triangles, &state.out);
                 let seam = across.map_or(Seam::Unknown, |a| {
-                    Seam::at_other_end(a, (tri, k, &corners), &counts, triangles, &state.out)
+                    Seam::at_other_end(a, (tri, k, &corners), &counts)
                 });
                 let pred = across.map(|a| a.copy);
                 let crease = across.map_or(0, |a| fold(tri[k], tri[a.other]));
@@ -255,12 +256,12 @@ impl State {
 }
 
 /// A corner's neighbour across an edge: the copy it uses there, the corner of this triangle at
-/// the edge's other end, and the coded triangle across.
+/// the edge's other end, and the copy that end uses there.
 #[derive(Clone, Copy)]
 struct Across {
     copy: u32,
     other: usize,
-    triangle: usize,
+    other_copy: Option<u32>,
 }
 
 /// The copy that corner `k` of `tri` uses in the first coded triangle sharing one of its edges
@@ -274,12 +275,12 @@ fn neighbour_copy(
 ) -> Option<Across> {
     (0..3).filter(|&j| j != k).find_map(|j| {
         let t = *first_on_edge.get(&undirected(tri[k], tri[j]))? as usize;
-        let pos = triangles.get(t)?.iter().position(|&x| x == tri[k])?;
-        let copy = out.triangles.get(t).map(|c| c[pos])?;
+        let (there, copies) = (triangles.get(t)?, out.triangles.get(t)?);
+        let copy_of = |v: u32| there.iter().position(|&x| x == v).map(|pos| copies[pos]);
         Some(Across {
-            copy,
+            copy: copy_of(tri[k])?,
             other: j,
-            triangle: t,
+            other_copy: copy_of(tri[j]),
         })
     })
 }
@@ -302,18 +303,12 @@ impl Seam {
         across: Across,
         (tri, k, corners): (&Triangle, usize, &[u32; 3]),
         counts: &[usize],
-        triangles: &[Triangle],
-        out: &Numbering,
     ) -> Seam {
         let j = across.other;
-        let w = tri[j];
-        if j >= k || counts.get(w as usize).is_none_or(|&c| c < 2) {
+        if j >= k || counts.get(tri[j] as usize).is_none_or(|&c| c < 2) {
             return Seam::Unknown;
         }
-        let there = (triangles.get(across.triangle))
-            .and_then(|t| t.iter().position(|&x| x == w))
-            .and_then(|pos| out.triangles.get(across.triangle).map(|c| c[pos]));
-        match there {
+        match across.other_copy {
             Some(copy) if copy == corners[j] => Seam::Kept,
             Some(_) => Seam::Cut,
             None => Seam::Unknown,
