@@ -19,6 +19,7 @@
 //! log2(F!) bits) with the input's vertex indices and orientation, possibly rotated.
 
 mod creases;
+mod free_ranks;
 mod geometry;
 mod order;
 mod quantise;
@@ -28,13 +29,12 @@ mod weld;
 pub use quantise::{Cell, Grid};
 
 use crate::error::{Error, Result};
-use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::{position_key, Point, Triangle};
 use crate::stream::entropy::{check_capacity, Decoder, Encoder, SymbolCoder, UIntModel};
 use traversal::{Models, Oracle, UNASSIGNED};
 use weld::Weld;
 
-const VERSION: u8 = 3;
+const VERSION: u8 = 4;
 /// Bytes of the header in front of the streams; its last four are the CRC-32 of the rest of the
 /// header and of the streams (tools that damage a first frame on purpose repair it there).
 pub const HEADER_LEN: usize = 52;
@@ -160,7 +160,6 @@ pub fn encode(
             &degenerate,
             &numbering.inputs,
             &numbering.welded,
-            vertex_count,
         )?
     };
     let (decoded_positions, permutation) =
@@ -340,23 +339,16 @@ fn to_traversal_indices(degenerate: &mut [Triangle], to_traversal: &[u32]) {
     }
 }
 
-/// Codes the traversal → input permutation over the adjacency of all triangles.
+/// Codes the traversal → input permutation over all triangles.
 fn encode_order(
     traversed: &[Triangle],
     degenerate: &[Triangle],
     from_traversal: &[u32],
     welded: &[u32],
-    vertex_count: usize,
 ) -> Result<Vec<u8>> {
     let mut order_coder = Encoder::new();
     let all: Vec<Triangle> = traversed.iter().chain(degenerate).copied().collect();
-    let adjacency = VertexAdjacency::new(vertex_count, &all);
-    order::code_order(
-        &mut order_coder,
-        &mut from_traversal.to_vec(),
-        &adjacency,
-        welded,
-    )?;
+    order::code_order(&mut order_coder, &mut from_traversal.to_vec(), &all, welded)?;
     order_coder.finish()
 }
 
@@ -435,11 +427,10 @@ pub fn decode(bytes: &[u8]) -> Result<(Vec<Triangle>, Vec<Point>)> {
         .collect();
     if header.has_order {
         let mut order_indices = vec![0u32; vertex_count];
-        let adjacency = VertexAdjacency::new(vertex_count, &triangles);
         order::code_order(
             &mut Decoder::new(order)?,
             &mut order_indices,
-            &adjacency,
+            &triangles,
             &welded,
         )?;
         let mut reordered = vec![[0.0; 3]; vertex_count];

@@ -17,16 +17,17 @@ use std::path::Path;
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
-/// The container version this build writes and reads: 9, the first frame's version 3 (a copy per
-/// corner said at once, seams cut both ends of an edge, a smaller header, the vertex order coded in
-/// the input's order; issue 35; 8: each affine
+/// The container version this build writes and reads: 10, the first frame's version 4 (a kept
+/// vertex order names the free corners of the triangles last used, escapes by rank among the free
+/// vertices; issue 35; 9: the first frame's version 3, a copy per corner said at once, seams cut
+/// both ends of an edge, a smaller header, the vertex order coded in the input's order; 8: each affine
 /// trajectory may add the innovation of a nearby cluster's; 7: the affine maps' linear part stored as a
 /// rotation and a symmetric stretch; 6: per entry, quantised per column by the
 /// cluster's extent along that axis, the temporal DCT's copies, the welded first frame; 5: the
 /// header holds what every codec shares and each codec its own fields in its set-up part;
 /// docs/history.md lists the versions).
 /// A reader refuses any other version, so an older reader says "update" instead of misreading.
-pub const VERSION: u16 = 9;
+pub const VERSION: u16 = 10;
 
 /// Bytes of a part header: tag, checksum kind, length, CRC.
 pub const PART_HEADER_LEN: usize = 17;
