@@ -15,7 +15,7 @@
 //! that follows the newest in the triangle's orientation (corners are used in their listed order),
 //! then by traversal index. Version 3 listed the previous vertex's neighbours, the recent copies,
 //! then the other recent vertices' neighbours, each by traversal index, and coded an escape as a
-//! difference of traversal indices: 3.4 % more bytes for the kept-order first frames of
+//! difference of traversal indices: 3.9 % more bytes for the kept-order first frames of
 //! `../shared/media` (docs/history.md).
 
 use super::free_ranks::FreeRanks;
@@ -26,11 +26,13 @@ use crate::stream::entropy::{IntModel, SymbolCoder, SymbolModel};
 /// Candidates a vertex may name; the symbol after them is the escape.
 const CANDIDATES: usize = 127;
 /// Earlier input vertices whose triangles and copies give the candidates, the latest first. 8
-/// and 16 cost 0.3-0.5 % more bytes than 32, 64 and 128 saved 0.1-0.2 % for up to twice the work.
+/// and 16 cost 0.2-0.5 % more bytes than 32, 64 and 128 saved 0.1-0.2 % for up to twice the work.
 const RECENT: usize = 32;
-/// What the best candidate is ([`Candidates::lead`]), one model each, after a named vertex and
-/// after an escape.
-const LEADS: usize = 4;
+/// What the best candidate is ([`Candidates::lead`]): none, only from an older vertex's triangle,
+/// the third corner of a triangle two of whose corners are numbered, or one numbered corner or a
+/// copy; each whether it follows its newest corner. One model each, after a named vertex and after
+/// an escape.
+const LEADS: usize = 8;
 
 fn corrupt(what: &str) -> Error {
     Error::Stream(format!("first frame vertex order: {what}"))
@@ -157,12 +159,14 @@ impl<'a> Candidates<'a> {
             }
         }
         let previous = recent.last().map(|&p| input[p as usize]);
-        self.lead = match self.found.first() {
+        let kind = match self.found.first() {
             None => 0,
             Some(&(key, _)) if Some((key >> 32) as u32) != previous => 1,
             Some(&(key, _)) if (key >> 1) & 0x7fff_ffff >= 2 => 2,
             Some(_) => 3,
         };
+        let follows = self.found.first().is_some_and(|&(key, _)| key & 1 == 1);
+        self.lead = kind + 4 * usize::from(follows);
     }
 
     /// The free corners of the triangles around numbered vertex `p`.
