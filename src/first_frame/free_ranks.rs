@@ -56,9 +56,9 @@ impl FreeRanks {
             }
             step /= 2;
         }
-        // The longest prefix `0..pos` holds at most `rank` present indices: `pos` is the answer if
-        // it is present and the prefix holds exactly `rank`.
-        (pos < n && self.below(pos + 1) == rank + 1).then_some(pos)
+        // `0..pos` is the longest prefix holding at most `rank` present indices: below `n`, the
+        // next index is present and the prefix holds exactly `rank`; `n` when there are no more.
+        (pos < n).then_some(pos)
     }
 }
 

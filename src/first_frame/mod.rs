@@ -545,8 +545,9 @@ impl Header {
         // of n copies, n of its corners' decisions or more) and every triangle at least three in the
         // connectivity stream (a seed: three new/old bits; a gate: more, flipped and the 5-way kind
         // of its third vertex; a degenerate one: three indices); when the order is stored, every
-        // vertex is a choice among 8 guesses (3 binary decisions) and a difference in the order
-        // stream. Checked per stream, before the decoders allocate anything per vertex or triangle.
+        // vertex is a choice among 127 candidates and the escape (7 binary decisions, of which 4
+        // are asked for here) in the order stream. Checked per stream, before the decoders
+        // allocate anything per vertex or triangle.
         let [lc, lg, lo] = header.lengths;
         let vertices = u64::from(header.vertex_count);
         let triangles = u64::from(header.traversed) + u64::from(header.degenerate);
