@@ -7,34 +7,51 @@
 //! A trajectory's *innovation* at frame f is its level there less its own extrapolation: what its
 //! past did not foretell. Clusters of one body share much of it (the body walks, turns or jumps
 //! as a whole), so a trajectory may also add the innovation of the same coefficient of an earlier
-//! coded cluster nearby, in its own units (container version 8).
+//! coded cluster nearby, in its own units (container version 8), or, for a translation, the
+//! innovation of that cluster's whole map at its own centroid (version 11: a turning thigh moves
+//! the shin's centroid by the turn times the lever between them).
 
 /// Predictor orders a trajectory may use (1..=ORDERS).
 pub const ORDERS: usize = 3;
 
-/// Symbols of a trajectory's [`Choice`].
-pub const CHOICES: usize = 2 * ORDERS;
+/// What a trajectory's prediction may add from its reference cluster.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Follow {
+    /// Nothing: its own extrapolation alone.
+    No = 0,
+    /// The innovation of the reference's same coefficient, scaled to this trajectory's step.
+    Coefficient = 1,
+    /// Translations only: the innovation of the reference's whole map (linear part included) at
+    /// this cluster's centroid.
+    Map = 2,
+}
 
-/// How a trajectory is predicted: its extrapolation order, and whether it adds its reference
-/// cluster's innovation.
+/// Symbols of a translation's [`Choice`]: every order with every [`Follow`].
+pub const CHOICES: usize = 3 * ORDERS;
+
+/// Symbols of a linear coefficient's [`Choice`], which never follows a [`Follow::Map`].
+pub const LINEAR_CHOICES: usize = 2 * ORDERS;
+
+/// How a trajectory is predicted: its extrapolation order, and what it adds from its reference
+/// cluster.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Choice {
     /// 1: the previous level, 2: linear, 3: quadratic extrapolation.
     pub order: usize,
-    /// Whether the reference's innovation, scaled to this trajectory's step, is added.
-    pub follows: bool,
+    /// What the reference cluster adds.
+    pub follows: Follow,
 }
 
 impl Choice {
     /// The plain previous-level predictor.
     pub const FIRST: Choice = Choice {
         order: 1,
-        follows: false,
+        follows: Follow::No,
     };
 
-    /// The coded symbol, `0..CHOICES`.
+    /// The coded symbol, `0..CHOICES` (`0..LINEAR_CHOICES` unless it follows a map).
     pub fn symbol(self) -> usize {
-        (self.order.clamp(1, ORDERS) - 1) + ORDERS * usize::from(self.follows)
+        (self.order.clamp(1, ORDERS) - 1) + ORDERS * self.follows as usize
     }
 
     /// The choice of symbol `s` (`s % CHOICES`).
@@ -42,7 +59,7 @@ impl Choice {
         let s = s % CHOICES;
         Choice {
             order: 1 + s % ORDERS,
-            follows: s >= ORDERS,
+            follows: [Follow::No, Follow::Coefficient, Follow::Map][s / ORDERS],
         }
     }
 }
@@ -90,23 +107,19 @@ fn bits_with(order: usize, trajectory: &[i64], reference: Option<&[i64]>) -> f64
 
 /// The order (1..=ORDERS) that codes `trajectory` smallest by the estimate, and its bits.
 pub fn best_order(trajectory: &[i64]) -> (usize, f64) {
-    let (choice, bits) = best_choice(trajectory, None);
+    let (choice, bits) = best_choice(trajectory, &[]);
     (choice.order, bits)
 }
 
-/// The [`Choice`] that codes `trajectory` smallest by the estimate, and its bits; `reference` is
-/// the reference cluster's innovation in this trajectory's levels, if it has one. Ties keep the
-/// lower order, and not following.
-pub fn best_choice(trajectory: &[i64], reference: Option<&[i64]>) -> (Choice, f64) {
-    let follows: &[bool] = if reference.is_some() {
-        &[false, true]
-    } else {
-        &[false]
-    };
+/// The [`Choice`] that codes `trajectory` smallest by the estimate, and its bits; `lifts` are what
+/// each way of following adds at each frame, in this trajectory's levels (none without a
+/// reference). Ties keep the lower order, and the earlier way (not following first).
+pub fn best_choice(trajectory: &[i64], lifts: &[(Follow, &[i64])]) -> (Choice, f64) {
     let mut best = (Choice::FIRST, f64::INFINITY);
-    for &follows in follows {
+    let ways = std::iter::once((Follow::No, None)).chain(lifts.iter().map(|&(f, l)| (f, Some(l))));
+    for (follows, lift) in ways {
         for order in 1..=ORDERS {
-            let bits = bits_with(order, trajectory, reference.filter(|_| follows));
+            let bits = bits_with(order, trajectory, lift);
             if bits < best.1 {
                 best = (Choice { order, follows }, bits);
             }
@@ -153,13 +166,18 @@ mod tests {
             .collect();
         assert_eq!(reference[0], 0);
         assert_eq!(reference[3], 8);
-        let (choice, bits) = best_choice(&own, Some(&reference));
-        assert!(choice.follows, "{choice:?}");
-        assert!(bits < best_choice(&own, None).1);
+        let lifts = [(Follow::Coefficient, &reference[..])];
+        let (choice, bits) = best_choice(&own, &lifts);
+        assert_eq!(choice.follows, Follow::Coefficient, "{choice:?}");
+        assert!(bits < best_choice(&own, &[]).1);
         // Without a reference, or one that does not help, it does not follow.
-        assert!(!best_choice(&own, None).0.follows);
-        let (still, _) = best_choice(&[4, 4, 4, 4], Some(&[0, 9, -9, 9]));
+        assert_eq!(best_choice(&own, &[]).0.follows, Follow::No);
+        let (still, _) = best_choice(&[4, 4, 4, 4], &[(Follow::Coefficient, &[0, 9, -9, 9])]);
         assert_eq!(still, Choice::FIRST);
+        // Of two ways, the one that predicts.
+        let worse = vec![1; own.len()];
+        let both = [(Follow::Coefficient, &worse[..]), (Follow::Map, &reference[..])];
+        assert_eq!(best_choice(&own, &both).0.follows, Follow::Map);
         for s in 0..CHOICES {
             assert_eq!(Choice::of_symbol(s).symbol(), s);
         }

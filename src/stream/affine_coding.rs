@@ -8,7 +8,10 @@
 //! extrapolation, 3: quadratic), and whether the prediction adds the *innovation* (level less its
 //! own extrapolation) of the same coefficient of the trajectory's reference cluster: the nearest
 //! earlier-coded cluster (by centroid on the decoded frame 0; for the linear part, the nearest of
-//! the same form), scaled to this cluster's step (container version 8). The first frame is
+//! the same form), scaled to this cluster's step (container version 8), or, for a translation,
+//! the innovation of the reference's whole map at this cluster's centroid (version 11: the
+//! reference's turn times the lever between the centroids, which a chain of limbs shares as
+//! their translations do not). The first frame is
 //! predicted by the identity map (frame 0 is fitted from the decoded frame 0 itself). Residuals go
 //! through adaptive integer models chosen by the coefficient's kind (entry, rotation, stretch or
 //! translation) and the size of the trajectory's previous residual, which tracks how busy the
@@ -21,7 +24,7 @@
 use crate::error::{Error, Result};
 use crate::mesh::Point;
 use crate::motion::trajectory::{
-    best_choice, extrapolate, innovation, scaled, Choice, CHOICES, ORDERS,
+    best_choice, extrapolate, innovation, scaled, Choice, Follow, CHOICES, LINEAR_CHOICES, ORDERS,
 };
 use crate::motion::{
     identity_levels, AffineTrack, ClusterGeometry, LinearForm, Partition, QuantisedAffine,
@@ -83,7 +86,14 @@ impl Models {
     fn new() -> Self {
         Self {
             form: SymbolModel::new(LinearForm::ALL.len()),
-            choice: std::array::from_fn(|_| SymbolModel::new(CHOICES)),
+            // Only a translation may follow its reference's whole map.
+            choice: std::array::from_fn(|kind| {
+                SymbolModel::new(if kind == Kind::Translation as usize {
+                    CHOICES
+                } else {
+                    LINEAR_CHOICES
+                })
+            }),
             first: Default::default(),
             residual: Default::default(),
         }
@@ -190,7 +200,7 @@ fn code_trajectories<C: SymbolCoder>(
                 kind: Kind::of(coeff, form),
                 reference: references.for_coeff(coeff, form, &steps),
             };
-            code_trajectory(c, q, choices, &trajectory, &mut models)?;
+            code_trajectory(c, q, choices, &trajectory, geometry, &mut models)?;
         }
     }
     if c.raw_bits(u64::from(AFFINE_END), 32)? != u64::from(AFFINE_END) {
@@ -230,6 +240,55 @@ fn level_innovation(q: &QuantisedAffine, cluster: usize, coeff: usize, order: us
     innovation(order, &before[..f - from], at(f))
 }
 
+/// What [`Follow::Map`] adds to translation `coeff` of cluster `k` at frame `f`: the innovation
+/// under `order` of reference `j`'s whole map at `k`'s centroid, in levels of the base step (which
+/// every translation shares): `j`'s translation innovation plus its linear part's, dequantised,
+/// applied to the lever from `j`'s centroid to `k`'s, rounded. Dequantising and extrapolating take
+/// + − × / alone (IEEE-exact), so encoder and decoder agree to the bit.
+fn map_innovation(
+    q: &QuantisedAffine,
+    geometry: &ClusterGeometry,
+    (k, j): (usize, usize),
+    coeff: usize,
+    order: usize,
+    f: usize,
+) -> i64 {
+    let translation = level_innovation(q, j, coeff, order, f);
+    let Some(&form) = q.forms.get(j) else {
+        return translation;
+    };
+    let step = f64::from(q.step);
+    let steps = geometry.steps(j, step, form);
+    let row = coeff / 4;
+    // Row `row` of j's linear part at frame g.
+    let linear = |g: usize| -> [f64; 3] {
+        let x: [f64; 9] = std::array::from_fn(|i| {
+            let c = 4 * (i / 3) + i % 3;
+            let level = q.values.get((g * q.clusters + j) * 12 + c).copied();
+            level.unwrap_or(0) as f64 * steps[c]
+        });
+        form.linear(&x)[row]
+    };
+    // As `extrapolate` over the last ORDERS frames: the order falls with a shorter past.
+    let guess: [f64; 3] = match order.min(f.min(ORDERS)) {
+        0 => return translation,
+        1 => linear(f - 1),
+        2 => {
+            let (a, b) = (linear(f - 1), linear(f - 2));
+            std::array::from_fn(|c| 2.0 * a[c] - b[c])
+        }
+        _ => {
+            let (a, b, d) = (linear(f - 1), linear(f - 2), linear(f - 3));
+            std::array::from_fn(|c| 3.0 * a[c] - 3.0 * b[c] + d[c])
+        }
+    };
+    let now = linear(f);
+    let (to, from) = (geometry.centroid(k), geometry.centroid(j));
+    let moved: f64 = (0..3).map(|c| (now[c] - guess[c]) * (to[c] - from[c])).sum();
+    // Saturating (and 0 for a NaN) like every level conversion.
+    translation.saturating_add((moved / step).round() as i64)
+}
+
 /// Codes `t`'s choice (`choices[cluster * 12 + coeff]`), then its level at every frame as the
 /// residual of the prediction. With the levels kept (`q.values` not empty) a trajectory that
 /// follows its reference adds the reference's innovation, recomputed from the reference's levels
@@ -239,6 +298,7 @@ fn code_trajectory<C: SymbolCoder>(
     q: &mut QuantisedAffine,
     choices: &mut [Choice],
     t: &Trajectory,
+    geometry: &ClusterGeometry,
     models: &mut Models,
 ) -> Result<()> {
     let (frames, clusters, kind) = (q.frames, q.clusters, t.kind as usize);
@@ -247,9 +307,16 @@ fn code_trajectory<C: SymbolCoder>(
     let choice = Choice::of_symbol(coded);
     choices[slot] = choice;
     let reference = match (choice.follows, t.reference) {
-        (false, _) => None,
-        (true, Some((j, ratio))) => Some((j, choices[j * 12 + t.coeff].order, ratio)),
-        (true, None) => {
+        (Follow::No, _) => None,
+        (Follow::Map, _) if t.kind != Kind::Translation => {
+            return Err(Error::Stream(format!(
+                "affine coefficients: cluster {}, coefficient {} follows a map, which only a \
+                 translation may",
+                t.cluster, t.coeff
+            )))
+        }
+        (follows, Some((j, ratio))) => Some((j, choices[j * 12 + t.coeff].order, ratio, follows)),
+        (_, None) => {
             return Err(Error::Stream(format!(
                 "affine coefficients: cluster {}, coefficient {} follows a reference cluster it \
                  does not have",
@@ -271,7 +338,10 @@ fn code_trajectory<C: SymbolCoder>(
             ),
         };
         let lift = match reference {
-            Some((j, order, ratio)) if f > 0 && keep => {
+            Some((j, order, _, Follow::Map)) if f > 0 && keep => {
+                map_innovation(q, geometry, (t.cluster, j), t.coeff, order, f)
+            }
+            Some((j, order, ratio, _)) if f > 0 && keep => {
                 scaled(level_innovation(q, j, t.coeff, order, f), ratio)
             }
             _ => 0,
@@ -316,14 +386,22 @@ fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
             let levels: Vec<i64> = (0..frames)
                 .map(|f| q.values[(f * clusters + k) * 12 + coeff])
                 .collect();
-            let lift: Option<Vec<i64>> =
-                references.for_coeff(coeff, q.forms[k], &steps).map(|(j, ratio)| {
-                    let order = choices[j * 12 + coeff].order;
-                    (0..frames)
-                        .map(|f| scaled(level_innovation(q, j, coeff, order, f), ratio))
-                        .collect()
-                });
-            choices[k * 12 + coeff] = best_choice(&levels, lift.as_deref()).0;
+            let mut lifts: Vec<(Follow, Vec<i64>)> = Vec::new();
+            if let Some((j, ratio)) = references.for_coeff(coeff, q.forms[k], &steps) {
+                let order = choices[j * 12 + coeff].order;
+                let coefficient = (0..frames)
+                    .map(|f| scaled(level_innovation(q, j, coeff, order, f), ratio))
+                    .collect();
+                lifts.push((Follow::Coefficient, coefficient));
+                if Kind::of(coeff, q.forms[k]) == Kind::Translation {
+                    let map = (0..frames)
+                        .map(|f| map_innovation(q, geometry, (k, j), coeff, order, f))
+                        .collect();
+                    lifts.push((Follow::Map, map));
+                }
+            }
+            let ways: Vec<(Follow, &[i64])> = lifts.iter().map(|(f, l)| (*f, &l[..])).collect();
+            choices[k * 12 + coeff] = best_choice(&levels, &ways).0;
         }
     }
     choices
