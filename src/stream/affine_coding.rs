@@ -289,6 +289,25 @@ fn map_innovation(
     translation.saturating_add((moved / step).round() as i64)
 }
 
+/// What following reference `j` the way `follows` adds to trajectory (`k`, `coeff`) at frame `f`,
+/// `j`'s own trajectory extrapolated by `order` and its steps `ratio` times this one's: the one
+/// definition the encoder's choice and the coder share.
+fn lift(
+    q: &QuantisedAffine,
+    geometry: &ClusterGeometry,
+    follows: Follow,
+    (k, j): (usize, usize),
+    coeff: usize,
+    (order, ratio): (usize, f64),
+    f: usize,
+) -> i64 {
+    match follows {
+        Follow::No => 0,
+        Follow::Coefficient => scaled(level_innovation(q, j, coeff, order, f), ratio),
+        Follow::Map => map_innovation(q, geometry, (k, j), coeff, order, f),
+    }
+}
+
 /// Codes `t`'s choice (`choices[cluster * 12 + coeff]`), then its level at every frame as the
 /// residual of the prediction. With the levels kept (`q.values` not empty) a trajectory that
 /// follows its reference adds the reference's innovation, recomputed from the reference's levels
@@ -338,12 +357,15 @@ fn code_trajectory<C: SymbolCoder>(
             ),
         };
         let lift = match reference {
-            Some((j, order, _, Follow::Map)) if f > 0 && keep => {
-                map_innovation(q, geometry, (t.cluster, j), t.coeff, order, f)
-            }
-            Some((j, order, ratio, _)) if f > 0 && keep => {
-                scaled(level_innovation(q, j, t.coeff, order, f), ratio)
-            }
+            Some((j, order, ratio, follows)) if f > 0 && keep => lift(
+                q,
+                geometry,
+                follows,
+                (t.cluster, j),
+                t.coeff,
+                (order, ratio),
+                f,
+            ),
             _ => 0,
         };
         let guess = own.saturating_add(lift);
@@ -389,15 +411,14 @@ fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
             let mut lifts: Vec<(Follow, Vec<i64>)> = Vec::new();
             if let Some((j, ratio)) = references.for_coeff(coeff, q.forms[k], &steps) {
                 let order = choices[j * 12 + coeff].order;
-                let coefficient = (0..frames)
-                    .map(|f| scaled(level_innovation(q, j, coeff, order, f), ratio))
-                    .collect();
-                lifts.push((Follow::Coefficient, coefficient));
-                if Kind::of(coeff, q.forms[k]) == Kind::Translation {
-                    let map = (0..frames)
-                        .map(|f| map_innovation(q, geometry, (k, j), coeff, order, f))
-                        .collect();
-                    lifts.push((Follow::Map, map));
+                let ways: &[Follow] = if Kind::of(coeff, q.forms[k]) == Kind::Translation {
+                    &[Follow::Coefficient, Follow::Map]
+                } else {
+                    &[Follow::Coefficient]
+                };
+                for &follows in ways {
+                    let at = |f| lift(q, geometry, follows, (k, j), coeff, (order, ratio), f);
+                    lifts.push((follows, (0..frames).map(at).collect()));
                 }
             }
             let ways: Vec<(Follow, &[i64])> = lifts.iter().map(|(f, l)| (*f, &l[..])).collect();
