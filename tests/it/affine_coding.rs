@@ -312,22 +312,25 @@ fn jolted_blocks(shared: bool) -> Blocks {
     }
 }
 
+/// Bytes of the affine part of `blocks`' fitted track, checked to decode to the same track.
+fn coded_size(blocks: Blocks) -> usize {
+    let Blocks {
+        rest,
+        frames,
+        partition,
+    } = blocks;
+    let track = AffineTrack::fit(&frames, &rest, &partition, 1e-4).unwrap();
+    let bytes = encode_affine(&track).unwrap();
+    let decoded = decode_affine(&bytes, frames.len(), &partition, &rest).unwrap();
+    assert_eq!(decoded, track);
+    bytes.len()
+}
+
 #[test]
 fn clusters_jolted_alike_follow_each_other() {
     // Each block's maps are a random walk, which no extrapolation foretells; when every block
     // walks the same way, each but the first adds its neighbour's innovation instead.
-    let size = |shared: bool| {
-        let Blocks {
-            rest,
-            frames,
-            partition,
-        } = jolted_blocks(shared);
-        let track = AffineTrack::fit(&frames, &rest, &partition, 1e-4).unwrap();
-        let bytes = encode_affine(&track).unwrap();
-        let decoded = decode_affine(&bytes, frames.len(), &partition, &rest).unwrap();
-        assert_eq!(decoded, track);
-        bytes.len()
-    };
+    let size = |shared: bool| coded_size(jolted_blocks(shared));
     let (alike, apart) = (size(true), size(false));
     assert!(
         (alike as f64) < 0.5 * apart as f64,
@@ -367,18 +370,7 @@ fn a_swung_arm_follows_its_neighbours_turn_at_its_own_centroid() {
     // Every block turns alike, so its linear part follows its neighbour's; its translation moves
     // by the turn times its own distance from the pivot, which the neighbour's whole map at this
     // block's centroid foretells, and its translation innovation does not.
-    let size = |blocks: usize| {
-        let Blocks {
-            rest,
-            frames,
-            partition,
-        } = swung_arm(blocks);
-        let track = AffineTrack::fit(&frames, &rest, &partition, 1e-4).unwrap();
-        let bytes = encode_affine(&track).unwrap();
-        let decoded = decode_affine(&bytes, frames.len(), &partition, &rest).unwrap();
-        assert_eq!(decoded, track);
-        bytes.len()
-    };
+    let size = |blocks: usize| coded_size(swung_arm(blocks));
     // Six blocks: 176 bytes, one: 60; following the translations' innovations alone, 328.
     let (one, six) = (size(1), size(6));
     assert!(six < 4 * one, "one block {one} bytes, six {six}");
