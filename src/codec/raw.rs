@@ -62,7 +62,7 @@ impl ResidualEncoder for Encoder {
             atlas: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
-                Part::whole(Tag::FRAME_INDEX, index.to_bytes()),
+                Part::whole(Tag::FRAME_INDEX, index.to_bytes()?),
                 Part {
                     tag: Tag::FRAMES,
                     bytes: payload,

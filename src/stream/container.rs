@@ -17,8 +17,9 @@ use std::path::Path;
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
-/// The container version this build writes and reads: 11, a translation's trajectory may follow
-/// its reference cluster's whole map at its own centroid (issue 35; 10: the first frame's version 4, a kept
+/// The container version this build writes and reads: 12, the frame index entropy-coded (issue
+/// 35; 11: a translation's trajectory may follow
+/// its reference cluster's whole map at its own centroid; 10: the first frame's version 4, a kept
 /// vertex order names the free corners of the triangles last used, escapes by rank among the free
 /// vertices; issue 35; 9: the first frame's version 3, a copy per corner said at once, seams cut
 /// both ends of an edge, a smaller header, the vertex order coded in the input's order; 8: each affine
@@ -28,7 +29,7 @@ pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 /// header holds what every codec shares and each codec its own fields in its set-up part;
 /// docs/history.md lists the versions).
 /// A reader refuses any other version, so an older reader says "update" instead of misreading.
-pub const VERSION: u16 = 11;
+pub const VERSION: u16 = 12;
 
 /// Bytes of a part header: tag, checksum kind, length, CRC.
 pub const PART_HEADER_LEN: usize = 17;

@@ -121,7 +121,7 @@ impl ResidualEncoder for Encoder {
             before_predictor: vec![Part::whole(Tag::LATTICE, lattice_part)],
             after_predictor: vec![
                 Part::whole(Tag::RANGES, ranges),
-                Part::whole(Tag::FRAME_INDEX, index.to_bytes()),
+                Part::whole(Tag::FRAME_INDEX, index.to_bytes()?),
                 Part {
                     tag: Tag::FRAMES,
                     bytes: payload,
