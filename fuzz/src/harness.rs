@@ -6,6 +6,7 @@ use mcgv_video::codec::tdct::index::BandIndex;
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::{parse_gltf, parse_obj, parse_pc2, AnimatedMesh, Summary, Triangle};
 use mcgv_video::stream::container::{FILE_HEADER_LEN, PART_HEADER_LEN};
+use mcgv_video::stream::frame_index::FrameIndex;
 use mcgv_video::Decoder;
 use mcgv_video::Result;
 use std::path::Path;
@@ -24,6 +25,7 @@ const ROUND_TRIP_LIMIT: usize = 4096;
 pub fn decode_stream(data: &[u8]) -> Result<()> {
     let mut bytes = data.to_vec();
     fix_band_index(&mut bytes);
+    fix_frame_index(&mut bytes);
     fix_checksums(&mut bytes);
     if let Some((start, end)) = part_span(&bytes, b"TDCT").filter(|&(s, e)| e > s) {
         // Where to cut follows the input, so that the corpus covers cuts at band boundaries and
@@ -148,8 +150,8 @@ fn same_bits(a: &[[f32; 3]], b: &[[f32; 3]]) -> bool {
             .all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()))
 }
 
-/// Rewrites every checksum a `.mcgv` file carries (each part's, the first frame's own and each
-/// frame chunk's from the frame index) to match the bytes, so that mutated files get past the
+/// Rewrites the checksums of a `.mcgv` file's parts and the first frame's own (the frame chunks'
+/// are [`fix_frame_index`]'s, the bands' [`fix_band_index`]'s) to match the bytes, so that mutated files get past the
 /// CRC checks, which would otherwise reject nearly every mutation before any decoder runs. Stops
 /// quietly where the layout stops making sense: the decoder reports that itself.
 pub fn fix_checksums(bytes: &mut [u8]) {
@@ -160,9 +162,6 @@ pub fn fix_checksums(bytes: &mut [u8]) {
         return;
     };
     let mut pos = FILE_HEADER_LEN;
-    // Each segment of a segmented stream has its own frame index and images part.
-    let mut index: Option<IndexSpan> = None;
-    let mut pairs: Vec<(IndexSpan, (usize, usize))> = Vec::new();
     for _ in 0..count.min(1024) {
         let Some(head) = bytes.get(pos..pos + PART_HEADER_LEN) else {
             return;
@@ -181,59 +180,87 @@ pub fn fix_checksums(bytes: &mut [u8]) {
             bytes[start + FIRST_FRAME_HEADER_LEN - 4..start + FIRST_FRAME_HEADER_LEN]
                 .copy_from_slice(&crc);
         }
-        match &tag {
-            b"INDX" => index = Some((pos, start, end)),
-            b"FRMS" => pairs.extend(index.take().map(|i| (i, (start, end)))),
-            _ => {}
-        }
         if whole {
             let crc = crc32fast::hash(&bytes[start..end]).to_le_bytes();
-            bytes[pos + 13..pos + 17].copy_from_slice(&crc);
+            bytes[pos + CRC_AT..pos + CRC_AT + 4].copy_from_slice(&crc);
         }
         pos = end;
     }
-    for (index, frames) in pairs {
-        fix_chunks(bytes, index, frames);
+}
+
+/// Where a part header holds its payload length (`u32`) and its CRC-32.
+const LEN_AT: usize = 5;
+const CRC_AT: usize = 9;
+
+/// The payload length a part header at `head` declares.
+fn declared_len(head: &[u8]) -> Option<u64> {
+    let word = head.get(LEN_AT..LEN_AT + 4)?.try_into().ok()?;
+    Some(u64::from(u32::from_le_bytes(word)))
+}
+
+/// Repairs the frame chunks' CRCs in every frame index (one per segment) that still parses, so
+/// that mutated pictures reach the picture decoders; the index is coded again and spliced in.
+pub fn fix_frame_index(bytes: &mut Vec<u8>) {
+    for n in 0..64 {
+        if !fix_nth_frame_index(bytes, n) {
+            return;
+        }
     }
 }
 
-/// A frame index part: its header's offset, and its payload's start and end.
-type IndexSpan = (usize, usize, usize);
-
-/// Frame chunks: the index (header at `i_pos`, payload `i_start..i_end`) lists (length, CRC, key)
-/// per frame, chunks laid end to end in `f_start..f_end`; the index's own CRC changes with them.
-fn fix_chunks(
-    bytes: &mut [u8],
-    (i_pos, i_start, i_end): IndexSpan,
-    (f_start, f_end): (usize, usize),
-) {
-    let word = |b: &[u8], at: usize| -> Option<u32> {
-        Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
+/// [`fix_frame_index`] for the `n`-th index and images part; false when there is none.
+fn fix_nth_frame_index(bytes: &mut Vec<u8>, n: usize) -> bool {
+    let Some((_, f_start, f_declared, f_end)) = part_layout_nth(bytes, b"FRMS", n) else {
+        return false;
     };
-    let mut offset = f_start;
-    let mut at = i_start + 4;
-    while at + 9 <= i_end {
-        let Some(len) = word(bytes, at) else {
-            return;
-        };
-        let Some(end) = offset.checked_add(len as usize).filter(|&e| e <= f_end) else {
-            break;
-        };
-        let crc = crc32fast::hash(&bytes[offset..end]).to_le_bytes();
-        bytes[at + 4..at + 8].copy_from_slice(&crc);
-        offset = end;
-        at += 9;
+    let Some((i_pos, i_start, _, i_end)) = part_layout_nth(bytes, b"INDX", n) else {
+        return false;
+    };
+    // The index states its own frame count; the decoder checks it against the header's.
+    let Some(count) = bytes
+        .get(i_start..i_start + 4)
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes)
+    else {
+        return true;
+    };
+    let Ok(mut index) = FrameIndex::from_bytes(&bytes[i_start..i_end], count as usize, f_declared)
+    else {
+        return true;
+    };
+    for e in index.entries_mut() {
+        if let Some(crc) = chunk_crc(bytes, (f_start, f_end), e.offset, e.len) {
+            e.crc = crc;
+        }
     }
-    if bytes[i_pos + 4] == 0 {
-        let crc = crc32fast::hash(&bytes[i_start..i_end]).to_le_bytes();
-        bytes[i_pos + 13..i_pos + 17].copy_from_slice(&crc);
+    if let Ok(coded) = index.to_bytes() {
+        splice_part(bytes, (i_pos, i_start, i_end), &coded);
     }
+    true
+}
+
+/// The CRC-32 of the non-empty chunk at `offset`, `len` bytes into the part payload
+/// `start..end`; `None` for an empty chunk or one past the payload (a cut file keeps its CRC: the
+/// decoder stops before it).
+fn chunk_crc(bytes: &[u8], (start, end): (usize, usize), offset: u64, len: u64) -> Option<u32> {
+    let from = start.checked_add(usize::try_from(offset).ok()?)?;
+    let to = from.checked_add(usize::try_from(len).ok()?)?;
+    (len > 0 && to <= end).then(|| crc32fast::hash(&bytes[from..to]))
+}
+
+/// Puts `coded` in place of the payload `start..end` of the part whose header is at `pos`, and
+/// fixes its declared length: re-coding may change an index's length (a mutated index that still
+/// parses need not be the encoder's own coding of it).
+fn splice_part(bytes: &mut Vec<u8>, (pos, start, end): (usize, usize, usize), coded: &[u8]) {
+    bytes.splice(start..end, coded.iter().copied());
+    let len = u32::try_from(coded.len()).unwrap_or(u32::MAX);
+    bytes[pos + LEN_AT..pos + LEN_AT + 4].copy_from_slice(&len.to_le_bytes());
 }
 
 /// Where the payload of the part whose header starts at `pos` lies, if it lies inside `bytes`.
 fn payload_span(bytes: &[u8], pos: usize) -> Option<(usize, usize)> {
     let head = bytes.get(pos..pos + PART_HEADER_LEN)?;
-    let len = u64::from_le_bytes(head[5..13].try_into().unwrap_or_default());
+    let len = declared_len(head)?;
     let start = pos + PART_HEADER_LEN;
     let end = usize::try_from(len).ok()?.checked_add(start)?;
     (end <= bytes.len()).then_some((start, end))
@@ -260,7 +287,7 @@ fn part_layout_nth(
     let mut pos = FILE_HEADER_LEN;
     loop {
         let head = bytes.get(pos..pos + PART_HEADER_LEN)?;
-        let len = u64::from_le_bytes(head[5..13].try_into().ok()?);
+        let len = declared_len(head)?;
         let start = pos + PART_HEADER_LEN;
         let end = usize::try_from(len)
             .ok()
@@ -312,23 +339,12 @@ fn fix_nth_band_index(bytes: &mut Vec<u8>, n: usize) -> bool {
         return true;
     };
     for band in &mut index.bands {
-        // Bands past the end of a cut file keep their CRC: the decoder stops before them.
-        let range = usize::try_from(band.offset)
-            .ok()
-            .zip(usize::try_from(band.len).ok())
-            .and_then(|(o, l)| Some((c_start.checked_add(o)?, l)))
-            .and_then(|(s, l)| Some((s, s.checked_add(l)?)))
-            .filter(|&(_, e)| e <= c_end);
-        if let (Some((s, e)), true) = (range, band.len > 0) {
-            band.crc = crc32fast::hash(&bytes[s..e]);
+        if let Some(crc) = chunk_crc(bytes, (c_start, c_end), band.offset, band.len) {
+            band.crc = crc;
         }
     }
-    let Ok(coded) = index.to_bytes() else {
-        return true;
-    };
-    // Re-coding may change the index's length (a mutated index that still parses need not be the
-    // encoder's own coding of it): splice it in and fix the part's declared length.
-    bytes.splice(i_start..i_end, coded.iter().copied());
-    bytes[i_pos + 5..i_pos + 13].copy_from_slice(&(coded.len() as u64).to_le_bytes());
+    if let Ok(coded) = index.to_bytes() {
+        splice_part(bytes, (i_pos, i_start, i_end), &coded);
+    }
     true
 }

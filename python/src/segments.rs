@@ -251,7 +251,7 @@ impl SegmentedEncoder {
                 let encoder = inner.as_ref().ok_or_else(spent)?;
                 encoder
                     .code_segment(first_frame, frames, &callback)
-                    .map(|s| s.to_bytes())
+                    .and_then(|s| s.to_bytes())
             })
         })?;
         let bytes = callback.finish(coded)?.py_err()?;

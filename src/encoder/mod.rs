@@ -557,6 +557,8 @@ fn assemble(
     }
     parts.extend(after);
     let mut container = ContainerWriter::new();
-    parts.into_iter().for_each(|p| container.push(p));
+    for part in parts {
+        container.push(part)?;
+    }
     Ok(container)
 }

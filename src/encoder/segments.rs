@@ -439,10 +439,9 @@ impl SegmentedEncoder {
         };
         let segments = self.segments.len();
         let mut container = ContainerWriter::new();
-        container.push(Part::whole(Tag::HEADER, header.to_bytes()));
-        self.shared.into_iter().for_each(|p| container.push(p));
-        for parts in self.segments {
-            parts.into_iter().for_each(|p| container.push(p));
+        container.push(Part::whole(Tag::HEADER, header.to_bytes()))?;
+        for part in self.shared.into_iter().chain(self.segments.into_iter().flatten()) {
+            container.push(part)?;
         }
         let mut report = self.report;
         report
@@ -536,10 +535,12 @@ impl CodedSegment {
     }
 
     /// The segment as bytes: a container of its parts.
-    pub fn to_bytes(&self) -> Vec<u8> {
+    pub fn to_bytes(&self) -> Result<Vec<u8>> {
         let mut container = ContainerWriter::new();
-        self.parts.iter().for_each(|p| container.push(p.clone()));
-        container.to_bytes()
+        for part in &self.parts {
+            container.push(part.clone())?;
+        }
+        Ok(container.to_bytes())
     }
 
     /// Reads a segment [`CodedSegment::to_bytes`] wrote, checking its parts' checksums.

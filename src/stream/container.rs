@@ -17,8 +17,8 @@ use std::path::Path;
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
-/// The container version this build writes and reads: 12, the frame index entropy-coded (issue
-/// 35; 11: a translation's trajectory may follow
+/// The container version this build writes and reads: 12, the frame index entropy-coded and a
+/// part's length in 4 bytes (issue 35; 11: a translation's trajectory may follow
 /// its reference cluster's whole map at its own centroid; 10: the first frame's version 4, a kept
 /// vertex order names the free corners of the triangles last used, escapes by rank among the free
 /// vertices; issue 35; 9: the first frame's version 3, a copy per corner said at once, seams cut
@@ -31,8 +31,13 @@ pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 /// A reader refuses any other version, so an older reader says "update" instead of misreading.
 pub const VERSION: u16 = 12;
 
-/// Bytes of a part header: tag, checksum kind, length, CRC.
-pub const PART_HEADER_LEN: usize = 17;
+/// Bytes of a part header: tag (4), checksum kind (1), payload length (`u32`: 4), CRC (4). Until
+/// container version 11 the length took 8 bytes; a part of 4 GiB or more is refused when added
+/// (no stream of this tool comes near: a segment's pictures are one part).
+pub const PART_HEADER_LEN: usize = 13;
+
+/// Largest payload of one part.
+pub const MAX_PART_LEN: usize = u32::MAX as usize;
 
 /// Bytes of the file header: magic, version, reserved, part count.
 pub const FILE_HEADER_LEN: usize = 16;
@@ -171,14 +176,24 @@ impl ContainerWriter {
         Self::default()
     }
 
-    /// Adds a part; parts are written in the order added.
-    pub fn add(&mut self, tag: Tag, payload: Vec<u8>, checksum: Checksum) {
+    /// Adds a part; parts are written in the order added. A payload past [`MAX_PART_LEN`] is
+    /// refused.
+    pub fn add(&mut self, tag: Tag, payload: Vec<u8>, checksum: Checksum) -> Result<()> {
+        if payload.len() > MAX_PART_LEN {
+            return Err(Error::Usage(format!(
+                "the {} part would be {} bytes, past the 4 GiB a part may hold: code shorter \
+                 temporal segments (--segment-frames) or at a lower quality",
+                tag.name(),
+                payload.len()
+            )));
+        }
         self.parts.push((tag, payload, checksum));
+        Ok(())
     }
 
-    /// Adds a part after those already added.
-    pub fn push(&mut self, part: Part) {
-        self.add(part.tag, part.bytes, part.checksum);
+    /// Adds a part after those already added (see [`Self::add`]).
+    pub fn push(&mut self, part: Part) -> Result<()> {
+        self.add(part.tag, part.bytes, part.checksum)
     }
 
     /// The file's length in bytes, without serialising it.
@@ -239,7 +254,8 @@ impl ContainerWriter {
             };
             w.raw(&tag.0)
                 .u8(checksum.id())
-                .u64(payload.len() as u64)
+                // `add` refused anything longer.
+                .u32(payload.len().min(MAX_PART_LEN) as u32)
                 .u32(crc)
                 .raw(payload);
         }
@@ -516,8 +532,8 @@ mod tests {
 
     fn sample() -> Vec<u8> {
         let mut w = ContainerWriter::new();
-        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
-        w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked);
+        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole).unwrap();
+        w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked).unwrap();
         w.to_bytes()
     }
 
@@ -526,8 +542,8 @@ mod tests {
         let mut w = ContainerWriter::new();
         assert!(w.is_empty());
         assert_eq!(w.len(), w.to_bytes().len() as u64);
-        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
-        w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked);
+        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole).unwrap();
+        w.add(Tag::FRAMES, b"0123456789".to_vec(), Checksum::Chunked).unwrap();
         assert_eq!(w.len(), w.to_bytes().len() as u64);
     }
 
@@ -553,7 +569,7 @@ mod tests {
             );
         }
         let mut flipped = bytes.clone();
-        flipped[16 + 17 + 1] ^= 0x10; // inside the header payload
+        flipped[FILE_HEADER_LEN + PART_HEADER_LEN + 1] ^= 0x10; // inside the header payload
         let mut r = ContainerReader::new(Cursor::new(flipped)).unwrap();
         assert!(r.part(Tag::HEADER).is_err());
         let mut extra = bytes;
@@ -563,10 +579,10 @@ mod tests {
 
     fn progressive(last: bool) -> Vec<u8> {
         let mut w = ContainerWriter::new();
-        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole);
-        w.add(Tag::TDCT, b"0123456789".to_vec(), Checksum::Progressive);
+        w.add(Tag::HEADER, b"hello".to_vec(), Checksum::Whole).unwrap();
+        w.add(Tag::TDCT, b"0123456789".to_vec(), Checksum::Progressive).unwrap();
         if !last {
-            w.add(Tag::AFFINE, b"abc".to_vec(), Checksum::Whole);
+            w.add(Tag::AFFINE, b"abc".to_vec(), Checksum::Whole).unwrap();
         }
         w.to_bytes()
     }

@@ -111,6 +111,12 @@ impl FrameIndex {
         Ok(Self { entries })
     }
 
+    /// Every frame's entry, to rewrite (the fuzz harness repairs the CRCs of mutated chunks).
+    #[cfg(any(test, feature = "internals"))]
+    pub fn entries_mut(&mut self) -> &mut [ChunkEntry] {
+        &mut self.entries
+    }
+
     /// The entry of frame `f`.
     pub fn entry(&self, f: usize) -> Result<ChunkEntry> {
         self.entries.get(f).copied().ok_or_else(|| {

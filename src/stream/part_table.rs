@@ -2,7 +2,7 @@
 //! (the whole stream's, or a temporal segment's). [`super::container::ContainerReader`] does this
 //! at open, before any payload is read.
 
-use super::container::{Checksum, PartEntry, Tag, MAGIC, MAX_PARTS, VERSION};
+use super::container::{Checksum, PartEntry, Tag, MAGIC, MAX_PARTS, PART_HEADER_LEN, VERSION};
 use crate::error::{Error, Result};
 use crate::stream::bytes::ByteReader;
 use std::io::Read;
@@ -84,7 +84,7 @@ pub(super) struct PartRead {
     pub truncated: Option<(Tag, u64)>,
 }
 
-/// Reads part `i` of `count`, whose 17-byte header starts at `pos`. `partial`: the file is still
+/// Reads part `i` of `count`, whose header (`PART_HEADER_LEN` bytes) starts at `pos`. `partial`: the file is still
 /// arriving, so any part may be cut short by its end (the caller decides what is of use).
 pub(super) fn read_part_entry<R: Read>(
     source: &mut R,
@@ -93,7 +93,7 @@ pub(super) fn read_part_entry<R: Read>(
     file_len: u64,
     partial: bool,
 ) -> Result<PartRead> {
-    let mut ph = [0u8; 17];
+    let mut ph = [0u8; PART_HEADER_LEN];
     read_exact_or(source, &mut ph, "a part header")?;
     let mut r = ByteReader::new(&ph, "part header");
     let mut tag = [0u8; 4];
@@ -116,9 +116,9 @@ pub(super) fn read_part_entry<R: Read>(
             )))
         }
     };
-    let len = r.u64()?;
+    let len = u64::from(r.u32()?);
     let crc = r.u32()?;
-    let offset = pos + 17;
+    let offset = pos + PART_HEADER_LEN as u64;
     let declared_end = offset.checked_add(len);
     let mut truncated = None;
     // A progressive last part may be cut by the end of the file: its prefix still decodes. So may

@@ -123,7 +123,7 @@ pub fn parts(bytes: &[u8]) -> Vec<(Tag, Vec<u8>, Checksum)> {
 pub fn rebuild(parts: Vec<(Tag, Vec<u8>, Checksum)>) -> Vec<u8> {
     let mut w = ContainerWriter::new();
     for (tag, payload, checksum) in parts {
-        w.add(tag, payload, checksum);
+        w.add(tag, payload, checksum).expect("a part under 4 GiB");
     }
     w.to_bytes()
 }

@@ -4,7 +4,7 @@
 
 use crate::common::{animate, config, decoder, encode_bytes, harness, parts, rebuild, tube};
 use mcgv_video::encoder::{analysis_frames, CodedSegment, SegmentedEncoder};
-use mcgv_video::stream::container::{Checksum, Tag, VERSION};
+use mcgv_video::stream::container::{Checksum, Tag, FILE_HEADER_LEN, PART_HEADER_LEN, VERSION};
 use mcgv_video::{encode, AnimatedMesh, Codec, EncodeOptions, Lattice, PredictorChoice, Silent};
 use mcgv_video::{PredictorKind, SegmentationChoice};
 
@@ -86,9 +86,9 @@ fn a_frame_reads_its_own_segment_only() {
         let mut segment = None;
         let mut damaged = bytes.clone();
         let reader_parts = parts(&bytes);
-        let mut offset = 16usize;
+        let mut offset = FILE_HEADER_LEN;
         for (tag, payload, _) in &reader_parts {
-            offset += 17;
+            offset += PART_HEADER_LEN;
             if *tag == Tag::SEGMENT {
                 segment = Some(segment.map_or(0, |s| s + 1));
             }
@@ -179,7 +179,7 @@ fn segments_pushed_one_by_one_make_the_stream_encode_makes() {
         .into_iter()
         .map(|r| {
             let coded = worker.code_segment(r.start, mesh.frames()[r].to_vec(), &Silent);
-            coded.unwrap().to_bytes()
+            coded.unwrap().to_bytes().unwrap()
         })
         .collect();
     joiner.push(mesh.frames()[..8].to_vec(), &Silent).unwrap();
@@ -195,7 +195,7 @@ fn segments_pushed_one_by_one_make_the_stream_encode_makes() {
     assert_eq!(joiner.finish().unwrap().to_bytes(), whole.to_bytes());
     // Its start marker (the first part's payload) flipped: refused by its checksum.
     let mut damaged = shipped[1].clone();
-    damaged[16 + 17] ^= 1;
+    damaged[FILE_HEADER_LEN + PART_HEADER_LEN] ^= 1;
     assert!(CodedSegment::from_bytes(&damaged).is_err());
     // A whole stream is not a segment.
     assert!(CodedSegment::from_bytes(&whole.to_bytes()).is_err());

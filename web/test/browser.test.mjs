@@ -64,13 +64,16 @@ function pc2(file) {
   return new Float32Array(b.buffer.slice(b.byteOffset + 32, b.byteOffset + b.length));
 }
 
+/** Bytes of a part header: tag, checksum kind, u32 length, CRC (container version 12). */
+const PART_HEADER_LEN = 13;
+
 /** Where a stream's first-frame part (MESH) ends: after the 16-byte file header, parts of a
- *  17-byte header (tag, checksum kind, u64 length, CRC) and their payload (docs/design.md). */
+ *  13-byte header (tag, checksum kind, u32 length, CRC) and their payload (docs/design.md). */
 function firstFrameEnd(bytes) {
   let at = 16;
-  while (at + 17 <= bytes.length) {
+  while (at + PART_HEADER_LEN <= bytes.length) {
     const tag = bytes.toString('latin1', at, at + 4);
-    at += 17 + Number(bytes.readBigUInt64LE(at + 5));
+    at += PART_HEADER_LEN + bytes.readUInt32LE(at + 5);
     if (tag === 'MESH') return at;
   }
   throw new Error('the stream has no MESH part');
@@ -356,10 +359,10 @@ function partsOf(bytes) {
   const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
   const parts = [];
   let pos = 16;
-  while (pos + 17 <= bytes.length) {
-    const len = Number(view.getBigUint64(pos + 5, true));
-    parts.push([pos, pos + 17, len]);
-    pos += 17 + len;
+  while (pos + PART_HEADER_LEN <= bytes.length) {
+    const len = view.getUint32(pos + 5, true);
+    parts.push([pos, pos + PART_HEADER_LEN, len]);
+    pos += PART_HEADER_LEN + len;
   }
   return parts;
 }
