@@ -135,11 +135,9 @@ pub(super) fn choose(
     let segmentations = segmentations(models);
     prepare_kmeans(&segmenter, &segmentations, &mut clock);
     let atlases: Vec<AtlasCache> = segmentations.iter().map(|_| AtlasCache::default()).collect();
-    // The ladder's stop reads tdct's estimates of every frame (`ladder`).
-    let gates = match estimated && sample.is_none() {
-        true => ladder::gates(&segmentations),
-        false => vec![None; segmentations.len()],
-    };
+    // The ladder's stop reads each rung's smallest cost: tdct's estimates, a picture codec's
+    // sampled costs at equal error (`ladder`).
+    let gates = ladder::gates(&segmentations);
     let jobs = jobs_of(models, &segmentations, &atlases, &gates);
     let outcomes = ladder::run_jobs(
         &gates,

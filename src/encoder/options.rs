@@ -148,9 +148,9 @@ impl From<PredictorKind> for PredictorChoice {
 pub enum SegmentationChoice {
     /// This segmentation.
     Fixed(Segmentation),
-    /// k-means (K = `EncodeOptions::clusters`; with tdct also the larger K of
-    /// `kmeans_ladder`) and decimation down to `e0` are tried at the encoding's step; the
-    /// smallest stream is kept.
+    /// k-means (K = `EncodeOptions::clusters` and the larger K of `kmeans_ladder`) and
+    /// decimation down to `e0` are tried at the encoding's step; the smallest stream at equal
+    /// error is kept.
     Auto {
         /// Decimation's error threshold E0.
         e0: f64,
@@ -203,8 +203,8 @@ pub struct MotionModel {
     pub clusters: usize,
 }
 
-/// The k-means cluster counts an automatic segmentation tries with a codec of cheap trials, from
-/// the caller's `k`: k, 1.5 k and 2 k (a rung only when the one below paid: `encoder/ladder.rs`). More clusters fit the motion more closely for more side
+/// The k-means cluster counts an automatic segmentation tries, from the caller's `k`: k, 1.5 k
+/// and 2 k (a rung only when the one below paid: `encoder/ladder.rs`), with every codec. More clusters fit the motion more closely for more side
 /// information; which wins depends on the animation and the step
 /// (docs/design.md, "First-frame bits trials and k-means ladder").
 pub fn kmeans_ladder(k: usize) -> Vec<usize> {
@@ -225,9 +225,8 @@ impl EncodeOptions {
     /// segmentation (each partition serves every predictor), the defaults first.
     pub fn motion_models(&self) -> Vec<MotionModel> {
         let predictors = self.predictor.candidates();
-        let cheap = self.codec.codec().cheap_exact_trials();
         let ladder = match self.segmentation {
-            SegmentationChoice::Auto { .. } if cheap => kmeans_ladder(self.clusters),
+            SegmentationChoice::Auto { .. } => kmeans_ladder(self.clusters),
             _ => vec![self.clusters],
         };
         let partitions = self.segmentation.candidates().into_iter().flat_map(|s| {

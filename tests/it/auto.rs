@@ -238,13 +238,14 @@ fn tdct_tries_a_ladder_of_cluster_counts_and_keeps_the_smallest() {
             assert_eq!(bytes.len() as u64, c.bytes, "K = {k}");
         }
     }
-    // The picture codecs, whose trials are whole encodings, try the caller's K only.
+    // The picture codecs climb the same ladder (since 2026-12-04; K alone before, too few
+    // clusters for a dancer): three k-means rungs and decimation.
     let jpeg = opts(
         Codec::Jpeg,
         PredictorKind::Affine.into(),
         SegmentationChoice::auto(),
     );
-    assert_eq!(jpeg.motion_models().len(), 2);
+    assert_eq!(jpeg.motion_models().len(), 4);
 }
 
 #[test]
@@ -306,7 +307,16 @@ fn sample_then_whole(codec: Codec, mesh: AnimatedMesh, sample: usize) {
             e0: mcgv_video::motion::DEFAULT_E0,
         },
     };
-    let fixed = fixed_bytes(&mesh, &options, (best.predictor, segmentation));
+    // The kept rung's K, for k-means (decimation finds its own count).
+    let clusters = match segmentation {
+        Segmentation::KMeans => best.clusters,
+        _ => options.clusters,
+    };
+    let base = EncodeOptions {
+        clusters,
+        ..options.clone()
+    };
+    let fixed = fixed_bytes(&mesh, &base, (best.predictor, segmentation));
     assert_eq!(
         encoded.to_bytes(),
         fixed,
@@ -437,12 +447,13 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
 fn progress_announces_the_trials_frames_and_reports_them_all() {
     let mesh = skinned_bend();
     let frames = mesh.frame_count() as u64;
-    // tdct estimates every candidate (its k-means at three K), then codes the winner; MPEG-4
-    // codes every candidate whole; JPEG 12 frames each, then the winner whole.
+    // Every codec's candidates: k-means at three K and decimation, two predictors each. tdct
+    // estimates every candidate, then codes the winner; MPEG-4 codes every candidate whole;
+    // JPEG 12 frames each, then the winner whole.
     let codecs = [
         (Codec::Tdct, 8 * frames + frames),
-        (Codec::Mpeg4, 4 * frames),
-        (Codec::Jpeg, 4 * 12 + frames),
+        (Codec::Mpeg4, 8 * frames),
+        (Codec::Jpeg, 8 * 12 + frames),
     ];
     for (codec, expected) in codecs {
         let counter = Counter::default();
