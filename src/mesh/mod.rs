@@ -54,6 +54,13 @@ use crate::error::{Error, Result};
 /// A 3D position.
 pub type Point = [f32; 3];
 
+/// Largest coordinate magnitude [`AnimatedMesh::new`] accepts. Segmentation squares and sums
+/// position differences in f32, and a coordinate of 1e25 made k-means++'s total seed weight
+/// infinite (a panic in the sampler); beyond this the codecs cannot code the motion anyway
+/// (f32 keeps about 7 digits: at 1e15 neighbouring values are 1e8 apart), so such input is refused
+/// up front with the vertex named.
+pub const MAX_COORDINATE: f32 = 1e15;
+
 /// A key equal for two positions exactly when their coordinates are equal (the bits, with −0
 /// and +0 one key), for welding vertices that share a position.
 pub(crate) fn position_key(p: &Point) -> [u32; 3] {
@@ -66,7 +73,8 @@ pub type Triangle = [u32; 3];
 /// An animated mesh: triangles shared by all frames and `F` frames of `V` positions.
 ///
 /// Invariants (checked by [`AnimatedMesh::new`]): at least one frame and one vertex, every frame has
-/// the same number of vertices, every index is in range, every coordinate is finite.
+/// the same number of vertices, every index is in range, every coordinate is finite and at most
+/// [`MAX_COORDINATE`] in magnitude.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnimatedMesh {
     triangles: Vec<Triangle>,
@@ -100,6 +108,17 @@ impl AnimatedMesh {
             if let Some(i) = frame.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
                 return Err(Error::Mesh(format!(
                     "frame {f}, vertex {i}: coordinate is not a finite number"
+                )));
+            }
+            if let Some(i) = frame
+                .iter()
+                .position(|p| p.iter().any(|c| c.abs() > MAX_COORDINATE))
+            {
+                let p = frame[i];
+                return Err(Error::Mesh(format!(
+                    "frame {f}, vertex {i}: coordinate ({} {} {}) is beyond ±{MAX_COORDINATE:e}, \
+                     the largest this tool handles",
+                    p[0], p[1], p[2]
                 )));
             }
         }

@@ -183,9 +183,25 @@ pub(crate) fn seed_rows(x: Rows<'_>, k: usize, rng: &mut impl Rng) -> Vec<usize>
                     }
                 }
             });
-        picked.push(WeightedIndex::new(nearest_d2.iter()).map_or(0, |w| w.sample(rng)));
+        picked.push(draw_by_distance(&nearest_d2, rng));
     }
     picked
+}
+
+/// A row drawn with probability proportional to `d2` (the first row when every weight is zero).
+/// Should the weights sum beyond f32 (rows far apart), they are drawn relative to the largest
+/// (the infinite ones alone when some are infinite): rand panics on an infinite total. Finite
+/// sums take the plain draw, so ordinary inputs draw exactly as before.
+fn draw_by_distance(d2: &[f32], rng: &mut impl Rng) -> usize {
+    let mut draw = |w: Result<WeightedIndex<f32>, _>| w.map_or(0, |w| w.sample(rng));
+    if d2.iter().sum::<f32>().is_finite() {
+        return draw(WeightedIndex::new(d2.iter()));
+    }
+    let largest = d2.iter().copied().fold(0f32, f32::max);
+    draw(WeightedIndex::new(d2.iter().map(|&d| match largest.is_finite() {
+        true => d / largest,
+        false => f32::from(u8::from(d == f32::INFINITY)),
+    })))
 }
 
 /// The rows of a matrix ready for the matrix product: moved so that their mean is the origin
@@ -322,6 +338,20 @@ mod tests {
             }
         }
         (Array2::from_shape_vec((300, 5), rows).unwrap(), truth)
+    }
+
+    #[test]
+    fn seeds_of_rows_too_far_apart_for_f32_are_drawn_without_panicking() {
+        // Squared distances of 1e30-apart rows overflow f32: the total seed weight was infinite
+        // and rand's uniform sampler panicked ("range overflow").
+        for far in [1e18f32, 1.4e19, 1e30, f32::MAX] {
+            let x = Array2::from_shape_vec((4, 2), vec![0.0, 0.0, far, 0.0, 0.0, far, 1.0, 1.0])
+                .unwrap();
+            let rows = Rows::all(&x);
+            let picked = seed_rows(rows, 3, &mut Xoshiro256Plus::seed_from_u64(1));
+            assert_eq!(picked.len(), 3);
+            assert!(picked.iter().all(|&r| r < 4), "{picked:?}");
+        }
     }
 
     #[test]

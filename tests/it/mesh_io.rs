@@ -155,6 +155,24 @@ fn bad_numbers_empty_files_and_missing_inputs_are_errors() {
     assert!(error_of(dir.path().join("missing.obj").to_str().unwrap()).contains("no such"));
 }
 
+/// A huge but finite coordinate (1e30) passed every check and panicked in k-means++ seeding
+/// (rand's "Uniform::new: range overflow"); it is refused as the mesh is built, naming the vertex.
+#[test]
+fn coordinates_beyond_the_limit_are_refused_naming_frame_and_vertex() {
+    let square = |z: f32| vec![[0.0, 0.0, z], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let mut far = square(0.0);
+    far[2][1] = -1e30;
+    let err = AnimatedMesh::new(vec![[0, 1, 2]], vec![square(0.0), far])
+        .expect_err("1e30 accepted")
+        .to_string();
+    assert!(
+        err.contains("frame 1, vertex 2") && err.contains("beyond"),
+        "{err}"
+    );
+    let limit = mcgv_video::mesh::MAX_COORDINATE;
+    assert!(AnimatedMesh::new(vec![[0, 1, 2]], vec![square(0.0), square(limit)]).is_ok());
+}
+
 /// The reader's triangles, read through positions, must be the ones `tobj` makes of the same file
 /// (which renumbers vertices per object, so only positions can be compared).
 #[test]

@@ -131,3 +131,61 @@ fn clusters_alone_means_k_means_with_that_k() {
     let both = encode(&["--clusters", "3", "--e0", "0.004"]);
     assert!(both["choice"]["candidates"].as_array().is_some(), "{both}");
 }
+
+/// A grid of 4 × 4 vertices moving over 6 frames, one vertex of frame 3 at `far`.
+fn grid_with_a_far_vertex(dir: &std::path::Path, far: &str) {
+    std::fs::create_dir_all(dir).expect("folder");
+    for f in 0..6 {
+        let mut lines: Vec<String> = (0..16)
+            .map(|i| format!("v {} {} {}", i % 4, i / 4, 0.05 * f as f64 * (i % 4) as f64))
+            .collect();
+        if f == 3 {
+            lines[0] = format!("v {far} 0 0");
+        }
+        for a in (1..=11).filter(|a| a % 4 != 0) {
+            lines.push(format!(
+                "f {a} {} {}\nf {a} {} {}",
+                a + 1,
+                a + 5,
+                a + 5,
+                a + 4
+            ));
+        }
+        std::fs::write(
+            dir.join(format!("frame_{f:03}.obj")),
+            lines.join("\n") + "\n",
+        )
+        .expect("frame");
+    }
+}
+
+#[test]
+fn a_huge_coordinate_is_a_clear_error_not_a_panic_in_kmeans() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let frames = dir.path().join("frames");
+    grid_with_a_far_vertex(&frames, "1e30");
+    let out = dir.path().join("s.mcgv");
+    let run_on = |codec: &str| {
+        run(&[
+            "encode",
+            frames.to_str().expect("utf-8 path"),
+            "-o",
+            out.to_str().expect("utf-8 path"),
+            "--quiet",
+            "--codec",
+            codec,
+            "--segmentation",
+            "kmeans",
+        ])
+    };
+    for codec in ["tdct", "jpeg"] {
+        let failed = run_on(codec);
+        let err = String::from_utf8_lossy(&failed.stderr);
+        assert_eq!(failed.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("frame 3, vertex 0") && !err.contains("panicked"),
+            "{err}"
+        );
+    }
+    assert!(!out.exists());
+}
