@@ -240,13 +240,7 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
         ));
     }
     let mut jobs = Vec::with_capacity(clips.len());
-    for clip in &clips {
-        let name = if clip.name.is_empty() {
-            clip.index.to_string()
-        } else {
-            clip.name.clone()
-        };
-        let output = clip_output(&args.output, &name);
+    for (clip, output) in clips.iter().zip(clip_outputs(&args.output, &clips)) {
         let read = ReadOptions {
             clip: Some(clip.index.to_string()),
             ..read_options.clone()
@@ -272,6 +266,29 @@ fn check_output(args: &EncodeArgs, read: &ReadOptions, output: &Path) -> Result<
     }
     check_not_input(&args.input, read, output)?;
     crate::staging::check_file(output, args.force)
+}
+
+/// One distinct output per clip. Cleaned names can clash (two unnamed clips named by index beside
+/// a clip named `1`, `a/b` beside `a_b`, names equal but for case on a case-blind file system),
+/// and each stream would then silently replace the one before: a clip whose name is taken gets
+/// its index appended (`fox-Walk-3.mcgv`), again until the name is free.
+fn clip_outputs(output: &Path, clips: &[mcgv_video::mesh::Clip]) -> Vec<PathBuf> {
+    let mut taken = std::collections::HashSet::new();
+    clips
+        .iter()
+        .map(|clip| {
+            let mut name = match clip.name.is_empty() {
+                true => clip.index.to_string(),
+                false => clip.name.clone(),
+            };
+            let mut path = clip_output(output, &name);
+            while !taken.insert(path.to_string_lossy().to_lowercase()) {
+                name = format!("{name}-{}", clip.index);
+                path = clip_output(output, &name);
+            }
+            path
+        })
+        .collect()
 }
 
 /// `fox.mcgv` for clip `Walk` → `fox-Walk.mcgv` (characters a file name cannot hold become `_`).

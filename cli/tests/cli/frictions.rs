@@ -183,6 +183,66 @@ fn f5_glb_clips_are_listed_and_chosen_aloud() {
     }
 }
 
+/// `RiggedSimple.glb` with its clip five times over: unnamed, unnamed, `a/b`, `a_b` and `1`.
+fn clashing_clips(path: &Path) {
+    let glb = std::fs::read(media_path("RiggedSimple.glb")).unwrap();
+    let length = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut gltf: serde_json::Value = serde_json::from_slice(&glb[20..20 + length]).unwrap();
+    let mut clip = gltf["animations"][0].clone();
+    clip.as_object_mut().unwrap().remove("name");
+    let clips: Vec<serde_json::Value> = [None, None, Some("a/b"), Some("a_b"), Some("1")]
+        .iter()
+        .map(|name| {
+            let mut c = clip.clone();
+            if let Some(name) = name {
+                c["name"] = (*name).into();
+            }
+            c
+        })
+        .collect();
+    gltf["animations"] = clips.into();
+    let mut text = serde_json::to_vec(&gltf).unwrap();
+    text.resize(text.len().div_ceil(4) * 4, b' ');
+    let rest = &glb[20 + length..];
+    let mut out = glb[..8].to_vec();
+    out.extend(((20 + text.len() + rest.len()) as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(text);
+    out.extend(rest);
+    std::fs::write(path, out).unwrap();
+}
+
+#[test]
+fn f5_clips_whose_names_clash_get_distinct_files() {
+    let d = tempfile::tempdir().unwrap();
+    let glb = d.path().join("clips.glb");
+    clashing_clips(&glb);
+    let o = d.path().join("out").join("r.mcgv");
+    let args = ["--clip", "all", "--fps", "4", "-q", "--codec", "jpeg"];
+    let all = run(&[
+        &["encode", glb.to_str().unwrap(), "-o", o.to_str().unwrap()],
+        &args[..],
+    ]
+    .concat());
+    assert!(all.status.success(), "{}", stderr(&all));
+    let mut names: Vec<String> = std::fs::read_dir(d.path().join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "r-0.mcgv",
+            "r-1-4.mcgv",
+            "r-1.mcgv",
+            "r-a_b-3.mcgv",
+            "r-a_b.mcgv"
+        ]
+    );
+}
+
 #[test]
 fn f6_a_decoded_pc2_reads_back() {
     let d = tempfile::tempdir().unwrap();
