@@ -153,6 +153,50 @@ fn existing_files_are_replaced_only_with_force() {
     }
 }
 
+/// `--force` onto a FIFO or a symbolic link replaced it with a regular file (the stream was
+/// written to a temporary file renamed over the path): a FIFO is written through, a link's
+/// target is written and the link stays.
+#[cfg(unix)]
+#[test]
+fn force_writes_through_a_fifo_and_a_symbolic_link() {
+    use std::os::unix::fs::FileTypeExt;
+    let d = tempfile::tempdir().unwrap();
+    let s = stream(d.path());
+    let (fifo, link, target) = (
+        d.path().join("pipe.glb"),
+        d.path().join("link.glb"),
+        d.path().join("target.glb"),
+    );
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    // The reader hands over what it read, and the test fails rather than hangs should nothing
+    // ever open the FIFO for writing (the path replaced by a regular file).
+    let (sent, read) = std::sync::mpsc::channel();
+    let reader = fifo.clone();
+    std::thread::spawn(move || sent.send(std::fs::read(reader).unwrap()));
+    let out = |o: &Path| run(&["decode", &s, "-o", o.to_str().unwrap(), "-q", "--force"]);
+    succeeds(&out(&fifo));
+    assert!(read
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("nothing written to the FIFO")
+        .starts_with(b"glTF"));
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    std::fs::write(&target, b"old").unwrap();
+    std::os::unix::fs::symlink("target.glb", &link).unwrap();
+    succeeds(&out(&link));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read(&target).unwrap().starts_with(b"glTF"));
+}
+
 #[test]
 fn an_output_that_cannot_be_written_is_found_before_any_work() {
     let d = tempfile::tempdir().unwrap();
