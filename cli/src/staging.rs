@@ -94,6 +94,25 @@ pub fn create_parent(path: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))
 }
 
+/// Runs `write` with the missing folders above `path` created; should it fail, the folders it
+/// created are removed again (deepest first, each only if empty), so that a failed run leaves no
+/// new empty folders behind, as a failed folder output or encode leaves none.
+pub fn in_new_parent<T>(path: &Path, write: impl FnOnce() -> Result<T>) -> Result<T> {
+    let mut missing = Vec::new();
+    let mut at = Some(folder(path));
+    while let Some(dir) = at.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+        missing.push(dir.to_path_buf());
+        at = dir.parent();
+    }
+    let undo = || {
+        for dir in &missing {
+            let _ = std::fs::remove_dir(dir);
+        }
+    };
+    create_parent(path).inspect_err(|_| undo())?;
+    write().inspect_err(|_| undo())
+}
+
 /// A folder output: the files of the names the run writes, staged in a hidden folder and moved
 /// into the target by [`StagedFolder::commit`]; dropped uncommitted, it leaves the target as it
 /// was.
@@ -233,6 +252,23 @@ mod tests {
         assert!(check_file(&file, false).is_err());
         assert!(check_file(&file, true).is_ok());
         assert!(check_file(d.path(), true).is_err());
+    }
+
+    #[test]
+    fn folders_made_for_a_failed_write_are_removed_and_others_kept() {
+        let d = tempfile::tempdir().unwrap();
+        let path = d.path().join("new/sub/x.glb");
+        let failed: Result<()> = in_new_parent(&path, || {
+            assert!(path.parent().unwrap().is_dir());
+            Err(Error::Usage("failed".into()))
+        });
+        assert!(failed.is_err());
+        assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);
+        in_new_parent(&path, || {
+            std::fs::write(&path, b"x").map_err(|e| Error::io(&path, e))
+        })
+        .unwrap();
+        assert!(path.is_file());
     }
 
     #[test]

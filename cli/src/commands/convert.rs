@@ -8,6 +8,7 @@
 
 use crate::args::ConvertArgs;
 use crate::output::animation_output;
+use crate::staging::in_new_parent;
 use crate::target::{finish_pc2_pair, Target};
 use mcgv_video::mesh::is_gltf_path;
 use mcgv_video::mesh::{write_gltf, write_pc2, GltfOptions, ObjFrameWriter, ReadOptions};
@@ -28,9 +29,10 @@ pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
     let count = mesh.frame_count();
     let span = ((0..count).collect(), count.saturating_sub(1));
     match Target::prepare(&args.output, kind, span, args.force, Some(&args.input))? {
-        Target::Pc2 { cache, base } => finish_pc2_pair(&mesh, &base, || write_pc2(&mesh, &cache))?,
+        Target::Pc2 { cache, base } => in_new_parent(&cache, || {
+            finish_pc2_pair(&mesh, &base, || write_pc2(&mesh, &cache))
+        })?,
         Target::Gltf(path) => {
-            crate::staging::create_parent(&path)?;
             super::decode::warn_if_many_targets(count);
             // A glTF source lends its materials and textures to the rewritten asset.
             let source = std::path::Path::new(&args.input);
@@ -43,7 +45,9 @@ pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
                 like: (is_gltf_path(source) && source.is_file()).then(|| source.to_path_buf()),
                 ..GltfOptions::default()
             };
-            write_gltf(&mesh, Some(mesh.attributes()), &path, &options)?;
+            in_new_parent(&path, || {
+                write_gltf(&mesh, Some(mesh.attributes()), &path, &options)
+            })?;
         }
         Target::Folder { staged, last } => {
             let writer =

@@ -3,6 +3,7 @@
 use crate::args::DecodeArgs;
 use crate::output::{animation_output, OutputKind};
 use crate::progress;
+use crate::staging::in_new_parent;
 use crate::target::{finish_pc2_pair, Target};
 use mcgv_video::mesh::MANY_MORPH_TARGETS;
 use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions, DEFAULT_FPS};
@@ -72,6 +73,14 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             "applies to a glTF output (.glb, .gltf)",
         ));
     }
+    // Options are checked before a frame is decoded or a folder made (glTF writing would find
+    // a bad rate only at the end).
+    if let Some(fps) = args.fps.filter(|r| !(r.is_finite() && *r > 0.0)) {
+        return Err(Error::option(
+            "fps",
+            format!("{fps}: the frame rate must be a positive number"),
+        ));
+    }
     let mut decoder =
         Decoder::open_with(&args.input, &decode_options(args.bands, args.max_positions))
             .map_err(|e| super::in_file(&args.input, e))?;
@@ -97,7 +106,9 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
             staged.commit_and_tell(quiet)?;
         }
         Target::Pc2 { cache, base } if every_frame => {
-            stream_pc2(&mut decoder, (&cache, &base), quiet).map_err(in_file)?;
+            in_new_parent(&cache, || {
+                stream_pc2(&mut decoder, (&cache, &base), quiet).map_err(in_file)
+            })?;
         }
         target => {
             let mesh = decode_mesh(&mut decoder, &frames, quiet).map_err(in_file)?;
@@ -136,13 +147,10 @@ fn write_mesh(
     quiet: bool,
 ) -> Result<()> {
     match target {
-        Target::Pc2 { cache, base } => {
+        Target::Pc2 { cache, base } => in_new_parent(&cache, || {
             finish_pc2_pair(mesh, &base, || mcgv_video::mesh::write_pc2(mesh, &cache))
-        }
-        Target::ObjFile(path) => {
-            crate::staging::create_parent(&path)?;
-            write_obj_mesh_frame(mesh, 0, &path)
-        }
+        }),
+        Target::ObjFile(path) => in_new_parent(&path, || write_obj_mesh_frame(mesh, 0, &path)),
         Target::Folder { staged, last } => {
             let writer =
                 ObjFrameWriter::new(staged.path(), last, mesh.triangles(), mesh.attributes())?;
@@ -152,14 +160,15 @@ fn write_mesh(
             staged.commit_and_tell(quiet)
         }
         Target::Gltf(path) => {
-            crate::staging::create_parent(&path)?;
             warn_if_many_targets(mesh.frame_count());
             let options = GltfOptions {
                 fps: args.fps.or(mesh.frame_rate()).unwrap_or(DEFAULT_FPS),
                 like: args.like.clone(),
                 ..GltfOptions::default()
             };
-            write_gltf(mesh, Some(mesh.attributes()), &path, &options)
+            in_new_parent(&path, || {
+                write_gltf(mesh, Some(mesh.attributes()), &path, &options)
+            })
         }
     }
 }
@@ -196,7 +205,6 @@ fn stream_pc2(
         decoder.header().vertices as usize,
     );
     let (triangles, attributes) = (decoder.triangles().to_vec(), decoder.attributes().clone());
-    crate::staging::create_parent(cache)?;
     let mut writer = Pc2Writer::create(cache, vertices, frames)?;
     let pb = progress::bar(frames as u64, "decode", quiet);
     let mut first = None;

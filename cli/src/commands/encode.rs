@@ -361,8 +361,7 @@ fn write_and_report(
     if to_stdout {
         write_stdout_bytes(&encoded.to_bytes())?;
     } else {
-        crate::staging::create_parent(output)?;
-        encoded.container.write_atomic(output)?;
+        crate::staging::in_new_parent(output, || encoded.container.write_atomic(output))?;
     }
     let seconds = start.elapsed().as_secs_f64();
     let achieved = match (to_stdout, quiet && !args.json) {

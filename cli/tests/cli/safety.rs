@@ -276,10 +276,28 @@ fn a_failed_run_leaves_nothing_behind() {
     std::fs::write(&damaged, bytes).unwrap();
     let bad = damaged.to_str().unwrap();
     let before = snapshot(d.path());
-    for name in ["new/frames/", "cache.pc2", "anim.glb"] {
+    // A PC2 or glTF in new folders left the folders behind; so did an option refused only as
+    // the glTF was written (a rate of 0, a --like that is not glTF).
+    let like = ["--like", bad];
+    let runs: [(&str, &[&str], i32); 7] = [
+        ("new/frames/", &[], 1),
+        ("cache.pc2", &[], 1),
+        ("anim.glb", &[], 1),
+        ("new/sub/cache.pc2", &[], 1),
+        ("new/sub/anim.glb", &[], 1),
+        ("new/sub/rate.glb", &["--fps", "0"], 2),
+        ("new/sub/like.glb", &like, 1),
+    ];
+    for (name, extra, code) in runs {
         let target = d.path().join(name);
-        let out = run(&["decode", bad, "-o", target.to_str().unwrap(), "-q"]);
-        assert_eq!(out.status.code(), Some(1), "{name}: {out:?}");
+        let input = if extra.is_empty() { bad } else { s.as_str() };
+        let args = [
+            &["decode", input, "-o", target.to_str().unwrap(), "-q"],
+            extra,
+        ]
+        .concat();
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(code), "{name}: {out:?}");
         assert_eq!(snapshot(d.path()), before, "{name}");
         assert!(!d.path().join("new").exists(), "{name}");
     }
