@@ -7,6 +7,7 @@
 //! before the work starts. Files are written to a hidden staging place beside their target and
 //! moved into place once every one of them is complete, so a failed run leaves nothing behind.
 
+use mcgv_video::mesh::{input_files, ReadOptions};
 use mcgv_video::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -30,6 +31,36 @@ pub fn check_file(path: &Path, force: bool) -> Result<()> {
         )));
     }
     probe(path)
+}
+
+/// The files a run reads: its inputs and the files each is read from (a frame of an OBJ folder
+/// or glob, the base OBJ of a PC2 cache, a glTF's buffer), by canonical path so that links and
+/// `./` spellings cannot sneak past. No output may be one of them, whatever `--force` says.
+pub struct Inputs(std::collections::HashSet<PathBuf>);
+
+impl Inputs {
+    /// The files `inputs` are read from with `read`.
+    pub fn of<P: AsRef<Path>>(inputs: &[P], read: &ReadOptions) -> Self {
+        let mut files = std::collections::HashSet::new();
+        for input in inputs.iter().map(AsRef::as_ref) {
+            // Listing fails for inputs that do not exist or are not readable; reading reports that.
+            let listed = input_files(&input.to_string_lossy(), read).unwrap_or_default();
+            let all = std::iter::once(input.to_path_buf()).chain(listed);
+            files.extend(all.filter_map(|p| p.canonicalize().ok()));
+        }
+        Self(files)
+    }
+
+    /// Refuses `output` when it is one of the inputs (an output that does not exist yet is none).
+    pub fn refuse(&self, output: &Path) -> Result<()> {
+        match output.canonicalize() {
+            Ok(target) if self.0.contains(&target) => Err(Error::Usage(format!(
+                "refusing to overwrite the input {}",
+                output.display()
+            ))),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// The folder `path` is written in: its parent, `.` for a bare name.

@@ -2,7 +2,7 @@
 //! and put in place whole once written ([`crate::staging`]'s rules).
 
 use crate::output::OutputKind;
-use crate::staging::{check_file, create_parent, StagedFolder};
+use crate::staging::{check_file, create_parent, Inputs, StagedFolder};
 use mcgv_video::mesh::{obj_frame_names, write_obj_mesh_frame, AnimatedMesh};
 use mcgv_video::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -33,30 +33,38 @@ pub enum Target {
 impl Target {
     /// Checks the output `path` of kind `kind` for the frames numbered `frames` of a clip whose
     /// last frame is numbered `last`, before any work: existing files only with `force`, a folder that takes
-    /// files, and no file of `input` (a PC2's base OBJ is written beside it).
+    /// files, and no file of `inputs`, even with `force` (a PC2's base OBJ is written beside it;
+    /// `decode --like` reads the glTF it is told to write).
     pub fn prepare(
         path: &Path,
         kind: OutputKind,
         (frames, last): (Vec<usize>, usize),
         force: bool,
-        input: Option<&str>,
+        inputs: &Inputs,
     ) -> Result<Self> {
         match kind {
             OutputKind::ObjFolder => {
                 let names = obj_frame_names(frames, last);
+                for name in &names {
+                    inputs.refuse(&path.join(name))?;
+                }
                 let staged = StagedFolder::prepare(path, names, force)?;
                 Ok(Target::Folder { staged, last })
             }
-            OutputKind::ObjFile => check_file(path, force).map(|()| Target::ObjFile(path.into())),
+            OutputKind::ObjFile => {
+                inputs.refuse(path)?;
+                check_file(path, force).map(|()| Target::ObjFile(path.into()))
+            }
             OutputKind::Pc2 => {
                 let base = path.with_extension("obj");
-                if input.is_some_and(|i| Path::new(i) == base) {
+                if inputs.refuse(&base).is_err() {
                     return Err(Error::Usage(format!(
                         "{}: writing the base OBJ would overwrite the input; name the .pc2 \
                          differently",
                         base.display()
                     )));
                 }
+                inputs.refuse(path)?;
                 check_file(path, force)?;
                 check_file(&base, force)?;
                 Ok(Target::Pc2 {
@@ -64,7 +72,10 @@ impl Target {
                     base,
                 })
             }
-            OutputKind::Gltf => check_file(path, force).map(|()| Target::Gltf(path.into())),
+            OutputKind::Gltf => {
+                inputs.refuse(path)?;
+                check_file(path, force).map(|()| Target::Gltf(path.into()))
+            }
         }
     }
 }

@@ -8,7 +8,7 @@
 
 use crate::args::ConvertArgs;
 use crate::output::animation_output;
-use crate::staging::in_new_parent;
+use crate::staging::{in_new_parent, Inputs};
 use crate::target::{finish_pc2_pair, Target};
 use mcgv_video::mesh::is_gltf_path;
 use mcgv_video::mesh::{write_gltf, write_pc2, GltfOptions, ObjFrameWriter, ReadOptions};
@@ -17,18 +17,20 @@ use mcgv_video::Result;
 /// Runs `convert`.
 pub fn run(args: &ConvertArgs, quiet: bool) -> Result<()> {
     let kind = animation_output(&args.output, false)?;
+    let read = ReadOptions::from(&args.input_args);
+    let inputs = Inputs::of(&[&args.input], &read);
     // The outputs are checked before the input is read (a folder's frame names once it is).
     drop(Target::prepare(
         &args.output,
         kind,
         (Vec::new(), 0),
         args.force,
-        Some(&args.input),
+        &inputs,
     )?);
-    let mesh = super::read_input(&args.input, &ReadOptions::from(&args.input_args), quiet)?;
+    let mesh = super::read_input(&args.input, &read, quiet)?;
     let count = mesh.frame_count();
     let span = ((0..count).collect(), count.saturating_sub(1));
-    match Target::prepare(&args.output, kind, span, args.force, Some(&args.input))? {
+    match Target::prepare(&args.output, kind, span, args.force, &inputs)? {
         Target::Pc2 { cache, base } => in_new_parent(&cache, || {
             finish_pc2_pair(&mesh, &base, || write_pc2(&mesh, &cache))
         })?,

@@ -3,7 +3,7 @@
 use crate::args::DecodeArgs;
 use crate::output::{animation_output, OutputKind};
 use crate::progress;
-use crate::staging::in_new_parent;
+use crate::staging::{in_new_parent, Inputs};
 use crate::target::{finish_pc2_pair, Target};
 use mcgv_video::mesh::MANY_MORPH_TARGETS;
 use mcgv_video::mesh::{write_gltf, AnimatedMesh, GltfOptions, DEFAULT_FPS};
@@ -97,7 +97,10 @@ pub fn run(args: &DecodeArgs, quiet: bool) -> Result<()> {
     let frames = selected(args, count)?;
     // Every file the run writes is checked before the frames are decoded.
     let span = (frames.clone(), count - 1);
-    let target = Target::prepare(&args.output, kind, span, args.force, None)?;
+    let mut read_from = vec![args.input.as_path()];
+    read_from.extend(args.like.as_deref());
+    let inputs = Inputs::of(&read_from, &mcgv_video::ReadOptions::default());
+    let target = Target::prepare(&args.output, kind, span, args.force, &inputs)?;
     let every_frame = frames.len() == count;
     let in_file = |e| super::in_file(&args.input, e);
     match target {

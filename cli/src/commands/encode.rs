@@ -9,7 +9,6 @@ use mcgv_video::encoder::EncodeReport;
 use mcgv_video::encoder::DEFAULT_PARALLEL_SEGMENTS;
 use mcgv_video::encoder::{self, Budget, BudgetReport, EncodeOptions, Encoded, Segmentation};
 use mcgv_video::encoder::{PredictorChoice as Predictor, SegmentationChoice as Segmenting};
-use mcgv_video::mesh::input_files;
 use mcgv_video::mesh::ReadOptions;
 use mcgv_video::Lattice;
 use mcgv_video::PredictorKind;
@@ -192,28 +191,6 @@ pub fn parse_lattice(s: &str) -> Result<Lattice> {
     ))
 }
 
-/// Refuses to write the output over the input or any file it is read from (a frame of an OBJ folder
-/// or glob, the base OBJ of a PC2 cache, a glTF's buffer), comparing canonical paths so that links
-/// and `./` spellings cannot sneak past. An output that does not exist yet cannot be an input.
-fn check_not_input(input: &str, opts: &ReadOptions, output: &Path) -> Result<()> {
-    let Ok(target) = output.canonicalize() else {
-        return Ok(());
-    };
-    let mut inputs = vec![PathBuf::from(input)];
-    // Listing fails for inputs that do not exist or are not readable; reading reports that.
-    inputs.extend(input_files(input, opts).unwrap_or_default());
-    if inputs
-        .iter()
-        .any(|p| p.canonicalize().is_ok_and(|p| p == target))
-    {
-        return Err(Error::Usage(format!(
-            "refusing to overwrite the input {}",
-            output.display()
-        )));
-    }
-    Ok(())
-}
-
 /// Runs `encode`: one stream, or with `--clip all` one stream per glTF clip. Every output is
 /// checked before any work, and with several clips every stream is coded before any is written.
 pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
@@ -264,7 +241,7 @@ fn check_output(args: &EncodeArgs, read: &ReadOptions, output: &Path) -> Result<
     if output.as_os_str() == "-" {
         return Ok(());
     }
-    check_not_input(&args.input, read, output)?;
+    crate::staging::Inputs::of(&[&args.input], read).refuse(output)?;
     crate::staging::check_file(output, args.force)
 }
 

@@ -144,3 +144,28 @@ fn outputs_get_ordinary_file_permissions() {
     let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
     assert_eq!(mode(&s), mode(&plain));
 }
+
+/// `decode -o like.glb --like like.glb --force` replaced the glTF it was told to copy the look
+/// of, and `convert in.glb -o in.glb --force` its input: every input of a run is refused as an
+/// output, as `encode` refuses its own.
+#[test]
+fn decode_and_convert_refuse_to_overwrite_what_they_read() {
+    let d = tempfile::tempdir().unwrap();
+    let frames = d.path().join("frames");
+    obj_frames(&frames);
+    let stream = d.path().join("s.mcgv");
+    encode_frames(&frames, &stream);
+    let like = d.path().join("like.glb");
+    std::fs::copy(media_path("RiggedSimple.glb"), &like).unwrap();
+    let before = std::fs::read(&like).unwrap();
+    let (s, l) = (stream.to_str().unwrap(), like.to_str().unwrap());
+    refused(&run(&["decode", s, "-o", l, "--like", l, "--force", "-q"]));
+    let sneaky = d.path().join("frames/../like.glb");
+    let sneaky = sneaky.to_str().unwrap();
+    refused(&run(&[
+        "decode", s, "-o", sneaky, "--like", l, "--force", "-q",
+    ]));
+    refused(&run(&["convert", l, "-o", sneaky, "--force", "-q"]));
+    assert_eq!(std::fs::read(&like).unwrap(), before);
+    assert!(leftovers(d.path()).is_empty());
+}
