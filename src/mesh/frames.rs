@@ -50,6 +50,7 @@ impl FrameSource {
         let extension = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        super::io::check_clip(input, extension.as_deref(), opts)?;
         match extension.as_deref() {
             Some("pc2") => Self::open_pc2(path, opts.base.as_deref()),
             Some("gltf") | Some("glb") => {

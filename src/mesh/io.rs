@@ -55,12 +55,25 @@ pub fn read_animation(input: &str, opts: &ReadOptions) -> Result<AnimatedMesh> {
             ));
         }
     }
+    check_clip(input, extension.as_deref(), opts)?;
     match extension.as_deref() {
         Some("pc2") => pc2::read_pc2_animation(path, opts.base.as_deref()),
         Some("gltf") | Some("glb") => {
             gltf::read_gltf(path, opts.fps, opts.clip.as_deref(), opts.max_positions)
         }
         _ => obj::read_sequence(&obj_files::frame_files(input)?),
+    }
+}
+
+/// Refuses [`ReadOptions::clip`] for an input that is not glTF (of lowercase `extension`): only
+/// glTF has clips, and a `--clip` silently ignored would encode something the user did not ask for.
+pub(crate) fn check_clip(input: &str, extension: Option<&str>, opts: &ReadOptions) -> Result<()> {
+    match (&opts.clip, extension) {
+        (Some(clip), ext) if !matches!(ext, Some("gltf" | "glb")) => Err(Error::option(
+            "clip",
+            format!("{clip}: applies to glTF inputs (.glb, .gltf) only, and {input} is not one"),
+        )),
+        _ => Ok(()),
     }
 }
 

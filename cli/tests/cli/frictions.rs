@@ -328,6 +328,30 @@ fn f8_options_of_another_codec_are_usage_errors() {
     }
 }
 
+/// `--clip` was silently ignored for OBJ frames (another animation than asked for was encoded):
+/// it is a usage error now (exit 2), as other options that do not apply are.
+#[test]
+fn f8_a_clip_of_obj_frames_is_a_usage_error() {
+    let d = tempfile::tempdir().unwrap();
+    let frames = d.path().join("frames");
+    std::fs::create_dir(&frames).unwrap();
+    for f in 0..2 {
+        let text = format!("v 0 0 0\nv 1 0 {f}\nv 0 1 0\nf 1 2 3\n");
+        std::fs::write(frames.join(format!("f_{f}.obj")), text).unwrap();
+    }
+    let (input, o) = (frames.to_str().unwrap(), d.path().join("x.mcgv"));
+    let o = o.to_str().unwrap();
+    fails(
+        &run(&["encode", input, "-o", o, "--clip", "3"]),
+        2,
+        &["--clip", "glTF"],
+    );
+    let pc2 = d.path().join("x.pc2");
+    let convert = run(&["convert", input, "-o", pc2.to_str().unwrap(), "--clip", "0"]);
+    fails(&convert, 2, &["--clip", "glTF"]);
+    assert!(!Path::new(o).exists() && !pc2.exists());
+}
+
 #[test]
 fn f9_messages_name_the_file_and_the_fix() {
     let d = tempfile::tempdir().unwrap();
