@@ -398,8 +398,9 @@ impl std::str::FromStr for Frames {
                     (end(a)?, end(b)?)
                 }
             };
-            if let (Some(a), Some(b)) = (from, to) {
-                if a >= b {
+            // A missing start is frame 0, so `..0` is as empty as `5..5`.
+            if let Some(b) = to {
+                if from.unwrap_or(0) >= b {
                     return Err(format!("{text}: {span} is empty (A must be below B)"));
                 }
             }
@@ -554,7 +555,9 @@ mod tests {
         assert_eq!(pick("..", 3).unwrap(), [0, 1, 2]);
         assert!(pick("8..12", 10).is_err());
         assert!(pick("10", 10).is_err());
-        for bad in ["5..5", "6..2", "a", "1..x", "", "1,,2", "-1"] {
+        for bad in [
+            "5..5", "6..2", "..0", "1,..0", "a", "1..x", "", "1,,2", "-1",
+        ] {
             assert!(bad.parse::<Frames>().is_err(), "{bad}");
         }
     }

@@ -328,10 +328,11 @@ fn f8_options_of_another_codec_are_usage_errors() {
     }
 }
 
-/// `--clip` was silently ignored for OBJ frames (another animation than asked for was encoded):
-/// it is a usage error now (exit 2), as other options that do not apply are.
+/// `--clip` was silently ignored for OBJ frames (another animation than asked for was encoded),
+/// and `decode --frames ..0` said "the animation has no frames" (exit 1) where `10..5` is a usage
+/// error: both are usage errors now (exit 2).
 #[test]
-fn f8_a_clip_of_obj_frames_is_a_usage_error() {
+fn f8_a_clip_of_obj_frames_and_an_empty_frame_range_are_usage_errors() {
     let d = tempfile::tempdir().unwrap();
     let frames = d.path().join("frames");
     std::fs::create_dir(&frames).unwrap();
@@ -350,6 +351,13 @@ fn f8_a_clip_of_obj_frames_is_a_usage_error() {
     let convert = run(&["convert", input, "-o", pc2.to_str().unwrap(), "--clip", "0"]);
     fails(&convert, 2, &["--clip", "glTF"]);
     assert!(!Path::new(o).exists() && !pc2.exists());
+    let s = stream(d.path(), &[]);
+    let out = d.path().join("f0");
+    for empty in ["..0", "10..5"] {
+        let args = ["decode", &s, "--frames", empty, "-o", out.to_str().unwrap()];
+        fails(&run(&args), 2, &[empty, "empty"]);
+    }
+    assert!(!out.exists());
 }
 
 #[test]
