@@ -127,9 +127,17 @@ pub(crate) fn read_obj(path: &Path) -> Result<ObjFrame> {
     parse_obj(&read_text(path)?, path)
 }
 
-/// The text of the file at `path`, invalid UTF-8 replaced.
+/// UTF-8's byte-order mark, which some Windows editors put before the first line.
+const BOM: &str = "\u{feff}";
+
+/// The text of the file at `path`, invalid UTF-8 replaced and a leading byte-order mark removed
+/// (left, it glued onto the first line's keyword and that `v` line was silently skipped; both
+/// the full parse and the later frames' position-only read take their text from here).
 pub(super) fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let mut bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    if bytes.starts_with(BOM.as_bytes()) {
+        bytes.drain(..BOM.len());
+    }
     // `from_utf8` checks ASCII a word at a time, the lossy decoder byte by byte: the fast check
     // first (an OBJ file is ASCII but for names and comments), the lossy one where it fails.
     Ok(match String::from_utf8(bytes) {
@@ -138,8 +146,9 @@ pub(super) fn read_text(path: &Path) -> Result<String> {
     })
 }
 
-/// Parses OBJ text; `path` only names the file in error messages.
+/// Parses OBJ text (a leading byte-order mark skipped); `path` only names the file in error messages.
 pub(crate) fn parse_obj(text: &str, path: &Path) -> Result<ObjFrame> {
+    let text = text.strip_prefix(BOM).unwrap_or(text);
     let mut positions: Vec<Point> = Vec::new();
     // Corners keep the 1-based or negative OBJ index until all positions are known, because a face
     // may name a vertex defined further down.

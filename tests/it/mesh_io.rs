@@ -173,6 +173,30 @@ fn coordinates_beyond_the_limit_are_refused_naming_frame_and_vertex() {
     assert!(AnimatedMesh::new(vec![[0, 1, 2]], vec![square(0.0), square(limit)]).is_ok());
 }
 
+/// A UTF-8 byte-order mark before the first line glued onto its `v`, and that vertex was
+/// silently dropped (then "face refers to vertex 4, but the file has 3"). Later frames are read
+/// by their positions alone when alike: with and without the mark, they read the same.
+#[test]
+fn a_byte_order_mark_before_the_first_line_is_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = dir.path().join("plain");
+    let marked = dir.path().join("marked");
+    for (folder, bom) in [(&plain, ""), (&marked, "\u{feff}")] {
+        std::fs::create_dir(folder).unwrap();
+        for f in 0..3 {
+            // Frame 2 has no mark: a file need not match the first one's.
+            let bom = if f == 2 { "" } else { bom };
+            let text = format!("{bom}v {f} 0 0\nv 1 0 {f}\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+            write(&folder.join(format!("frame_{f}.obj")), &text);
+        }
+    }
+    let want = read(plain.to_str().unwrap()).unwrap();
+    assert_eq!(want.vertex_count(), 4);
+    assert_eq!(read(marked.to_str().unwrap()).unwrap(), want);
+    let one = mcgv_video::mesh::parse_obj(&format!("\u{feff}{QUAD}"), Path::new("q.obj")).unwrap();
+    assert_eq!(one.vertex_count(), 4);
+}
+
 /// The reader's triangles, read through positions, must be the ones `tobj` makes of the same file
 /// (which renumbers vertices per object, so only positions can be compared).
 #[test]
