@@ -187,8 +187,12 @@ pub struct EncodeArgs {
     /// --quality sets.
     #[arg(long)]
     pub step: Option<f64>,
-    /// Number of motion clusters K: alone, k-means with exactly K; with --segmentation auto,
-    /// K of its k-means candidate (tdct's auto also tries 1.5 K, and 2 K when 1.5 K paid) [default: 20].
+    /// Number of motion clusters K asked of k-means: alone, k-means into K; with --segmentation
+    /// auto, K of its k-means candidate (tdct's auto also tries 1.5 K, and 2 K when 1.5 K paid)
+    /// [default: 20]. At most K are kept, often fewer: clusters of fewer than 4 vertices (too few
+    /// to fit an affine map) merge into the nearest, clusters that border refinement empties
+    /// vanish, K is at most the vertex count, and a mesh moving as one takes one; the report
+    /// says how many.
     #[arg(long)]
     pub clusters: Option<usize>,
     /// Motion segmentation: k-means with K = --clusters, decimation, which finds K itself, or

@@ -189,3 +189,20 @@ fn a_huge_coordinate_is_a_clear_error_not_a_panic_in_kmeans() {
     }
     assert!(!out.exists());
 }
+
+/// The help promised "k-means with exactly K", but clusters too small for an affine map merge
+/// and emptied ones vanish (RiggedSimple asked for 10 keeps 8): it says at most K, often fewer.
+#[test]
+fn clusters_help_says_at_most_k_are_kept() {
+    let help = ok(&run(&["encode", "--help"]));
+    let clusters = help
+        .split("--clusters <CLUSTERS>")
+        .nth(1)
+        .and_then(|h| h.split("\n      --").next())
+        .expect("--clusters in the help");
+    assert!(!clusters.contains("exactly"), "{clusters}");
+    assert!(
+        clusters.contains("At most K are kept, often fewer"),
+        "{clusters}"
+    );
+}
