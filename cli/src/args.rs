@@ -188,7 +188,7 @@ pub struct EncodeArgs {
     #[arg(long)]
     pub step: Option<f64>,
     /// Number of motion clusters K asked of k-means: alone, k-means into K; with --segmentation
-    /// auto, K of its k-means candidate (tdct's auto also tries 1.5 K, and 2 K when 1.5 K paid)
+    /// auto, the first of its k-means candidates (auto also tries 1.5 K, and 2 K when 1.5 K paid)
     /// [default: 20]. At most K are kept, often fewer: clusters of fewer than 4 vertices (too few
     /// to fit an affine map) merge into the nearest, clusters that border refinement empties
     /// vanish, K is at most the vertex count, and a mesh moving as one takes one; the report
