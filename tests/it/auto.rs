@@ -238,8 +238,9 @@ fn tdct_tries_a_ladder_of_cluster_counts_and_keeps_the_smallest() {
             assert_eq!(bytes.len() as u64, c.bytes, "K = {k}");
         }
     }
-    // The picture codecs climb the same ladder (since 2026-12-04; K alone before, too few
-    // clusters for a dancer): three k-means rungs and decimation.
+    // The picture codecs' options name the same ladder (since 2026-12-04; K alone before, too
+    // few clusters for a dancer): three k-means rungs and decimation, of which they try the rung
+    // tdct's estimates rank first.
     let jpeg = opts(
         Codec::Jpeg,
         PredictorKind::Affine.into(),
@@ -298,6 +299,18 @@ fn sample_then_whole(codec: Codec, mesh: AnimatedMesh, sample: usize) {
     let choice = encoded.report.choice.clone().expect("a choice");
     assert_eq!(choice.trial_frames, sample, "{codec:?}: {choice:?}");
     assert!(choice.reason.contains("estimated"), "{}", choice.reason);
+    // One k-means rung, the one tdct's estimates rank first, beside decimation.
+    assert!(
+        choice.reason.contains("tdct's estimates rank first"),
+        "{}",
+        choice.reason
+    );
+    let mut ks: Vec<usize> = (choice.candidates.iter())
+        .filter(|c| c.segmentation == "kmeans")
+        .map(|c| c.clusters)
+        .collect();
+    ks.dedup();
+    assert_eq!(ks.len(), 1, "{choice:?}");
     // Each candidate's sample stream, with those frames' affine maps, is decoded and its error
     // weighed as the whole stream's.
     let best = kept_at_least_cost(&choice, mesh.bbox_diagonal());
@@ -447,13 +460,14 @@ fn picture_codecs_weigh_each_candidates_measured_error_against_its_bits() {
 fn progress_announces_the_trials_frames_and_reports_them_all() {
     let mesh = skinned_bend();
     let frames = mesh.frame_count() as u64;
-    // Every codec's candidates: k-means at three K and decimation, two predictors each. tdct
-    // estimates every candidate, then codes the winner; MPEG-4 codes every candidate whole;
-    // JPEG 12 frames each, then the winner whole.
+    // tdct estimates every candidate (its k-means at three K and decimation, two predictors
+    // each), then codes the winner; the picture codecs try the rung tdct's estimates rank first
+    // and decimation (their ranking is not on the bar): MPEG-4 codes every candidate whole, JPEG
+    // 12 frames each, then the winner whole.
     let codecs = [
         (Codec::Tdct, 8 * frames + frames),
-        (Codec::Mpeg4, 8 * frames),
-        (Codec::Jpeg, 8 * 12 + frames),
+        (Codec::Mpeg4, 4 * frames),
+        (Codec::Jpeg, 4 * 12 + frames),
     ];
     for (codec, expected) in codecs {
         let counter = Counter::default();

@@ -35,6 +35,9 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+mod rungs;
+use rungs::rank_rungs;
+
 /// What the automatic choice measured and kept.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ChoiceReport {
@@ -127,13 +130,26 @@ pub(super) fn choose(
         sample: sample.as_ref(),
         smallest_estimate: AtomicU64::new(u64::MAX),
     };
+    let segmenter = analysis::Segmenter::new(mesh);
+    let mut segmentations = segmentations(models);
+    prepare_kmeans(&segmenter, &segmentations, &mut clock);
+    // A picture codec tries the k-means rung tdct's estimates rank first, and decimation.
+    let ranked = rank_rungs(&shared, &segmenter, (&segmentations, models), progress, &mut clock)?;
+    let kept_rungs: Vec<MotionModel>;
+    let models = match ranked {
+        Some(k) => {
+            let kept = |s: Segmentation, c: usize| s != Segmentation::KMeans || c == k;
+            segmentations.retain(|&(s, c)| kept(s, c));
+            let models = models.iter().filter(|m| kept(m.segmentation, m.clusters));
+            kept_rungs = models.copied().collect();
+            &kept_rungs[..]
+        }
+        None => models,
+    };
     let (frames, trial_frames) = (mesh.frame_count(), shared.trial_frames());
     let estimated = sample.is_some() || settings.opts.codec.codec().estimated_trials();
     let total = (models.len() * trial_frames + if estimated { frames } else { 0 }) as u64;
     progress.total(total);
-    let segmenter = analysis::Segmenter::new(mesh);
-    let segmentations = segmentations(models);
-    prepare_kmeans(&segmenter, &segmentations, &mut clock);
     let atlases: Vec<AtlasCache> = segmentations.iter().map(|_| AtlasCache::default()).collect();
     // The ladder's stop reads each rung's smallest cost: tdct's estimates, a picture codec's
     // sampled costs at equal error (`ladder`).
@@ -155,6 +171,9 @@ pub(super) fn choose(
         .ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
     let mut reason = reason(&candidates, &costs, at, (trial_frames, frames));
     reason.extend(skipped.iter().map(|s| format!("; {s}")));
+    if let Some(k) = ranked {
+        reason.push_str(&format!("; k-means at K = {k}, the rung tdct's estimates rank first"));
+    }
     // A sample too close to call: both coded whole (a segmented encoding's analysis clip is
     // coded on its first frame alone, so its sample decides).
     let whole_streams = sample.is_some() && settings.keep == Keep::Whole;
