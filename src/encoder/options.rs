@@ -204,7 +204,8 @@ pub struct MotionModel {
 }
 
 /// The k-means cluster counts an automatic segmentation tries, from the caller's `k`: k, 1.5 k
-/// and 2 k (a rung only when the one below paid: `encoder/ladder.rs`), with every codec. More clusters fit the motion more closely for more side
+/// and 2 k (a rung only when the one below paid: `encoder/ladder.rs`; a picture codec tries the
+/// one tdct's estimates rank first: `encoder/auto/rungs.rs`). More clusters fit the motion more closely for more side
 /// information; which wins depends on the animation and the step
 /// (docs/design.md, "First-frame bits trials and k-means ladder").
 pub fn kmeans_ladder(k: usize) -> Vec<usize> {
