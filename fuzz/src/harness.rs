@@ -155,9 +155,6 @@ fn same_bits(a: &[[f32; 3]], b: &[[f32; 3]]) -> bool {
 /// CRC checks, which would otherwise reject nearly every mutation before any decoder runs. Stops
 /// quietly where the layout stops making sense: the decoder reports that itself.
 pub fn fix_checksums(bytes: &mut [u8]) {
-    let word = |b: &[u8], at: usize| -> Option<u32> {
-        Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
-    };
     let Some(count) = word(bytes, 12) else {
         return;
     };
@@ -192,51 +189,53 @@ pub fn fix_checksums(bytes: &mut [u8]) {
 const LEN_AT: usize = 5;
 const CRC_AT: usize = 9;
 
+/// The little-endian `u32` at `at`, if `b` holds it.
+fn word(b: &[u8], at: usize) -> Option<u32> {
+    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
+}
+
 /// The payload length a part header at `head` declares.
 fn declared_len(head: &[u8]) -> Option<u64> {
-    let word = head.get(LEN_AT..LEN_AT + 4)?.try_into().ok()?;
-    Some(u64::from(u32::from_le_bytes(word)))
+    word(head, LEN_AT).map(u64::from)
 }
 
 /// Repairs the frame chunks' CRCs in every frame index (one per segment) that still parses, so
 /// that mutated pictures reach the picture decoders; the index is coded again and spliced in.
 pub fn fix_frame_index(bytes: &mut Vec<u8>) {
-    for n in 0..64 {
-        if !fix_nth_frame_index(bytes, n) {
-            return;
+    recode_indexes(bytes, (b"INDX", b"FRMS"), |bytes, (start, end), chunks| {
+        // The index states its own frame count; the decoder checks it against the header's.
+        let count = word(bytes, start)? as usize;
+        let mut index = FrameIndex::from_bytes(&bytes[start..end], count, chunks.1).ok()?;
+        for e in index.entries_mut() {
+            if let Some(crc) = chunk_crc(bytes, (chunks.0, chunks.2), e.offset, e.len) {
+                e.crc = crc;
+            }
         }
-    }
+        index.to_bytes().ok()
+    });
 }
 
-/// [`fix_frame_index`] for the `n`-th index and images part; false when there is none.
-fn fix_nth_frame_index(bytes: &mut Vec<u8>, n: usize) -> bool {
-    let Some((_, f_start, f_declared, f_end)) = part_layout_nth(bytes, b"FRMS", n) else {
-        return false;
-    };
-    let Some((i_pos, i_start, _, i_end)) = part_layout_nth(bytes, b"INDX", n) else {
-        return false;
-    };
-    // The index states its own frame count; the decoder checks it against the header's.
-    let Some(count) = bytes
-        .get(i_start..i_start + 4)
-        .and_then(|b| b.try_into().ok())
-        .map(u32::from_le_bytes)
-    else {
-        return true;
-    };
-    let Ok(mut index) = FrameIndex::from_bytes(&bytes[i_start..i_end], count as usize, f_declared)
-    else {
-        return true;
-    };
-    for e in index.entries_mut() {
-        if let Some(crc) = chunk_crc(bytes, (f_start, f_end), e.offset, e.len) {
-            e.crc = crc;
+/// For the `n`-th part tagged `index` and the `n`-th tagged `chunks` (one pair per segment, up to
+/// 64): `recode` gets the file, the index's payload span and the chunked part's (start, declared
+/// length, end), and returns the index coded again, which is spliced in; `None` leaves it as it
+/// is (an index that no longer parses: refusing it is the decoder's job).
+fn recode_indexes(
+    bytes: &mut Vec<u8>,
+    (index, chunks): (&[u8; 4], &[u8; 4]),
+    recode: impl Fn(&[u8], (usize, usize), (usize, u64, usize)) -> Option<Vec<u8>>,
+) {
+    // Each splice keeps the later parts' order.
+    for n in 0..64 {
+        let Some((_, c_start, c_declared, c_end)) = part_layout_nth(bytes, chunks, n) else {
+            return;
+        };
+        let Some((i_pos, i_start, _, i_end)) = part_layout_nth(bytes, index, n) else {
+            return;
+        };
+        if let Some(coded) = recode(bytes, (i_start, i_end), (c_start, c_declared, c_end)) {
+            splice_part(bytes, (i_pos, i_start, i_end), &coded);
         }
     }
-    if let Ok(coded) = index.to_bytes() {
-        splice_part(bytes, (i_pos, i_start, i_end), &coded);
-    }
-    true
 }
 
 /// The CRC-32 of the non-empty chunk at `offset`, `len` bytes into the part payload
@@ -310,41 +309,15 @@ fn part_layout_nth(
 /// coefficients part (TDCT), re-coding the index; its part CRC is left to [`fix_checksums`]. An
 /// index that no longer parses is left as it is: refusing it is the decoder's job.
 pub fn fix_band_index(bytes: &mut Vec<u8>) {
-    // One index and one coefficients part per segment; each splice keeps the later parts' order.
-    for n in 0..64 {
-        if !fix_nth_band_index(bytes, n) {
-            return;
+    recode_indexes(bytes, (b"TDIX", b"TDCT"), |bytes, (start, end), chunks| {
+        // The index states its own band count; the decoder checks it against the header's frames.
+        let count = word(bytes, start + 4)? as usize;
+        let mut index = BandIndex::from_bytes(&bytes[start..end], count, chunks.1).ok()?;
+        for band in &mut index.bands {
+            if let Some(crc) = chunk_crc(bytes, (chunks.0, chunks.2), band.offset, band.len) {
+                band.crc = crc;
+            }
         }
-    }
-}
-
-/// [`fix_band_index`] for the `n`-th index and coefficients part; false when there is none.
-fn fix_nth_band_index(bytes: &mut Vec<u8>, n: usize) -> bool {
-    let Some((_, c_start, c_declared, c_end)) = part_layout_nth(bytes, b"TDCT", n) else {
-        return false;
-    };
-    let Some((i_pos, i_start, _, i_end)) = part_layout_nth(bytes, b"TDIX", n) else {
-        return false;
-    };
-    // The index states its own band count; the decoder checks it against the header's frames.
-    let Some(count) = bytes
-        .get(i_start + 4..i_start + 8)
-        .and_then(|b| b.try_into().ok())
-        .map(u32::from_le_bytes)
-    else {
-        return true;
-    };
-    let Ok(mut index) = BandIndex::from_bytes(&bytes[i_start..i_end], count as usize, c_declared)
-    else {
-        return true;
-    };
-    for band in &mut index.bands {
-        if let Some(crc) = chunk_crc(bytes, (c_start, c_end), band.offset, band.len) {
-            band.crc = crc;
-        }
-    }
-    if let Ok(coded) = index.to_bytes() {
-        splice_part(bytes, (i_pos, i_start, i_end), &coded);
-    }
-    true
+        index.to_bytes().ok()
+    });
 }
