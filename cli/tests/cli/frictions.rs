@@ -1,7 +1,7 @@
 //! Issue 21, a command line a user can trust: one test per friction a new user met, each doing what
 //! the user did and checking that it now behaves (exit codes, messages, files on disk).
 
-use crate::common::{json, media_path, ok, run};
+use crate::common::{file_names, json, media_path, ok, run};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
@@ -226,13 +226,8 @@ fn f5_clips_whose_names_clash_get_distinct_files() {
     ]
     .concat());
     assert!(all.status.success(), "{}", stderr(&all));
-    let mut names: Vec<String> = std::fs::read_dir(d.path().join("out"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
     assert_eq!(
-        names,
+        file_names(&d.path().join("out")),
         [
             "r-0.mcgv",
             "r-1-4.mcgv",

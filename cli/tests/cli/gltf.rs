@@ -4,7 +4,7 @@
 //! The validator is npm's `gltf-validator`, installed by `make node-tools` (a step of `make test`)
 //! into `scripts/node/`. A missing validator fails the test: a check that silently skips checks nothing.
 
-use crate::common::{json, media_path, ok, repo_root, run};
+use crate::common::{file_names, json, media_path, ok, repo_root, run};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -25,13 +25,8 @@ fn validate(files: &[PathBuf]) -> std::process::Output {
 }
 
 fn samples() -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(repo_root().join("media"))
-        .expect("media/ lists")
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".glb") || n.ends_with(".gltf"))
-        .collect();
-    names.sort();
+    let mut names = file_names(&repo_root().join("media"));
+    names.retain(|n| n.ends_with(".glb") || n.ends_with(".gltf"));
     names
 }
 
@@ -167,13 +162,8 @@ fn decode_frames_a_to_b_keeps_their_numbers() {
     ok(&run(&[
         "decode", &stream, "-o", &out, "--frames", "2..5", "--quiet",
     ]));
-    let mut names: Vec<String> = std::fs::read_dir(&folder)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
     assert_eq!(
-        names,
+        file_names(&folder),
         ["frame_0002.obj", "frame_0003.obj", "frame_0004.obj"]
     );
     let glb = dir.path().join("part.glb");
