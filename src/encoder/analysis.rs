@@ -70,10 +70,12 @@ pub fn segment(
 }
 
 /// Segments one animation several ways, keeping what every K of k-means shares (the motion
-/// descriptors, most of a segmentation's time after k-means itself).
+/// descriptors, most of a segmentation's time after k-means itself) and each K's partition (a
+/// picture codec's choice asks for its ranked rung twice: `encoder/auto/rungs.rs`).
 pub struct Segmenter<'a> {
     mesh: &'a AnimatedMesh,
     descriptors: std::sync::OnceLock<MotionDescriptors>,
+    kmeans_done: std::sync::Mutex<Vec<(usize, (Partition, SegmentationReport))>>,
 }
 
 impl<'a> Segmenter<'a> {
@@ -82,11 +84,39 @@ impl<'a> Segmenter<'a> {
         Self {
             mesh,
             descriptors: std::sync::OnceLock::new(),
+            kmeans_done: std::sync::Mutex::new(Vec::new()),
         }
     }
 
-    /// The motion segmentation `segmentation` (k-means into `clusters`), and what it did.
+    /// The motion segmentation `segmentation` (k-means into `clusters`), and what it did; a
+    /// k-means partition made before is handed out again (k-means is deterministic).
     pub fn segment(
+        &self,
+        segmentation: Segmentation,
+        clusters: usize,
+    ) -> Result<(Partition, SegmentationReport)> {
+        if segmentation != Segmentation::KMeans {
+            return self.segment_now(segmentation, clusters);
+        }
+        if let Some(found) = self.kmeans_made(clusters) {
+            return Ok(found);
+        }
+        let made = self.segment_now(segmentation, clusters)?;
+        if let Ok(mut list) = self.kmeans_done.lock() {
+            list.push((clusters, made.clone()));
+        }
+        Ok(made)
+    }
+
+    /// The k-means partition into `clusters` made before, if any.
+    fn kmeans_made(&self, clusters: usize) -> Option<(Partition, SegmentationReport)> {
+        let list = self.kmeans_done.lock().ok()?;
+        let found = list.iter().find(|(k, _)| *k == clusters);
+        found.map(|(_, made)| made.clone())
+    }
+
+    /// [`Self::segment`], computed.
+    fn segment_now(
         &self,
         segmentation: Segmentation,
         clusters: usize,
