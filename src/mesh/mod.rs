@@ -105,19 +105,22 @@ impl AnimatedMesh {
                     frame.len()
                 )));
             }
-            if let Some(i) = frame.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            // One pass over the coordinates (NaN fails the comparison too); a frame with a
+            // coordinate out of bounds names its first non-finite one if any, else the first
+            // beyond the bound.
+            let within = |p: &Point| p.iter().all(|c| c.abs() <= MAX_COORDINATE);
+            if let Some(beyond) = frame.iter().position(|p| !within(p)) {
+                let not_finite = |p: &Point| p.iter().any(|c| !c.is_finite());
+                if let Some(i) = frame[beyond..].iter().position(not_finite) {
+                    return Err(Error::Mesh(format!(
+                        "frame {f}, vertex {}: coordinate is not a finite number",
+                        beyond + i
+                    )));
+                }
+                let p = frame[beyond];
                 return Err(Error::Mesh(format!(
-                    "frame {f}, vertex {i}: coordinate is not a finite number"
-                )));
-            }
-            if let Some(i) = frame
-                .iter()
-                .position(|p| p.iter().any(|c| c.abs() > MAX_COORDINATE))
-            {
-                let p = frame[i];
-                return Err(Error::Mesh(format!(
-                    "frame {f}, vertex {i}: coordinate ({} {} {}) is beyond ±{MAX_COORDINATE:e}, \
-                     the largest this tool handles",
+                    "frame {f}, vertex {beyond}: coordinate ({} {} {}) is beyond \
+                     ±{MAX_COORDINATE:e}, the largest this tool handles",
                     p[0], p[1], p[2]
                 )));
             }
