@@ -151,8 +151,8 @@ pub(super) fn choose(
     let total = (models.len() * trial_frames + if estimated { frames } else { 0 }) as u64;
     progress.total(total);
     let atlases: Vec<AtlasCache> = segmentations.iter().map(|_| AtlasCache::default()).collect();
-    // The ladder's stop reads each rung's smallest cost: tdct's estimates, a picture codec's
-    // sampled costs at equal error (`ladder`).
+    // The ladder's stop reads tdct's estimates of each rung (`ladder`; a picture codec has one
+    // rung left, the one `rank_rungs` kept).
     let gates = ladder::gates(&segmentations);
     let jobs = jobs_of(models, &segmentations, &atlases, &gates);
     let outcomes = ladder::run_jobs(
