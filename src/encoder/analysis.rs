@@ -69,13 +69,16 @@ pub fn segment(
     Segmenter::new(mesh).segment(segmentation, clusters)
 }
 
+/// A partition made, by segmentation and K (0 for decimation), and its report.
+type Made = ((Segmentation, usize), (Partition, SegmentationReport));
+
 /// Segments one animation several ways, keeping what every K of k-means shares (the motion
-/// descriptors, most of a segmentation's time after k-means itself) and each K's partition (a
-/// picture codec's choice asks for its ranked rung twice: `encoder/auto/rungs.rs`).
+/// descriptors, most of a segmentation's time after k-means itself) and each partition made (a
+/// picture codec's choice asks for the segmentations it tries twice: `encoder/auto/rungs.rs`).
 pub struct Segmenter<'a> {
     mesh: &'a AnimatedMesh,
     descriptors: std::sync::OnceLock<MotionDescriptors>,
-    kmeans_done: std::sync::Mutex<Vec<(usize, (Partition, SegmentationReport))>>,
+    done: std::sync::Mutex<Vec<Made>>,
 }
 
 impl<'a> Segmenter<'a> {
@@ -84,34 +87,36 @@ impl<'a> Segmenter<'a> {
         Self {
             mesh,
             descriptors: std::sync::OnceLock::new(),
-            kmeans_done: std::sync::Mutex::new(Vec::new()),
+            done: std::sync::Mutex::new(Vec::new()),
         }
     }
 
     /// The motion segmentation `segmentation` (k-means into `clusters`), and what it did; a
-    /// k-means partition made before is handed out again (k-means is deterministic).
+    /// partition made before is handed out again (both segmentations are deterministic).
     pub fn segment(
         &self,
         segmentation: Segmentation,
         clusters: usize,
     ) -> Result<(Partition, SegmentationReport)> {
-        if segmentation != Segmentation::KMeans {
-            return self.segment_now(segmentation, clusters);
-        }
-        if let Some(found) = self.kmeans_made(clusters) {
+        // Decimation ignores `clusters` (it finds its own count): one entry whatever is asked.
+        let key = match segmentation {
+            Segmentation::KMeans => (segmentation, clusters),
+            Segmentation::Decimation { .. } => (segmentation, 0),
+        };
+        if let Some(found) = self.made(key) {
             return Ok(found);
         }
         let made = self.segment_now(segmentation, clusters)?;
-        if let Ok(mut list) = self.kmeans_done.lock() {
-            list.push((clusters, made.clone()));
+        if let Ok(mut list) = self.done.lock() {
+            list.push((key, made.clone()));
         }
         Ok(made)
     }
 
-    /// The k-means partition into `clusters` made before, if any.
-    fn kmeans_made(&self, clusters: usize) -> Option<(Partition, SegmentationReport)> {
-        let list = self.kmeans_done.lock().ok()?;
-        let found = list.iter().find(|(k, _)| *k == clusters);
+    /// The partition made before for `key`, if any.
+    fn made(&self, key: (Segmentation, usize)) -> Option<(Partition, SegmentationReport)> {
+        let list = self.done.lock().ok()?;
+        let found = list.iter().find(|(k, _)| *k == key);
         found.map(|(_, made)| made.clone())
     }
 

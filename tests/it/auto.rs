@@ -502,3 +502,37 @@ fn auto_segmentation_checks_its_threshold() {
     let err = encode(&mesh, &options).err().expect("refused").to_string();
     assert!(err.contains("e0"), "{err}");
 }
+
+#[test]
+fn a_picture_codec_codes_the_one_candidate_tdct_leaves_without_a_trial() {
+    // A smooth bend: skinning blends the clusters' maps, affine on 4 clusters is 24 % larger by
+    // tdct's estimates; a coarse decimation (E0 = 0.1) leaves 2 clusters, twice k-means' bytes.
+    let mesh = skinned_bend_of(30);
+    let options = EncodeOptions {
+        clusters: 4,
+        ..opts(
+            Codec::Jpeg,
+            PredictorChoice::Auto,
+            SegmentationChoice::Auto { e0: 0.1 },
+        )
+    };
+    let encoded = encode(&mesh, &options).expect("encodes");
+    let choice = encoded.report.choice.clone().expect("a choice");
+    assert_eq!(choice.chosen, "skinning+kmeans", "{choice:?}");
+    assert_eq!(choice.trial_frames, 0, "{choice:?}");
+    assert_eq!(choice.candidates.len(), 1, "{choice:?}");
+    for words in [
+        "the one candidate tdct's estimates left",
+        "affine+kmeans not tried with pictures",
+        "decimation not tried with pictures",
+    ] {
+        assert!(choice.reason.contains(words), "{}", choice.reason);
+    }
+    // The stream is the one that candidate gives when fixed.
+    let fixed = fixed_bytes(
+        &mesh,
+        &options,
+        (PredictorKind::Skinning, Segmentation::KMeans),
+    );
+    assert_eq!(encoded.to_bytes(), fixed);
+}

@@ -36,7 +36,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 mod rungs;
-use rungs::rank_rungs;
+use rungs::{only, rank_rungs};
 
 /// What the automatic choice measured and kept.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -131,30 +131,26 @@ pub(super) fn choose(
         smallest_estimate: AtomicU64::new(u64::MAX),
     };
     let segmenter = analysis::Segmenter::new(mesh);
-    let mut segmentations = segmentations(models);
+    let segmentations = segmentations(models);
     prepare_kmeans(&segmenter, &segmentations, &mut clock);
-    // A picture codec tries the k-means rung tdct's estimates rank first, and decimation.
+    // A picture codec tries the k-means rung tdct's estimates rank first, and decimation and
+    // the affine predictor unless they rank them far behind.
     let ranked = rank_rungs(&shared, &segmenter, (&segmentations, models), progress, &mut clock)?;
-    let kept_rungs: Vec<MotionModel>;
-    let models = match ranked {
-        Some(k) => {
-            let kept = |s: Segmentation, c: usize| s != Segmentation::KMeans || c == k;
-            segmentations.retain(|&(s, c)| kept(s, c));
-            let models = models.iter().filter(|m| kept(m.segmentation, m.clusters));
-            kept_rungs = models.copied().collect();
-            &kept_rungs[..]
-        }
-        None => models,
-    };
+    let narrowed = ranked.as_ref().map(|ranking| ranking.narrow(models));
+    let tried = narrowed.as_deref().unwrap_or(models);
+    if let ([model], Some(ranking)) = (tried, &ranked) {
+        return only(&shared, &segmenter, (*model, models), ranking, progress, clock);
+    }
+    let segmentations = self::segmentations(tried);
     let (frames, trial_frames) = (mesh.frame_count(), shared.trial_frames());
     let estimated = sample.is_some() || settings.opts.codec.codec().estimated_trials();
-    let total = (models.len() * trial_frames + if estimated { frames } else { 0 }) as u64;
+    let total = (tried.len() * trial_frames + if estimated { frames } else { 0 }) as u64;
     progress.total(total);
     let atlases: Vec<AtlasCache> = segmentations.iter().map(|_| AtlasCache::default()).collect();
     // The ladder's stop reads tdct's estimates of each rung (`ladder`; a picture codec has one
     // rung left, the one `rank_rungs` kept).
     let gates = ladder::gates(&segmentations);
-    let jobs = jobs_of(models, &segmentations, &atlases, &gates);
+    let jobs = jobs_of(tried, &segmentations, &atlases, &gates);
     let outcomes = ladder::run_jobs(
         &gates,
         |i| jobs[i].run(&shared, &segmenter, progress),
@@ -171,8 +167,8 @@ pub(super) fn choose(
         .ok_or_else(|| Error::option("predictor", "no candidate to choose from"))?;
     let mut reason = reason(&candidates, &costs, at, (trial_frames, frames));
     reason.extend(skipped.iter().map(|s| format!("; {s}")));
-    if let Some(k) = ranked {
-        reason.push_str(&format!("; k-means at K = {k}, the rung tdct's estimates rank first"));
+    if let Some(ranking) = &ranked {
+        reason.push_str(&format!("; {}", ranking.describe(models)));
     }
     // A sample too close to call: both coded whole (a segmented encoding's analysis clip is
     // coded on its first frame alone, so its sample decides).
@@ -184,12 +180,12 @@ pub(super) fn choose(
             progress.total(total + frames as u64);
             let pair = [(best, at), runner_up];
             let (encoded, model, why) =
-                close_call::settle(&shared, pair, models, &mut candidates, progress, clock)?;
+                close_call::settle(&shared, pair, tried, &mut candidates, progress, clock)?;
             reason = format!("{why}. On the sample: {reason}");
             (encoded, model)
         }
         None => {
-            let model = models[best.index];
+            let model = tried[best.index];
             (keep(&shared, model, best.kept, progress, clock)?, model)
         }
     };
@@ -298,6 +294,14 @@ struct Job<'a> {
     may_stop: bool,
 }
 
+/// A job's partition, its segmentation's report, its affine track and the stages' seconds.
+type Prepared = (
+    Partition,
+    analysis::SegmentationReport,
+    AffineTrack,
+    Vec<(String, f64)>,
+);
+
 /// One candidate tried: its report, cost, and what keeping it needs.
 struct Tried<'a> {
     candidate: Candidate,
@@ -316,6 +320,18 @@ struct Outcome<'a> {
 }
 
 impl<'a> Job<'a> {
+    /// A job of one candidate on its own segmentation, no gate.
+    fn alone(model: MotionModel, atlas: &'a AtlasCache) -> Self {
+        Job {
+            segmentation: (model.segmentation, model.clusters),
+            models: vec![model],
+            first: 0,
+            atlas,
+            below: None,
+            may_stop: false,
+        }
+    }
+
     /// Segments, fits the affine track every predictor builds on, and tries each candidate.
     fn run(
         &self,
@@ -323,35 +339,15 @@ impl<'a> Job<'a> {
         segmenter: &analysis::Segmenter,
         progress: &dyn Progress,
     ) -> Result<Outcome<'a>> {
-        let (segmentation, k) = self.segmentation;
-        let (mesh, settings) = (shared.mesh, shared.settings);
-        let stage = match segmentation {
-            Segmentation::KMeans => format!("segmentation (kmeans, K = {k})"),
-            Segmentation::Decimation { .. } => "segmentation (decimation)".to_string(),
-        };
-        progress.stage(&stage);
-        let start = Instant::now();
-        let (partition, segmented) = segmenter.segment(segmentation, k)?;
-        let reference = &shared.ff.decoded_positions;
-        let track = analysis::fit_track(mesh, reference, &partition, settings.plan.affine_step)?;
+        let (partition, segmented, track, stages) = self.prepare(shared, segmenter, progress)?;
         let mut outcome = Outcome {
             candidates: Vec::new(),
             costs: Vec::new(),
-            stages: vec![(stage, start.elapsed().as_secs_f64())],
+            stages,
             podium: Podium::new(),
             skipped: None,
         };
-        // A picture codec's candidates on this partition share its atlas, most of a trial's
-        // work: built first, their trials then run side by side (tdct's, cheap and stopping
-        // once they cannot win, run in turn).
-        let pictures = settings.plan.pictures.as_ref();
-        if let Some(option) = pictures.map(|p| p.lattice) {
-            let start = Instant::now();
-            let triangles = mesh.triangles();
-            let build = || lattice::build_atlas(reference, triangles, &partition, option);
-            self.atlas.get_or_build(build)?;
-            outcome.stages.push(("atlas".into(), start.elapsed().as_secs_f64()));
-        }
+        let pictures = shared.settings.plan.pictures.as_ref();
         let analysis = (&partition, &segmented, &track);
         let one = |&model: &MotionModel| self.try_model(shared, analysis, model, progress);
         let tried: Vec<Result<Tried>> = match pictures {
@@ -376,6 +372,37 @@ impl<'a> Job<'a> {
             outcome.podium.offer(best, i);
         }
         Ok(outcome)
+    }
+
+    /// The job's partition, its affine track and (picture codecs) its atlas, built first: most of
+    /// a picture codec's trial, shared by its candidates, whose trials then run side by side
+    /// (tdct's, cheap and stopping once they cannot win, run in turn); and the stages' seconds.
+    fn prepare(
+        &self,
+        shared: &Shared,
+        segmenter: &analysis::Segmenter,
+        progress: &dyn Progress,
+    ) -> Result<Prepared> {
+        let (segmentation, k) = self.segmentation;
+        let (mesh, settings) = (shared.mesh, shared.settings);
+        let stage = match segmentation {
+            Segmentation::KMeans => format!("segmentation (kmeans, K = {k})"),
+            Segmentation::Decimation { .. } => "segmentation (decimation)".to_string(),
+        };
+        progress.stage(&stage);
+        let start = Instant::now();
+        let (partition, segmented) = segmenter.segment(segmentation, k)?;
+        let reference = &shared.ff.decoded_positions;
+        let track = analysis::fit_track(mesh, reference, &partition, settings.plan.affine_step)?;
+        let mut stages = vec![(stage, start.elapsed().as_secs_f64())];
+        if let Some(option) = settings.plan.pictures.as_ref().map(|p| p.lattice) {
+            let start = Instant::now();
+            let triangles = mesh.triangles();
+            let build = || lattice::build_atlas(reference, triangles, &partition, option);
+            self.atlas.get_or_build(build)?;
+            stages.push(("atlas".into(), start.elapsed().as_secs_f64()));
+        }
+        Ok((partition, segmented, track, stages))
     }
 
     /// Predicts `model` on the job's partition and track and tries it ([`trial`]).
