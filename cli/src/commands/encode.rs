@@ -418,6 +418,10 @@ fn report_text(
         None => line,
     };
     let line = match &r.choice {
+        // No trial (the estimates left one candidate): no trial size to tell apart from the file's.
+        Some(choice) if choice.trial_frames == 0 && choice.candidates.len() == 1 => {
+            format!("{line}\nauto: kept {}, {}", choice.chosen, choice.reason)
+        }
         Some(choice) => format!(
             "{line}\nauto: kept {} of {} candidates: {}{}",
             choice.chosen,
