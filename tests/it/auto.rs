@@ -299,7 +299,8 @@ fn sample_then_whole(codec: Codec, mesh: AnimatedMesh, sample: usize) {
     let choice = encoded.report.choice.clone().expect("a choice");
     assert_eq!(choice.trial_frames, sample, "{codec:?}: {choice:?}");
     assert!(choice.reason.contains("estimated"), "{}", choice.reason);
-    // One k-means rung, the one tdct's estimates rank first, beside decimation.
+    // The k-means rung tdct's estimates rank first, beside decimation, and the rung above it
+    // only when the estimates put it within 5 % (on this bend: K = 3 at 1.4 % above K = 2).
     assert!(
         choice.reason.contains("tdct's estimates rank first"),
         "{}",
@@ -310,7 +311,8 @@ fn sample_then_whole(codec: Codec, mesh: AnimatedMesh, sample: usize) {
         .map(|c| c.clusters)
         .collect();
     ks.dedup();
-    assert_eq!(ks.len(), 1, "{choice:?}");
+    let above = choice.reason.contains("tried too");
+    assert_eq!(ks.len(), 1 + usize::from(above), "{choice:?}");
     // Each candidate's sample stream, with those frames' affine maps, is decoded and its error
     // weighed as the whole stream's.
     let best = kept_at_least_cost(&choice, mesh.bbox_diagonal());
@@ -461,13 +463,13 @@ fn progress_announces_the_trials_frames_and_reports_them_all() {
     let mesh = skinned_bend();
     let frames = mesh.frame_count() as u64;
     // tdct estimates every candidate (its k-means at three K and decimation, two predictors
-    // each), then codes the winner; the picture codecs try the rung tdct's estimates rank first
-    // and decimation (their ranking is not on the bar): MPEG-4 codes every candidate whole, JPEG
-    // 12 frames each, then the winner whole.
+    // each), then codes the winner; the picture codecs try the rung tdct's estimates rank first,
+    // the one above it (within 5 % on this bend) and decimation (their ranking is not on the
+    // bar): MPEG-4 codes every candidate whole, JPEG 12 frames each, then the winner whole.
     let codecs = [
         (Codec::Tdct, 8 * frames + frames),
-        (Codec::Mpeg4, 4 * frames),
-        (Codec::Jpeg, 4 * 12 + frames),
+        (Codec::Mpeg4, 6 * frames),
+        (Codec::Jpeg, 6 * 12 + frames),
     ];
     for (codec, expected) in codecs {
         let counter = Counter::default();

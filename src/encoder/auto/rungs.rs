@@ -1,5 +1,6 @@
 //! What tdct's cheap estimates rule out before a picture codec flattens any chart: they rank the
-//! k-means ladder's rungs (`encoder/ladder.rs`) and only the first is tried with pictures;
+//! k-means ladder's rungs (`encoder/ladder.rs`) and only the first is tried with pictures (and the
+//! rung above it when close: the pictures favour more clusters than tdct);
 //! decimation, and the affine predictor on a segmentation, are tried only when the estimates do
 //! not put them far behind; one candidate left is coded at once, with no sampled trial. Each
 //! rung's atlas and sampled picture trials cost a picture codec's choice 1.3–2.0× its CPU; the
@@ -21,6 +22,8 @@ use std::time::Instant;
 pub(super) struct Ranking {
     /// The K whose candidates rank first among the k-means rungs.
     pub(super) k: usize,
+    /// The rung above it, when tdct's estimates put it within [`RUNG_ABOVE_WITHIN`] of it.
+    pub(super) above: Option<usize>,
     /// tdct's estimated bytes of each candidate it coded, in the choice's order (none of a
     /// skipped rung's, nor of a failed trial's).
     pub(super) estimates: Vec<(MotionModel, u64)>,
@@ -35,6 +38,14 @@ pub(super) struct Ranking {
 /// estimates rule out").
 pub(super) const OTHERS_WITHIN: f64 = 1.35;
 
+/// A picture codec also tries the k-means rung above the ranked one when tdct's smallest estimate
+/// on it is at most this many times the ranked rung's: the pictures favour more clusters than tdct
+/// does. At quality 50, skinning on K = 40 against 30 at equal error: CesiumMan JPEG −15 %, AV1
+/// −4.4 % (tdct: +3.1 %); the three.js Horse on 30 against 20, JPEG and AV1 −23 % (tdct: +4.3 %);
+/// RiggedFigure −2 … −3 % (tdct: +4.7 %); pdance at quality 25 on 40 against 30 +1 … +3 % (tdct:
+/// +3.0 %), which the trials then decline (docs/design.md, "Candidates tdct's estimates rule out").
+pub(super) const RUNG_ABOVE_WITHIN: f64 = 1.05;
+
 /// A picture codec drops the affine predictor on a segmentation where tdct's estimate for it is
 /// at least this many times skinning's: on the same choices (168 pairs of affine and skinning
 /// on one segmentation) the pictures judged affine against skinning as tdct did or worse in 150,
@@ -44,9 +55,10 @@ pub(super) const OTHERS_WITHIN: f64 = 1.35;
 pub(super) const AFFINE_BEHIND: f64 = 1.2;
 
 impl Ranking {
-    /// Whether `model` is tried with pictures: on the ranked rung or a segmentation tdct did not
-    /// rank more than [`OTHERS_WITHIN`] times the rung's bytes (or could not rank), and not an
-    /// affine predictor [`AFFINE_BEHIND`] skinning's on its segmentation.
+    /// Whether `model` is tried with pictures: on the ranked rung, the rung above it when close
+    /// ([`RUNG_ABOVE_WITHIN`]), or a segmentation tdct did not rank more than [`OTHERS_WITHIN`]
+    /// times the rung's bytes (or could not rank); and not an affine predictor [`AFFINE_BEHIND`]
+    /// skinning's on its segmentation.
     pub(super) fn keeps(&self, model: &MotionModel) -> bool {
         self.keeps_segmentation((model.segmentation, model.clusters)) && !self.affine_behind(model)
     }
@@ -58,19 +70,21 @@ impl Ranking {
 
     fn keeps_segmentation(&self, (s, k): (Segmentation, usize)) -> bool {
         match s {
-            Segmentation::KMeans => k == self.k,
+            Segmentation::KMeans => k == self.k || Some(k) == self.above,
             _ => self.segmentation_ratio((s, k)).is_none_or(|r| r <= OTHERS_WITHIN),
         }
     }
 
     /// tdct's smallest estimate on `(s, k)` over the ranked rung's.
     fn segmentation_ratio(&self, on: (Segmentation, usize)) -> Option<f64> {
-        let best = |on: (Segmentation, usize)| {
-            let same = self.estimates.iter().filter(|(m, _)| (m.segmentation, m.clusters) == on);
-            same.map(|(_, bytes)| *bytes).min()
-        };
-        let (other, rung) = (best(on)?, best((Segmentation::KMeans, self.k))?);
+        let other = smallest_on(&self.estimates, on)?;
+        let rung = smallest_on(&self.estimates, (Segmentation::KMeans, self.k))?;
         Some(other as f64 / rung.max(1) as f64)
+    }
+
+    /// tdct's smallest estimate on k-means rung `k` over the ranked rung's.
+    fn rung_ratio(&self, k: usize) -> Option<f64> {
+        self.segmentation_ratio((Segmentation::KMeans, k))
     }
 
     /// tdct's estimate of `model` over skinning's on its segmentation, for an affine predictor.
@@ -98,6 +112,13 @@ impl Ranking {
             "k-means at K = {}, the rung tdct's estimates rank first",
             self.k
         );
+        if let Some(above) = self.above {
+            let ratio = self.rung_ratio(above).map_or(String::new(), |r| format!(" {}", relative(r)));
+            text.push_str(&format!(
+                "; K = {above} tried too: tdct's estimates put it{ratio}, within {:.0} %",
+                100.0 * (RUNG_ABOVE_WITHIN - 1.0)
+            ));
+        }
         let mut told: Vec<(Segmentation, usize)> = Vec::new();
         for model in models {
             let on = (model.segmentation, model.clusters);
@@ -128,6 +149,25 @@ impl Ranking {
         let (name, standing) = (on.0.name(), relative(ratio));
         format!("; {name} {verdict}: tdct's estimates put it {standing} that rung")
     }
+}
+
+/// The rung after `k` among `rungs` (the ladder's K, ascending) when tdct's smallest estimate on it
+/// is within [`RUNG_ABOVE_WITHIN`] of `least`, `k`'s; `None` when `k` is the top rung or the one
+/// above was not estimated (its gate skipped it).
+fn rung_above(
+    mut rungs: impl Iterator<Item = usize>,
+    (k, least): (usize, u64),
+    estimates: &[(MotionModel, u64)],
+) -> Option<usize> {
+    let next = rungs.by_ref().skip_while(|&r| r != k).nth(1)?;
+    let bytes = smallest_on(estimates, (Segmentation::KMeans, next))?;
+    (bytes as f64 <= RUNG_ABOVE_WITHIN * least as f64).then_some(next)
+}
+
+/// tdct's smallest estimate among the candidates on `on`.
+fn smallest_on(estimates: &[(MotionModel, u64)], on: (Segmentation, usize)) -> Option<u64> {
+    let same = estimates.iter().filter(|(m, _)| (m.segmentation, m.clusters) == on);
+    same.map(|(_, bytes)| *bytes).min()
 }
 
 /// A ratio of bytes in words: "43.9 % above", "1.0 % below".
@@ -198,7 +238,16 @@ pub(super) fn rank_rungs(
     }
     let seconds = start.elapsed().as_secs_f64();
     clock.stages.push(("candidates by tdct's estimates".into(), seconds));
-    Ok(first.map(|(_, k)| Ranking { k, estimates }))
+    let Some((least, k)) = first else {
+        return Ok(None);
+    };
+    let rungs = segmentations.iter().filter(|(s, _)| *s == Segmentation::KMeans);
+    let above = rung_above(rungs.map(|&(_, r)| r), (k, least), &estimates);
+    Ok(Some(Ranking {
+        k,
+        above,
+        estimates,
+    }))
 }
 
 /// The one candidate tdct's estimates leave a picture codec (of `models`, the choice's):
@@ -288,7 +337,12 @@ mod tests {
             estimates.push((model(PredictorKind::Skinning, segmentation, k), bytes(1.0)));
         }
         let models = estimates.iter().map(|(m, _)| *m).collect();
-        (Ranking { k: 30, estimates }, models)
+        let ranking = Ranking {
+            k: 30,
+            above: None,
+            estimates,
+        };
+        (ranking, models)
     }
 
     fn kept(r: &Ranking, models: &[MotionModel]) -> Vec<String> {
@@ -353,5 +407,42 @@ mod tests {
         let text = r.describe(&models);
         assert!(text.contains("decimation tried: tdct's estimates put it 5.0 % below"), "{text}");
         assert!(!text.contains("affine"), "{text}");
+    }
+
+    #[test]
+    fn the_rung_above_is_kept_when_it_is_close() {
+        let (mut r, models) = ranking(1.0, 2.0);
+        r.k = 20;
+        r.above = Some(30);
+        let kept = kept(&r, &models);
+        assert_eq!(
+            kept,
+            [
+                "affine+kmeans20",
+                "skinning+kmeans20",
+                "affine+kmeans30",
+                "skinning+kmeans30"
+            ]
+        );
+        let text = r.describe(&models);
+        assert!(text.contains("K = 30 tried too: tdct's estimates put it 9.1 % below"), "{text}");
+    }
+
+    #[test]
+    fn the_rung_above_is_the_next_one_up_within_five_per_cent() {
+        // K = 20, 30, 40 at 1000, 1030 and 1100 bytes (skinning; affine more).
+        let at = |k: usize, bytes: u64| {
+            let m = model(PredictorKind::Skinning, Segmentation::KMeans, k);
+            [(m, bytes), (MotionModel { predictor: PredictorKind::Affine, ..m }, 2 * bytes)]
+        };
+        let estimates: Vec<(MotionModel, u64)> =
+            [at(20, 1000), at(30, 1030), at(40, 1100)].concat();
+        let ladder = || [20, 30, 40].into_iter();
+        assert_eq!(rung_above(ladder(), (20, 1000), &estimates), Some(30));
+        // 40 is 6.8 % above 30: too far.
+        assert_eq!(rung_above(ladder(), (30, 1030), &estimates), None);
+        // No rung above the top one; none estimated above (a skipped rung).
+        assert_eq!(rung_above(ladder(), (40, 1100), &estimates), None);
+        assert_eq!(rung_above(ladder(), (20, 1000), &estimates[..2]), None);
     }
 }
