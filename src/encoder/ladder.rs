@@ -1,8 +1,8 @@
 //! The k-means ladder's stop: with `--segmentation auto` tdct tries k-means at K, 1.5 K and 2 K
 //! ([`super::options::kmeans_ladder`]; a picture codec ranks the same rungs by tdct's estimates,
-//! then tries the first with pictures: `encoder/auto/rungs.rs`); a rung is tried only when the
-//! one below it beat the one below that. More clusters fit the motion more closely for more side information, and where
-//! 1.5 K did not pay, 2 K did not either on any of 75 default encodes (15 clips, quality 10 … 90),
+//! then tries the first with pictures, and the one above when close: `encoder/auto/rungs.rs`); a
+//! rung is tried only when the one below it beat the one below that. More clusters fit the motion
+//! more closely for more side information, and where 1.5 K did not pay, 2 K did not either on any of 75 default encodes (15 clips, quality 10 … 90),
 //! while skipping it spared its segmentation and trials in 41 of them (docs/design.md, "First-frame
 //! bits trials and k-means ladder").
 //!

@@ -133,8 +133,8 @@ pub(super) fn choose(
     let segmenter = analysis::Segmenter::new(mesh);
     let segmentations = segmentations(models);
     prepare_kmeans(&segmenter, &segmentations, &mut clock);
-    // A picture codec tries the k-means rung tdct's estimates rank first, and decimation and
-    // the affine predictor unless they rank them far behind.
+    // A picture codec tries the k-means rung tdct's estimates rank first (and the one above when
+    // close), and decimation and the affine predictor unless they rank them far behind.
     let ranked = rank_rungs(&shared, &segmenter, (&segmentations, models), progress, &mut clock)?;
     let narrowed = ranked.as_ref().map(|ranking| ranking.narrow(models));
     let tried = narrowed.as_deref().unwrap_or(models);
@@ -147,8 +147,8 @@ pub(super) fn choose(
     let total = (tried.len() * trial_frames + if estimated { frames } else { 0 }) as u64;
     progress.total(total);
     let atlases: Vec<AtlasCache> = segmentations.iter().map(|_| AtlasCache::default()).collect();
-    // The ladder's stop reads tdct's estimates of each rung (`ladder`; a picture codec has one
-    // rung left, the one `rank_rungs` kept).
+    // The ladder's stop reads tdct's estimates of each rung (`ladder`; a picture codec has the one
+    // or two rungs `rank_rungs` kept, too few for a gate).
     let gates = ladder::gates(&segmentations);
     let jobs = jobs_of(tried, &segmentations, &atlases, &gates);
     let outcomes = ladder::run_jobs(

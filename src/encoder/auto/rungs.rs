@@ -8,11 +8,11 @@
 //! "Candidates tdct's estimates rule out").
 
 use super::{jobs_of, ladder, Candidate, ChoiceReport, Job, Shared};
-use crate::encoder::{code, Analysed, Encoded, Keep};
 use crate::codec::Codec;
-use crate::encoder::{analysis, EncodeOptions, MotionModel, Segmentation, Settings, Stopwatch};
-use crate::motion::PredictorKind;
+use crate::encoder::{analysis, code, Analysed, Encoded, EncodeOptions, Keep};
+use crate::encoder::{MotionModel, Segmentation, Settings, Stopwatch};
 use crate::error::Result;
+use crate::motion::PredictorKind;
 use crate::geometry_image::lattice::AtlasCache;
 use crate::progress::{Progress, Silent};
 use std::sync::atomic::AtomicU64;
@@ -180,11 +180,11 @@ fn relative(ratio: f64) -> String {
 }
 
 /// For a picture codec whose choice climbs the k-means ladder: the K whose candidates tdct's cheap
-/// estimates rank first (the earliest on a tie, the same gate on the rungs), so that only that
-/// rung's charts are flattened and its pictures tried beside decimation's, and every candidate's
-/// estimate. On 8 clips the K with the least AV1 cost at equal error was tdct's first
-/// (docs/design.md, "First-frame bits trials and k-means ladder"). `None` for tdct, or with one
-/// rung.
+/// estimates rank first (the earliest on a tie, the same gate on the rungs), the rung above it
+/// when close, and every candidate's estimate, from which [`Ranking::keeps`] tells which
+/// candidates' charts are flattened and pictures tried. On 8 clips the K with the least AV1 cost
+/// at equal error was tdct's first or (CesiumMan) the one above (docs/design.md, "First-frame
+/// bits trials and k-means ladder"). `None` for tdct, or with one rung.
 pub(super) fn rank_rungs(
     shared: &Shared,
     segmenter: &analysis::Segmenter,
