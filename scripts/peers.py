@@ -456,7 +456,8 @@ def timed(cmd, time_file):
 
 
 def evaluate(binary, original, other):
-    result = subprocess.run([binary, "eval", str(original), str(other), "--json", "--quiet"],
+    # Every frame in full: the bench compares codecs at equal error, so no estimate.
+    result = subprocess.run([binary, "eval", str(original), str(other), "--json", "--quiet", "--every-frame"],
                             capture_output=True, text=True)
     if result.returncode != 0:
         die(f"mcgv-video eval {original} {other} failed:\n{result.stderr}")

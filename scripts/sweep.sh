@@ -133,7 +133,7 @@ for input in "$@"; do
                 label="$codec@$used"
             fi
             read -r dw dc dm < <(measure "$bin" decode "$stream" -o "$tmp/dec.pc2" --force --quiet)
-            m=$("$bin" eval "$input" "$stream" --json --quiet)
+            m=$("$bin" eval "$input" "$stream" --json --quiet --every-frame)
             printf '%s,%s,%s,%d,%.4f,%.6e,%.6e,%.5f,%.6e,%s,%s,%s,%s,%s,%s,%d,%d\n' \
                 "$name" "$label$suffix" "${flag#--} $value" "$(stat -c %s "$stream")" "$(field bpvf "$m")" \
                 "$(field rmse "$m")" "$(field vertex_rmse "$m")" "$(field kg_error "$m")" \

@@ -67,6 +67,9 @@ pub struct TriangleBvh {
     triangles: Vec<PreparedTriangle>,
     /// Settles most hinted queries without the tree (see [`super::grid`]).
     grid: TriangleGrid,
+    /// Whether the grid holds the triangles as they are now (false after a refit, until a query
+    /// needs it: a frame `eval` only bounds may never do).
+    gridded: bool,
     /// The tree, built when a query first needs it: most measures never do.
     tree: Option<Tree>,
     /// Whether the tree's boxes hold the triangles as they are now (false after a refit, until a
@@ -109,11 +112,10 @@ impl TriangleBvh {
             return None;
         }
         let triangles: Vec<PreparedTriangle> = prepared(triangles, positions).collect();
-        let mut grid = TriangleGrid::default();
-        grid.rebuild(&triangles);
         Some(Self {
             triangles,
-            grid,
+            grid: TriangleGrid::default(),
+            gridded: false,
             tree: None,
             fitted: false,
         })
@@ -131,7 +133,7 @@ impl TriangleBvh {
         for (slot, t) in self.triangles.iter_mut().zip(prepared(triangles, positions)) {
             *slot = t;
         }
-        self.grid.rebuild(&self.triangles);
+        self.gridded = false;
         self.fitted = false;
         true
     }
@@ -209,6 +211,10 @@ impl TriangleBvh {
     ) -> Nearest {
         // A near hint bounds the search to a few grid cells.
         let mut found = (best.distance_squared, best.triangle);
+        if !self.gridded {
+            self.grid.rebuild(&self.triangles);
+            self.gridded = true;
+        }
         if self.grid.improve(p, &self.triangles, &mut found) {
             return Nearest {
                 triangle: found.1,

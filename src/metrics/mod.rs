@@ -5,6 +5,7 @@
 //! [`compare`] measures two animations held in memory; [`Comparison`] measures a long one a run of
 //! frames at a time.
 
+mod frame_sampling;
 mod running;
 internal! {
     bvh;
@@ -14,6 +15,7 @@ internal! {
     triangle;
 }
 
+pub use frame_sampling::{FrameSampling, DEFAULT_RELATIVE_ERROR};
 pub use running::Comparison;
 pub use surface::Surface;
 #[cfg(feature = "internals")]
@@ -60,6 +62,9 @@ pub struct Measures {
     pub bpvf: Option<f64>,
     /// Frames compared.
     pub frames: usize,
+    /// Frames whose surface distances were measured in full: all of them unless the comparison
+    /// sampled frames ([`FrameSampling::Converged`]), when `rmse` is an estimate from these.
+    pub surface_frames: usize,
     /// Vertices of the original.
     pub vertices: usize,
     /// The symmetric RMS of each frame, normalised like `rmse` (not in the JSON summary).
@@ -175,9 +180,29 @@ impl VertexSums {
 }
 
 #[cfg(test)]
+/// The triangles of a grid of `n`×`n` vertices numbered row by row, each square cut along the
+/// diagonal from its second corner (`flip`: from its first).
+pub(crate) fn grid_triangles(n: u32, flip: bool) -> Vec<crate::mesh::Triangle> {
+    let mut triangles = Vec::new();
+    for i in 0..n.saturating_sub(1) {
+        for j in 0..n - 1 {
+            let v = i * n + j;
+            if flip {
+                triangles.push([v, v + 1, v + n + 1]);
+                triangles.push([v, v + n + 1, v + n]);
+            } else {
+                triangles.push([v, v + 1, v + n]);
+                triangles.push([v + 1, v + n + 1, v + n]);
+            }
+        }
+    }
+    triangles
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{Point, Triangle};
+    use crate::mesh::Point;
 
     #[test]
     fn the_unit_is_the_first_frames_diagonal_and_never_zero() {
@@ -192,14 +217,7 @@ mod tests {
     /// A bumpy 12×12 grid patch, swaying over `frames` frames.
     fn patch(frames: usize) -> AnimatedMesh {
         let n = 12u32;
-        let mut triangles: Vec<Triangle> = Vec::new();
-        for i in 0..n - 1 {
-            for j in 0..n - 1 {
-                let v = i * n + j;
-                triangles.push([v, v + 1, v + n]);
-                triangles.push([v + 1, v + n + 1, v + n]);
-            }
-        }
+        let triangles = grid_triangles(n, false);
         let frames: Vec<Vec<Point>> = (0..frames)
             .map(|f| {
                 (0..n * n)

@@ -37,7 +37,12 @@ pub struct Sample {
     pub weight: f64,
     /// A face it lies on (the first one that produced it).
     pub face: u32,
+    /// Another face it stands for (across the edge it lies on), or [`NO_FACE`].
+    pub other_face: u32,
 }
+
+/// No other face.
+pub const NO_FACE: u32 = u32::MAX;
 
 fn position(positions: &[Point], i: u32) -> Vec3 {
     positions
@@ -167,10 +172,16 @@ impl SamplingPlan {
                 .iter()
                 .map(|&(f, fraction)| fraction * areas.get(f as usize).copied().unwrap_or(0.0))
                 .sum();
+            let other_face = shares
+                .iter()
+                .map(|&(f, _)| f)
+                .find(|&f| f != s.face)
+                .unwrap_or(NO_FACE);
             Sample {
                 point,
                 weight,
                 face: s.face,
+                other_face,
             }
         }));
     }

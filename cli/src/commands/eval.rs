@@ -5,7 +5,10 @@ use crate::progress;
 use indicatif::ProgressBar;
 use mcgv_video::mesh::Point;
 use mcgv_video::mesh::{AnimatedMesh, FrameSource, ReadOptions};
-use mcgv_video::metrics::{bpvf, same_frame_count, Comparison, Measures, Surface, VertexSums};
+use mcgv_video::metrics::{
+    bpvf, same_frame_count, Comparison, FrameSampling, Measures, Surface, VertexSums,
+    DEFAULT_RELATIVE_ERROR,
+};
 use mcgv_video::Decoder;
 use mcgv_video::{Error, Result};
 use serde::Serialize;
@@ -16,7 +19,14 @@ use std::path::Path;
 /// Runs `eval`.
 pub fn run(args: &EvalArgs, quiet: bool) -> Result<()> {
     let opts: ReadOptions = (&args.input_args).into();
-    let tally = Tally::new(args.fast);
+    let sampling = if args.every_frame {
+        FrameSampling::Every
+    } else {
+        FrameSampling::Converged {
+            relative_error: DEFAULT_RELATIVE_ERROR,
+        }
+    };
+    let tally = Tally::new(args.fast, sampling);
     let result = if is_mcgv(&args.decoded) {
         let mut original = super::open_source(&args.original, &opts, quiet)?;
         let options = super::decode::decode_options(args.bands, args.input_args.max_positions);
@@ -79,7 +89,8 @@ pub struct FastMeasures {
 
 /// What `eval` accumulates, a run of frames at a time: every measure, or the vertex ones.
 enum Tally {
-    Full(Option<Box<Comparison>>),
+    /// Which frames to measure in full, and the comparison once started.
+    Full(FrameSampling, Option<Box<Comparison>>),
     /// Running sums, the original's first-frame diagonal, vertices, frames so far.
     Fast(Option<(VertexSums, f64, usize, usize)>),
 }
@@ -103,18 +114,21 @@ impl Outcome {
 }
 
 impl Tally {
-    fn new(fast: bool) -> Self {
+    fn new(fast: bool, sampling: FrameSampling) -> Self {
         if fast {
             Self::Fast(None)
         } else {
-            Self::Full(None)
+            Self::Full(sampling, None)
         }
     }
 
     /// Sets the comparison up from the two first frames, unless done already.
     fn start(&mut self, original: Surface<'_>, decoded: Surface<'_>) -> Result<()> {
         match self {
-            Self::Full(c @ None) => *c = Some(Box::new(Comparison::new(original, decoded)?)),
+            Self::Full(sampling, c @ None) => {
+                let comparison = Comparison::new(original, decoded)?.with_frame_sampling(*sampling);
+                *c = Some(Box::new(comparison))
+            }
             Self::Fast(f @ None) => {
                 let (v, w) = (original.positions.len(), decoded.positions.len());
                 if v != w {
@@ -139,7 +153,9 @@ impl Tally {
         pb: &ProgressBar,
     ) -> Result<()> {
         match self {
-            Self::Full(Some(c)) => c.add_with_progress(original, decoded, &progress::Reporter(pb)),
+            Self::Full(_, Some(c)) => {
+                c.add_with_progress(original, decoded, &progress::Reporter(pb))
+            }
             Self::Fast(Some((sums, _, _, frames))) => {
                 for (a, b) in original.iter().zip(decoded) {
                     sums.add_frame(a, b);
@@ -154,7 +170,7 @@ impl Tally {
 
     fn finish(self) -> Result<Outcome> {
         match self {
-            Self::Full(Some(c)) => Ok(Outcome::Full((*c).finish())),
+            Self::Full(_, Some(c)) => Ok(Outcome::Full((*c).finish())),
             Self::Fast(Some((sums, diagonal, vertices, frames))) => {
                 let e = sums.errors(vertices as f64 * frames.max(1) as f64);
                 Ok(Outcome::Fast(FastMeasures {
@@ -264,9 +280,17 @@ pub fn report(m: &Measures) -> String {
     s.push_str(&format!("vertices     {}\n", m.vertices));
     s.push_str(&format!("frames       {}\n", m.frames));
     s.push_str(&format!(
-        "RMSE         {:.6e} of the bbox diagonal = {:.4} ×10⁻⁴\n",
+        "RMSE         {:.6e} of the bbox diagonal = {:.4} ×10⁻⁴{}\n",
         m.rmse,
-        m.rmse * 1e4
+        m.rmse * 1e4,
+        if m.surface_frames < m.frames {
+            format!(
+                " (from {} of the {} frames measured in full; --every-frame for all)",
+                m.surface_frames, m.frames
+            )
+        } else {
+            String::new()
+        }
     ));
     s.push_str(&format!(
         "Hausdorff    {:.6e} of the bbox diagonal = {:.4} ×10⁻⁴\n",
@@ -325,6 +349,7 @@ mod tests {
             hausdorff: 2e-3,
             bpvf: Some(3.25),
             frames: 10,
+            surface_frames: 10,
             vertices: 100,
             frame_rmse: vec![],
         };

@@ -122,3 +122,62 @@ fn fast_gives_the_vertex_measures_alone_and_alike() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--fast") && err.contains("36"), "{err}");
 }
+
+/// A 12×12 sheet over `frames` frames, each vertex pushed off by `jitter` (varying by vertex and
+/// frame) as a codec's error would, as an OBJ sequence.
+fn write_jittered_sheet(dir: &Path, frames: usize, jitter: f32) {
+    std::fs::create_dir_all(dir).unwrap_or_else(|e| panic!("{e}"));
+    for f in 0..frames {
+        let mut s = String::new();
+        for v in 0..144 {
+            let (x, y) = ((v % 12) as f32, (v / 12) as f32);
+            let off = |k: f32| jitter * (v as f32 * 12.99 + f as f32 * 0.37 + k).sin();
+            let z = (0.5 * x + 0.3 * f as f32).sin() * y * 0.2;
+            let _ = writeln!(s, "v {} {} {}", x + off(0.0), y + off(1.3), z + off(2.9));
+        }
+        for i in 0..11 {
+            for j in 0..11 {
+                let v = i * 12 + j + 1;
+                let _ = writeln!(
+                    s,
+                    "f {} {} {}\nf {} {} {}",
+                    v,
+                    v + 1,
+                    v + 12,
+                    v + 1,
+                    v + 13,
+                    v + 12
+                );
+            }
+        }
+        std::fs::write(dir.join(format!("frame_{f:03}.obj")), s).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+#[test]
+fn a_long_clip_is_sampled_unless_every_frame_is_asked() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    write_jittered_sheet(&a, 64, 0.0);
+    write_jittered_sheet(&b, 64, 0.02);
+    let (a, b) = (a.to_string_lossy(), b.to_string_lossy());
+    let sampled = json(&eval(&[&a, &b, "--json"]));
+    let every = json(&eval(&[&a, &b, "--json", "--every-frame"]));
+    assert_eq!(number(&every, "surface_frames"), 64.0, "{every}");
+    let measured = number(&sampled, "surface_frames");
+    assert!(measured < 64.0, "{sampled}");
+    let off = number(&sampled, "rmse") / number(&every, "rmse") - 1.0;
+    assert!(off.abs() < 0.01, "{off}: {sampled} {every}");
+    for key in ["hausdorff", "vertex_rmse", "kg_error", "frames"] {
+        assert_eq!(number(&sampled, key), number(&every, key), "{key}");
+    }
+    let text = ok(&eval(&[&a, &b]));
+    assert!(
+        text.contains(&format!(
+            "from {measured} of the 64 frames measured in full"
+        )),
+        "{text}"
+    );
+    let both = eval(&[&a, &b, "--fast", "--every-frame"]);
+    assert!(!both.status.success());
+}
