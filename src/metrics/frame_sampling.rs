@@ -7,8 +7,8 @@
 //! chickenCrossing's tdct stream, 1.5 % spread), so one frame in eight measured in full, at a
 //! pseudo-random place in each block of eight, scales the bounds of the others (see [`estimate`]).
 //! While the estimate's standard error exceeds the tolerance, one frame in four, in two, then
-//! every frame, is measured. The Hausdorff distance stays exact: a bounded frame measures every sample whose
-//! bound exceeds the largest distance found.
+//! every frame, is measured. The Hausdorff distance stays exact: a bounded frame measures every
+//! sample whose bound exceeds the largest distance found.
 
 /// Which frames of a comparison have their surface distances measured in full.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -17,8 +17,8 @@ pub enum FrameSampling {
     Every,
     /// One frame in eight (one per block of eight frames of the animation), then in four, in
     /// two, then every frame, until the estimated RMSE's standard error is at most
-    /// `relative_error` of it; the others are bounded only and their RMS estimated. Runs of fewer than [`MIN_SAMPLED_RUN`] frames,
-    /// and surfaces whose faces do not all pair up, are measured in full.
+    /// `relative_error` of it; the others are bounded only and their RMS estimated. Runs of
+    /// fewer than 32 frames, and surfaces whose faces do not all pair up, are measured in full.
     Converged {
         /// Largest standard error accepted, as a fraction of the estimated RMSE.
         relative_error: f64,
