@@ -317,6 +317,11 @@ struct Estimated {
 }
 
 impl Estimated {
+    /// The segmentation it used, for trials that keep it.
+    fn segmentation(&self) -> (Partition, SegmentationReport) {
+        (self.once.partition.clone(), self.once.segmentation.clone())
+    }
+
     fn code(self, settings: Settings, progress: &dyn Progress) -> Result<Encoded> {
         let analysed = self.once.analysed();
         let (mesh, ff) = (&self.mesh, &self.ff);

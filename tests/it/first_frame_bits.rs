@@ -127,3 +127,38 @@ fn the_trials_are_announced_once_and_picture_codecs_do_not_try() {
     let err = encode(&mesh, &refused).err().expect("refused").to_string();
     assert!(err.contains("first_frame_bits"), "{err}");
 }
+
+#[test]
+fn a_fixed_model_weighs_coarser_precisions_by_their_estimates() {
+    let mesh = crate::common::read_media("CesiumMan.glb");
+    for quality in [5, 90] {
+        // Two segments or more: the first-frame precision is chosen on the analysis clip.
+        let fixed_model = EncodeOptions {
+            predictor: mcgv_video::PredictorKind::Affine.into(),
+            segmentation: mcgv_video::encoder::Segmentation::KMeans.into(),
+            segment_frames: Some(16),
+            ..tdct(quality)
+        };
+        let encoded = encode(&mesh, &fixed_model).expect("encodes");
+        let trials = &encoded.report.first_frame_trials;
+        assert!(trials.len() >= 2 && trials[0].bits == 12, "{trials:?}");
+        // The finest is estimated, not coded whole, unless a coarser one's estimate beats it:
+        // both are then coded whole and compared.
+        assert_eq!(trials[0].estimated, trials[1].estimated, "{trials:?}");
+        // On CesiumMan the 8-bit estimate loses to the 10-bit one: only estimated, not coded.
+        assert!(trials.last().is_some_and(|t| t.estimated), "{trials:?}");
+        let kept = encoded.report.header.first_frame_bits;
+        if trials[1].estimated {
+            assert!(
+                trials[1].bytes >= trials[0].bytes && kept == 12,
+                "{trials:?}"
+            );
+        }
+        let fixed = EncodeOptions {
+            first_frame_bits: Some(kept),
+            ..fixed_model.clone()
+        };
+        let again = encode(&mesh, &fixed).expect("encodes");
+        assert_eq!(again.to_bytes(), encoded.to_bytes(), "quality {quality}");
+    }
+}
