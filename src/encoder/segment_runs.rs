@@ -107,7 +107,9 @@ fn encode_runs(
     mut read: impl FnMut(&[usize], ReadAgain) -> Result<Vec<Vec<Point>>>,
 ) -> Result<Encoded> {
     let analysis = spread_clip(first, frames, length, |list| read(list, ReadAgain::Yes))?;
-    progress.total(frames as u64);
+    // The analysis counts as its clip's frames (see `SegmentedEncoder::start`), then each
+    // segment its own.
+    progress.total((frames + analysis.frame_count()) as u64);
     let mut encoder = SegmentedEncoder::start_reusing(&analysis, opts, length, progress, reuse)?;
     drop(analysis);
     progress.stage("segments");

@@ -22,7 +22,7 @@ use crate::error::{Error, Result};
 use crate::geometry_image::lattice::AtlasCache;
 use crate::mesh::{AnimatedMesh, Point, Triangle};
 use crate::motion::{AffineTrack, Partition, PredictorKind, SkinningWeights};
-use crate::progress::Progress;
+use crate::progress::{Budgeted, Progress};
 use crate::stream::bytes::{ByteReader, ByteWriter};
 use crate::stream::container::{ContainerReader, ContainerWriter, Part, Tag};
 use crate::stream::header::Header;
@@ -227,6 +227,8 @@ fn options_checksum(opts: &EncodeOptions) -> u32 {
 impl SegmentedEncoder {
     /// Makes the choices of an encoding in segments of `length` frames on `analysis`, the clip's
     /// [`super::analysis_frames`] (frame 0 first), with every automatic choice `opts` leaves open.
+    /// Its work counts as `analysis`'s frames on `progress` (whose total it does not tell): a
+    /// caller's total for the whole encoding is the clip's frames plus these.
     pub fn start(
         analysis: &AnimatedMesh,
         opts: &EncodeOptions,
@@ -261,8 +263,9 @@ impl SegmentedEncoder {
         };
         whole.check(analysis)?;
         let keep = super::Keep::SharedParts;
-        let progress = &NoTotal(progress);
-        let mut encoded = super::encode_clip(analysis, &whole, progress, keep, reuse)?;
+        let budgeted = Budgeted::new(progress, analysis.frame_count() as u64);
+        let mut encoded = super::encode_clip(analysis, &whole, &budgeted, keep, reuse)?;
+        budgeted.finish();
         // The segments' atlas is the analysis clip's (same first frame, partition and lattice
         // option; `check_shared` holds them to its lattice part): built once, not twice.
         let atlas = encoded.atlas.take().map_or_else(AtlasCache::default, AtlasCache::holding);
@@ -571,18 +574,5 @@ impl CodedSegment {
             frames: first..first + start.frames as usize,
             parts,
         })
-    }
-}
-
-/// Passes progress on, except the analysis clip's total: the whole clip's is told up front.
-struct NoTotal<'a>(&'a dyn Progress);
-
-impl Progress for NoTotal<'_> {
-    fn stage(&self, name: &str) {
-        self.0.stage(name);
-    }
-
-    fn frames(&self, count: u64) {
-        self.0.frames(count);
     }
 }

@@ -341,3 +341,25 @@ fn damaged_analysis_bytes_are_errors_not_panics() {
         );
     }
 }
+
+#[test]
+fn a_segmented_encodings_progress_ends_at_the_total_it_told() {
+    let mesh = clip(23);
+    let open = |codec| EncodeOptions {
+        predictor: PredictorChoice::Auto,
+        segmentation: SegmentationChoice::auto(),
+        ..options(codec, Some(8))
+    };
+    for opts in [
+        open(Codec::Tdct),
+        open(Codec::Jpeg),
+        options(Codec::Tdct, Some(8)),
+    ] {
+        let counter = crate::common::Counter::default();
+        mcgv_video::encode_with_progress(&mesh, &opts, &counter).expect("encodes");
+        let (total, done) = (counter.total.into_inner(), counter.done.into_inner());
+        // The analysis clip's 8 frames, then the clip's 23 (the automatic choice's trials are
+        // within the analysis' share; until 2026-12-04 they ran the bar past its end).
+        assert_eq!((total, done), (23 + 8, 23 + 8), "{:?}", opts.codec);
+    }
+}
