@@ -122,7 +122,7 @@ impl<'a> Search<'a> {
         // A segmented encoding's analysis clip keeps its shared parts alone, unless precisions
         // are compared by whole streams (a picture codec has no estimate to compare them by).
         let estimated = models.len() > 1 && opts.codec.codec().estimated_trials();
-        let partial = settings.keep == Keep::SharedParts && estimated;
+        let partial = shared && estimated;
         let keep = if partial { Keep::SharedParts } else { Keep::Whole };
         let settings_first = Settings {
             opts: &first,

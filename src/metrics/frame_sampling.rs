@@ -102,9 +102,7 @@ pub fn estimate(frames: &[FrameValue]) -> (Vec<f64>, f64) {
             after.checked_sub(1).and_then(|b| known.get(b)),
             known.get(after),
         ) {
-            (Some(&(a, ra)), Some(&(b, rb))) if b > a => {
-                ra + (rb - ra) * (i - a) as f64 / (b - a) as f64
-            }
+            (Some(&a), Some(&b)) if b.0 > a.0 => between(a, b, i),
             (Some(&(_, r)), _) | (None, Some(&(_, r))) => r,
             (None, None) => 0.0,
         }
@@ -133,19 +131,20 @@ pub fn estimate(frames: &[FrameValue]) -> (Vec<f64>, f64) {
     }
     let residuals: Vec<f64> = known
         .windows(3)
-        .map(|w| {
-            let ((a, ra), (k, rk), (b, rb)) = (w[0], w[1], w[2]);
-            rk - (ra + (rb - ra) * (k - a) as f64 / (b - a) as f64)
-        })
+        .map(|w| w[1].1 - between(w[0], w[2], w[1].0))
         .collect();
-    if residuals.len() < MIN_RESIDUALS
-        || total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
-    {
+    if residuals.len() < MIN_RESIDUALS || total.is_nan() || total <= 0.0 {
         return (values, f64::INFINITY);
     }
     let variance = residuals.iter().map(|r| r * r).sum::<f64>() / residuals.len() as f64;
     let spread: f64 = gaps.iter().map(|g| g * g).sum();
     (values, (spread * variance).sqrt() / total)
+}
+
+/// The ratio at frame `at` on the line through the (frame, ratio) points `a` and `b`
+/// (`a.0 <= at`, `a.0 < b.0`).
+fn between(a: (usize, f64), b: (usize, f64), at: usize) -> f64 {
+    a.1 + (b.1 - a.1) * (at - a.0) as f64 / (b.0 - a.0) as f64
 }
 
 /// Fewest leave-one-out residuals a standard error is computed from.

@@ -114,13 +114,27 @@ impl Comparison {
         decoded: &[Vec<Point>],
         progress: &dyn Progress,
     ) -> Result<Vec<FrameDistance>> {
+        self.each_frame(which, (original, decoded), progress, |a, b, cache| {
+            frame_distance_planned(a, b, &self.plans, cache)
+        })
+    }
+
+    /// `per_frame` of frames `which` of the run, in parallel, each thread keeping its indexes
+    /// from frame to frame; `progress` is told of each frame, an error names its frame.
+    fn each_frame<T: Send>(
+        &self,
+        which: &[usize],
+        (original, decoded): (&[Vec<Point>], &[Vec<Point>]),
+        progress: &dyn Progress,
+        per_frame: impl Fn(Surface<'_>, Surface<'_>, &mut IndexCache) -> Result<T> + Sync,
+    ) -> Result<Vec<T>> {
         let first = self.frames();
         which
             .par_iter()
             .map_init(IndexCache::default, |cache, &i| {
                 let (a, b) = self.surfaces(original, decoded, i)?;
-                frame_distance_planned(a, b, &self.plans, cache)
-                    .map_err(|e| self.in_frame(e, first + i))
+                per_frame(a, b, cache)
+                    .map_err(|e| in_frame(e, first + i))
                     .inspect(|_| progress.frames(1))
             })
             .collect()
@@ -145,13 +159,6 @@ impl Comparison {
                 },
             )),
             _ => Err(Error::Usage(format!("no frame {i} in this run"))),
-        }
-    }
-
-    fn in_frame(&self, e: Error, frame: usize) -> Error {
-        match e {
-            Error::Mesh(m) => Error::Mesh(format!("frame {frame}: {m}")),
-            other => other,
         }
     }
 
@@ -211,20 +218,13 @@ impl Comparison {
         progress: &dyn Progress,
         hausdorff: &mut f64,
     ) -> Result<()> {
-        let first = self.frames();
         let floor = *hausdorff;
         let which: Vec<usize> = (0..frames.len())
             .filter(|&i| frames[i].measured.is_none())
             .collect();
-        let bounds: Vec<_> = which
-            .par_iter()
-            .map_init(IndexCache::default, |cache, &i| {
-                let (a, b) = self.surfaces(original, decoded, i)?;
-                frame_bound_planned(a, b, &self.plans, cache, floor)
-                    .map_err(|e| self.in_frame(e, first + i))
-                    .inspect(|_| progress.frames(1))
-            })
-            .collect::<Result<_>>()?;
+        let bounds = self.each_frame(&which, (original, decoded), progress, |a, b, cache| {
+            frame_bound_planned(a, b, &self.plans, cache, floor)
+        })?;
         for (&i, b) in which.iter().zip(bounds) {
             if let Some(f) = frames.get_mut(i) {
                 f.bound = b.bound_rms;
@@ -257,6 +257,14 @@ impl Comparison {
             vertices: self.vertices,
             frame_rmse,
         }
+    }
+}
+
+/// `e` naming the frame it happened in.
+fn in_frame(e: Error, frame: usize) -> Error {
+    match e {
+        Error::Mesh(m) => Error::Mesh(format!("frame {frame}: {m}")),
+        other => other,
     }
 }
 

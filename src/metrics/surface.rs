@@ -95,11 +95,7 @@ pub fn one_sided(
         sum_sq += s.weight * nearest.distance_squared;
         max_sq = max_sq.max(nearest.distance_squared);
     }
-    if area <= 0.0 || !area.is_finite() {
-        return Err(Error::Mesh(
-            "the surface has zero area, so a distance averaged over it is undefined".into(),
-        ));
-    }
+    averaged_over(area)?;
     Ok(OneSided {
         rms: (sum_sq / area).sqrt(),
         mean: sum / area,
@@ -150,7 +146,6 @@ pub fn one_sided_bound(
     floor: f64,
 ) -> Result<(f64, f64)> {
     let (mut area, mut bound_sq, mut max_sq) = (0.0f64, 0.0f64, floor * floor);
-    let mut found = 0.0f64;
     let mut last = None;
     let mut stack = Vec::new();
     for s in samples {
@@ -164,18 +159,23 @@ pub fn one_sided_bound(
         if hinted.distance_squared > max_sq {
             let nearest = b.nearest_from(s.point, hinted, &mut stack);
             last = Some(nearest.triangle);
-            if nearest.distance_squared > max_sq {
-                max_sq = nearest.distance_squared;
-                found = max_sq;
-            }
+            max_sq = max_sq.max(nearest.distance_squared);
         }
     }
+    averaged_over(area)?;
+    // Only a distance beyond the floor raised the maximum.
+    let found = if max_sq > floor * floor { max_sq } else { 0.0 };
+    Ok(((bound_sq / area).sqrt(), found.sqrt()))
+}
+
+/// Refuses a surface of no area: a distance averaged over it is undefined.
+fn averaged_over(area: f64) -> Result<()> {
     if area <= 0.0 || !area.is_finite() {
         return Err(Error::Mesh(
             "the surface has zero area, so a distance averaged over it is undefined".into(),
         ));
     }
-    Ok(((bound_sq / area).sqrt(), found.sqrt()))
+    Ok(())
 }
 
 fn corners(s: Surface<'_>, face: u32) -> [Vec3; 3] {
@@ -304,6 +304,19 @@ pub fn frame_distance_planned(
     plans: &SurfacePlans,
     cache: &mut IndexCache,
 ) -> Result<FrameDistance> {
+    let (forward, backward) = both_ways(a, b, plans, cache, one_sided)?;
+    Ok(FrameDistance { forward, backward })
+}
+
+/// `one_side(samples of a, a, b's index, same triangles, a's twins)` from the first surface to
+/// the second and back, the samples placed by `plans` and the indexes refitted in `cache`.
+fn both_ways<T>(
+    a: Surface<'_>,
+    b: Surface<'_>,
+    plans: &SurfacePlans,
+    cache: &mut IndexCache,
+    mut one_side: impl FnMut(&[Sample], Surface<'_>, &mut TriangleBvh, bool, Option<&[u32]>) -> Result<T>,
+) -> Result<(T, T)> {
     let same = a.triangles == b.triangles;
     let a_index = refit_or_build(&mut cache.first, a, "first")?;
     let b_index = refit_or_build(&mut cache.second, b, "second")?;
@@ -314,12 +327,12 @@ pub fn frame_distance_planned(
         Some((f, b)) => (Some(f.as_slice()), Some(b.as_slice())),
         None => (None, None),
     };
-    let forward = one_sided(&cache.samples, a, b_index, same, a_twins)?;
+    let forward = one_side(&cache.samples, a, b_index, same, a_twins)?;
     plans
         .second
         .apply(b.triangles, b.positions, &mut cache.samples);
-    let backward = one_sided(&cache.samples, b, a_index, same, b_twins)?;
-    Ok(FrameDistance { forward, backward })
+    let backward = one_side(&cache.samples, b, a_index, same, b_twins)?;
+    Ok((forward, backward))
 }
 
 /// What a frame not measured in full still gives: see [`frame_bound_planned`].
@@ -342,21 +355,9 @@ pub fn frame_bound_planned(
     cache: &mut IndexCache,
     floor: f64,
 ) -> Result<FrameBound> {
-    let same = a.triangles == b.triangles;
-    let a_index = refit_or_build(&mut cache.first, a, "first")?;
-    let b_index = refit_or_build(&mut cache.second, b, "second")?;
-    let (a_twins, b_twins) = match &plans.twins {
-        Some((f, b)) => (Some(f.as_slice()), Some(b.as_slice())),
-        None => (None, None),
-    };
-    plans
-        .first
-        .apply(a.triangles, a.positions, &mut cache.samples);
-    let forward = one_sided_bound(&cache.samples, a, b_index, same, a_twins, floor)?;
-    plans
-        .second
-        .apply(b.triangles, b.positions, &mut cache.samples);
-    let backward = one_sided_bound(&cache.samples, b, a_index, same, b_twins, floor)?;
+    let (forward, backward) = both_ways(a, b, plans, cache, |samples, a, b, same, twins| {
+        one_sided_bound(samples, a, b, same, twins, floor)
+    })?;
     Ok(FrameBound {
         bound_rms: forward.0.max(backward.0),
         max: forward.1.max(backward.1),

@@ -15,6 +15,17 @@ fn number(v: &serde_json::Value, key: &str) -> f64 {
         .unwrap_or_else(|| panic!("no number {key} in {v}"))
 }
 
+/// The faces of an `n`×`n` grid of vertices numbered row by row from 1, two per square.
+fn grid_faces(s: &mut String, n: usize) {
+    for i in 0..n - 1 {
+        for j in 0..n - 1 {
+            let v = i * n + j + 1;
+            let _ = writeln!(s, "f {} {} {}", v, v + 1, v + n);
+            let _ = writeln!(s, "f {} {} {}", v + 1, v + n + 1, v + n);
+        }
+    }
+}
+
 /// A 6×6 grid sheet in the z = `z` plane, `frames` frames swaying in x, as an OBJ sequence.
 fn write_sheet(dir: &Path, frames: usize, z: f32) {
     std::fs::create_dir_all(dir).unwrap_or_else(|e| panic!("{e}"));
@@ -24,13 +35,7 @@ fn write_sheet(dir: &Path, frames: usize, z: f32) {
             let (x, y) = ((v % 6) as f32, (v / 6) as f32);
             let _ = writeln!(s, "v {} {y} {z}", x + 0.1 * f as f32 * y);
         }
-        for i in 0..5 {
-            for j in 0..5 {
-                let v = i * 6 + j + 1;
-                let _ = writeln!(s, "f {} {} {}", v, v + 1, v + 6);
-                let _ = writeln!(s, "f {} {} {}", v + 1, v + 7, v + 6);
-            }
-        }
+        grid_faces(&mut s, 6);
         std::fs::write(dir.join(format!("frame_{f}.obj")), s).unwrap_or_else(|e| panic!("{e}"));
     }
 }
@@ -135,21 +140,7 @@ fn write_jittered_sheet(dir: &Path, frames: usize, jitter: f32) {
             let z = (0.5 * x + 0.3 * f as f32).sin() * y * 0.2;
             let _ = writeln!(s, "v {} {} {}", x + off(0.0), y + off(1.3), z + off(2.9));
         }
-        for i in 0..11 {
-            for j in 0..11 {
-                let v = i * 12 + j + 1;
-                let _ = writeln!(
-                    s,
-                    "f {} {} {}\nf {} {} {}",
-                    v,
-                    v + 1,
-                    v + 12,
-                    v + 1,
-                    v + 13,
-                    v + 12
-                );
-            }
-        }
+        grid_faces(&mut s, 12);
         std::fs::write(dir.join(format!("frame_{f:03}.obj")), s).unwrap_or_else(|e| panic!("{e}"));
     }
 }
