@@ -177,6 +177,9 @@ pub struct EncodeArgs {
     /// hevc, av1: bits a sample of the residual pictures, 10, 12 or auto: 10 below --quality 90,
     /// 12 from 90 (at equal error 12 bits cost more below 90; from 90 as much or less, and they
     /// reach errors 10 bits cannot; docs/design.md, "Sample depth: 12 bits from quality 90").
+    /// With --target-error or --target-max-error, auto is 12 bits also from the quality where
+    /// 10-bit pictures would widen a group's step (the report names each encode's depth;
+    /// docs/design.md, "Budgets").
     #[arg(long, default_value = "auto", value_parser = parse_bit_depth)]
     pub bit_depth: BitDepth,
     /// JPEG's own quality 1..100 for the residual pictures; overrides the one --quality sets.

@@ -19,8 +19,9 @@ use pyo3::types::{PyBytes, PyDict};
 /// The stream never exceeds the budget and lands within 3 % under it when the quality range
 /// allows, in as few full encodes as the search can (usually 2 or 3; ``quality``, default 50,
 /// is where it starts). ``report`` is the command line's ``--json`` ``budget`` object: the
-/// ``quality`` found (between the integers too), ``achieved``, ``limit``, ``within_tolerance``,
-/// ``encodes``, each encode's ``trials`` and the ``model`` the first encode chose. The other
+/// ``quality`` found (between the integers too), HEVC's and AV1's ``bit_depth``, ``achieved``,
+/// ``limit``, ``within_tolerance``, ``encodes``, each encode's ``trials`` and the ``model`` the
+/// first encode chose. The other
 /// arguments are ``encode``'s (no ``step``: the search chooses it); the same options give the
 /// same bytes as ``mcgv-video encode --target-*``.
 #[pyfunction]

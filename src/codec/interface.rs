@@ -56,6 +56,8 @@ pub(crate) struct CodedResiduals {
     pub after_predictor: Vec<Part>,
     /// Seconds per stage of the coder.
     pub stage_seconds: Vec<(String, f64)>,
+    /// Picture codecs: the residuals' spread (`geometry_image::quantise::Chosen::spread`).
+    pub residual_spread: Option<f64>,
 }
 
 #[cfg(feature = "encode")]

@@ -369,6 +369,18 @@ impl CodecConfig {
         }
     }
 
+    /// The bits a sample of the pictures an encoding at `quality` codes: the option's, else the
+    /// automatic depth (`None` for codecs without deeper pictures).
+    pub(crate) fn picture_depth(&self, quality: f64) -> Option<u8> {
+        match self {
+            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(
+                c.bit_depth
+                    .unwrap_or_else(|| pictures::deep::auto_depth_at(quality)),
+            ),
+            _ => None,
+        }
+    }
+
     /// The frames per group of pictures of a video codec (`None` for codecs that code every frame
     /// alone or no pictures).
     pub fn gop_mut(&mut self) -> Option<&mut usize> {

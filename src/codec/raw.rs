@@ -60,6 +60,7 @@ impl ResidualEncoder for Encoder {
         Ok(CodedResiduals {
             setup: setup.into_bytes(),
             atlas: None,
+            residual_spread: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
                 Part::whole(Tag::FRAME_INDEX, index.to_bytes()?),

@@ -7,10 +7,12 @@
 //! can: the first at the caller's quality (with the automatic choices, which the later encodes
 //! keep), then a model of the measure — a size's bytes beyond its fixed parts — against the log
 //! of the target step (a straight line: its slope a prior per measure and codec, then the secant
-//! through the encodes made; JPEG's bytes bent by a prior curvature), then
-//! regula falsi inside the bracket if the model misses. It never returns a stream over the budget
-//! (docs/design.md, "Budgets").
+//! through the encodes made; JPEG's bytes and AV1's error bent by a prior curvature), then
+//! regula falsi inside the bracket if the model misses. Under an error budget HEVC and AV1 at the
+//! automatic depth code 12-bit pictures from the quality where 10-bit ones would widen a group's
+//! step ([`super::budget_depth`]). It never returns a stream over the budget (docs/design.md, "Budgets").
 
+use super::budget_depth::{deeper_at, deeper_from};
 use super::budget_line::{interpolated, jumps, next_log_scale, Bend};
 use super::{
     encode_reusing, encode_with_progress, EncodeOptions, Encoded, PredictorChoice, Reuse,
@@ -111,8 +113,9 @@ impl Budget {
     /// beyond the fixed ones: the temporal DCT's fall about as the step to the power 0.75, the
     /// picture codecs' as its power 1.3 (JPEG) to 1.9 (MPEG-4), each the median of six searches
     /// (AV1's ranged 0.7 to 1.9, JPEG's 1.0 to 2.4); the temporal DCT's error follows the step
-    /// nearly in proportion, and so does AV1's, whose quantiser follows it (0.9-1.1 from quality
-    /// 40 to 75 on pdance and chickenCrossing); HEVC's falls faster, as its power 1.3 (the median
+    /// nearly in proportion, and so does AV1's near quality 50, whose quantiser follows it
+    /// (0.8-1.5 from 50 to 59 on seven clips, at the depth a search codes), steeper above (its
+    /// bend, [`Budget::prior_bend`]); HEVC's falls faster, as its power 1.3 (the median
     /// from quality 50 to 80 on nine clips, 0.94-1.45; 1.0 before 2026-12-04 made 25 encodes of
     /// four searches, 1.3 makes 15); JPEG's as its power 1.1 (0.9-1.6
     /// from quality 50 to 90 on five clips; 0.6, the first guess before, made its second encode
@@ -136,13 +139,25 @@ impl Budget {
     /// The prior curvature of the modelled measure, where one is known: JPEG's bytes below
     /// quality 50, whose slope flattens from about 2 to under 0.5 by quality 12 (pdance,
     /// walking_cat, horse-gallop: 1.3-1.9 per unit of log step) as the pictures near the bytes
-    /// of their block headers; the other codecs' searches did as well or better without one
-    /// (docs/design.md, "Budgets").
+    /// of their block headers; AV1's error above quality 50, whose slope grows from 0.8-1.5
+    /// between qualities 50 and 59 to 1.5-2.2 between 79 and 87 on seven clips (-1.0 per unit of
+    /// log step, followed from the first encode: 140 encodes of 35 simulated searches → 114); the
+    /// other codecs' searches did as
+    /// well or better without one (docs/design.md, "Budgets").
     fn prior_bend(&self, codec: Codec) -> Option<Bend> {
-        (self.is_size() && codec == Codec::Jpeg).then(|| Bend {
-            curvature: 1.5,
-            from: log_scale(50.0),
-        })
+        match (self.is_size(), codec) {
+            (true, Codec::Jpeg) => Some(Bend {
+                curvature: 1.5,
+                over: (log_scale(50.0), f64::INFINITY),
+                from_first: false,
+            }),
+            (false, Codec::Av1) => Some(Bend {
+                curvature: -1.0,
+                over: (f64::NEG_INFINITY, log_scale(50.0)),
+                from_first: true,
+            }),
+            _ => None,
+        }
     }
 
     fn what(&self) -> &'static str {
@@ -165,6 +180,9 @@ pub struct BudgetTrial {
     pub vertex_rmse: Option<f64>,
     /// Its largest vertex error over the diagonal (as `vertex_rmse`).
     pub max_vertex_error: Option<f64>,
+    /// HEVC and AV1: its pictures' bits a sample (12 where 10 would widen a group's step, see
+    /// [`encode_to_budget`]).
+    pub bit_depth: Option<u8>,
 }
 
 /// What a search did and found.
@@ -175,8 +193,14 @@ pub struct BudgetReport {
     /// The bound in the measure's units (bytes, or a fraction of the diagonal).
     pub limit: f64,
     /// The quality of the stream kept (`--quality` with this value codes the same stream when the
-    /// automatic choices are given as `model` says).
+    /// automatic choices are given as `model` says, and HEVC's and AV1's `bit_depth`).
     pub quality: f64,
+    /// HEVC and AV1: the kept stream's bits a sample.
+    pub bit_depth: Option<u8>,
+    /// HEVC and AV1 at the automatic depth under an error budget: the quality from which the
+    /// search codes 12-bit pictures, as 10-bit ones would widen a group's step there (`None`: from
+    /// the automatic depth's 90, a size budget, or a depth the caller gave).
+    pub deeper_from: Option<f64>,
     /// The stream kept's measure (bytes, or its error).
     pub achieved: f64,
     /// Whether it lies within [`Budget::tolerance`] under the limit (else it is the closest under
@@ -227,21 +251,28 @@ pub fn encode_to_budget_with_progress(
     opts.check(mesh)?;
     let mut search = Search::new(mesh, opts, budget);
     let start = opts.fine_quality.unwrap_or(f64::from(opts.quality));
-    let mut first = encode_with_progress(mesh, &at_quality(opts, start), progress)?;
+    let first_opts = at_quality(opts, start);
+    let mut first = encode_with_progress(mesh, &first_opts, progress)?;
     let pinned = pin_choices(opts, &first);
     search.model = model_name(&pinned, first.report.segmentation.clusters);
+    // Error budgets only: where the depth turns, the bytes jump (HEVC's 12-bit pictures cost
+    // 10 % more at the same quality on chickenCrossing), and no size there lands.
+    if let Some(spread) = first.report.residual_spread.filter(|_| !budget.is_size()) {
+        search.deeper_from = deeper_from(mesh, &pinned, spread)?;
+    }
     // The later encodes keep the first one's partition and atlas: no quality changes them.
     let reuse = Reuse::take(&mut first);
-    search.record(first, start)?;
+    search.record(first, start, first_opts.codec.picture_depth(start))?;
     while let Some(quality) = search.next_quality()? {
-        let encoded = encode_reusing(mesh, &at_quality(&pinned, quality), progress, Some(&reuse))?;
-        search.record(encoded, quality)?;
+        let at = search.options_at(&pinned, quality);
+        let encoded = encode_reusing(mesh, &at, progress, Some(&reuse))?;
+        search.record(encoded, quality, at.codec.picture_depth(quality))?;
     }
     search.finish()
 }
 
 /// `opts` at `quality` (between the integers too).
-fn at_quality(opts: &EncodeOptions, quality: f64) -> EncodeOptions {
+pub(super) fn at_quality(opts: &EncodeOptions, quality: f64) -> EncodeOptions {
     let integral = quality.fract() == 0.0;
     EncodeOptions {
         quality: quality.round().clamp(1.0, 100.0) as u8,
@@ -305,6 +336,9 @@ struct Search<'a> {
     trials: Vec<BudgetTrial>,
     best: Option<(Encoded, usize)>,
     model: String,
+    /// HEVC and AV1 at the automatic depth: the quality from which [`Search::options_at`] codes
+    /// 12-bit pictures ([`deeper_from`]).
+    deeper_from: Option<f64>,
 }
 
 impl<'a> Search<'a> {
@@ -319,7 +353,14 @@ impl<'a> Search<'a> {
             trials: Vec::new(),
             best: None,
             model: String::new(),
+            deeper_from: None,
         }
+    }
+
+    /// `pinned` at `quality`, its pictures at 12 bits from [`Self::deeper_from`] on where their
+    /// automatic depth is 10.
+    fn options_at(&self, pinned: &EncodeOptions, quality: f64) -> EncodeOptions {
+        deeper_at(at_quality(pinned, quality), quality, self.deeper_from)
     }
 
     /// Whether `measure` lies at most `window` (a share of the limit) under the limit.
@@ -328,8 +369,9 @@ impl<'a> Search<'a> {
         (floor..=self.limit).contains(&measure)
     }
 
-    /// Measures `encoded` (coded at `quality`) and keeps it if it is the closest under the limit.
-    fn record(&mut self, encoded: Encoded, quality: f64) -> Result<()> {
+    /// Measures `encoded` (coded at `quality`, its pictures at `bit_depth`) and keeps it if it is
+    /// the closest under the limit.
+    fn record(&mut self, encoded: Encoded, quality: f64, bit_depth: Option<u8>) -> Result<()> {
         let errors = if self.budget.is_size() {
             None
         } else {
@@ -340,6 +382,7 @@ impl<'a> Search<'a> {
             bytes: encoded.report.bytes,
             vertex_rmse: errors.map(|e| e.0),
             max_vertex_error: errors.map(|e| e.1),
+            bit_depth,
         };
         let measure = self.budget.measure(&trial);
         if self.budget.is_size() {
@@ -518,6 +561,8 @@ impl<'a> Search<'a> {
             budget: self.budget,
             limit: self.limit,
             quality: self.trials[i].quality,
+            bit_depth: self.trials[i].bit_depth,
+            deeper_from: self.deeper_from,
             achieved,
             within_tolerance: self.landed(achieved, self.budget.tolerance()),
             encodes: self.trials.len(),

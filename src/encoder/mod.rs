@@ -10,6 +10,7 @@
 
 mod attributes;
 mod budget;
+mod budget_depth;
 mod budget_line;
 mod choice_reason;
 mod options;
@@ -447,6 +448,7 @@ fn code(
     clock.stages.extend(coded.stage_seconds.iter().cloned());
     clock.restart();
     let atlas = coded.atlas.take();
+    let residual_spread = coded.residual_spread;
     let stats = atlas.as_ref().map(|(_, a)| a.stats());
     let model = analysed.model;
     let header = header(mesh, settings, model, partition);
@@ -468,6 +470,7 @@ fn code(
         segmentation: analysed.segmentation.clone(),
         choice: None,
         first_frame_trials: Vec::new(),
+        residual_spread,
         segments: 1,
         permutation: ff.permutation.clone(),
     };

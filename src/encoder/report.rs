@@ -39,6 +39,12 @@ pub struct EncodeReport {
     /// tdct with the first frame's precision left open: each precision tried and its stream's
     /// bytes (empty otherwise); the header says which was kept.
     pub first_frame_trials: Vec<FirstFrameTrial>,
+    /// Picture codecs: the widest window a group of pictures' residuals of one coordinate span
+    /// (model units; all but the share sent as corrections), over every group and segment coded
+    /// by this encoding; a pixel step finer than it over a sample's levels widens a group's step,
+    /// and the error stops following the quality. `None` for tdct, and for a segmented encoding
+    /// resumed from a shipped analysis.
+    pub residual_spread: Option<f64>,
     /// Temporal segments the stream is cut into (1: not cut). The choices above were made on the
     /// first segment.
     pub segments: usize,

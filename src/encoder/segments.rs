@@ -47,6 +47,8 @@ pub struct SegmentedEncoder {
     header: Header,
     shared: Vec<Part>,
     segments: Vec<Vec<Part>>,
+    /// Each segment's residual spread, where known ([`EncodeReport::residual_spread`]).
+    spreads: Vec<Option<f64>>,
     frames: usize,
     report: EncodeReport,
     clock: Instant,
@@ -208,6 +210,7 @@ fn resumed_report(header: &Header, analysis: &Analysis, opts: &EncodeOptions) ->
         },
         choice: None,
         first_frame_trials: Vec::new(),
+        residual_spread: None,
         segments: 0,
         permutation: analysis.permutation.clone(),
     }
@@ -366,6 +369,7 @@ impl SegmentedEncoder {
             header,
             shared,
             segments: Vec::new(),
+            spreads: Vec::new(),
             frames: 0,
             report,
             clock,
@@ -408,10 +412,11 @@ impl SegmentedEncoder {
         if let Some(order) = &self.analysis.permutation {
             clip = clip.permuted(order)?;
         }
-        let parts = self.code(&clip, &range, progress)?;
+        let (parts, residual_spread) = self.code(&clip, &range, progress)?;
         Ok(CodedSegment {
             frames: range,
             parts,
+            residual_spread,
         })
     }
 
@@ -425,6 +430,7 @@ impl SegmentedEncoder {
         }
         self.frames = segment.frames.end;
         self.segments.push(segment.parts);
+        self.spreads.push(segment.residual_spread);
         Ok(())
     }
 
@@ -454,6 +460,10 @@ impl SegmentedEncoder {
         report.bytes = container.len();
         report.bpvf = report.bytes as f64 * 8.0 / (header.vertices as f64 * self.frames as f64);
         report.segments = segments;
+        // Known when every segment's is (one shipped as bytes does not carry it).
+        report.residual_spread = (self.spreads.iter())
+            .try_fold(None, |m: Option<f64>, s| s.map(|s| Some(m.map_or(s, |m| m.max(s)))))
+            .flatten();
         report.header = header;
         Ok(Encoded {
             container,
@@ -470,7 +480,7 @@ impl SegmentedEncoder {
         clip: &AnimatedMesh,
         range: &Range<usize>,
         progress: &dyn Progress,
-    ) -> Result<Vec<Part>> {
+    ) -> Result<(Vec<Part>, Option<f64>)> {
         let track = AffineTrack::fit(
             clip.frames(),
             &self.reference,
@@ -492,6 +502,7 @@ impl SegmentedEncoder {
             progress,
             atlas: Some(&self.atlas),
         })?;
+        let spread = coded.residual_spread;
         let (before, after) = coded.into_parts();
         self.check_shared(&before)?;
         let mut parts = vec![
@@ -499,7 +510,7 @@ impl SegmentedEncoder {
             Part::whole(Tag::AFFINE, side_info::encode_affine(&track)?),
         ];
         parts.extend(after);
-        Ok(parts)
+        Ok((parts, spread))
     }
 
     /// A segment's codec must have made the analysis clip's set-up and whole-stream parts (its
@@ -529,6 +540,8 @@ impl SegmentedEncoder {
 pub struct CodedSegment {
     frames: Range<usize>,
     parts: Vec<Part>,
+    /// Its residuals' spread ([`EncodeReport::residual_spread`]); not among its bytes.
+    residual_spread: Option<f64>,
 }
 
 impl CodedSegment {
@@ -573,6 +586,7 @@ impl CodedSegment {
         Ok(Self {
             frames: first..first + start.frames as usize,
             parts,
+            residual_spread: None,
         })
     }
 }

@@ -25,6 +25,8 @@ pub struct GeometryImages {
     pub gop: usize,
     /// Bits a sample of the pictures (8 for JPEG and MPEG-4).
     pub depth: u8,
+    /// The residuals' spread ([`quantise::Chosen::spread`]).
+    pub spread: f64,
 }
 
 impl GeometryImages {
@@ -39,18 +41,19 @@ impl GeometryImages {
         pixel_step: f32,
         padding: padding::PaddingOptions,
     ) -> Result<Self> {
-        let (ranges, corrections) = quantise::choose(residuals, mode, pixel_step, depth);
+        let chosen = quantise::choose(residuals, mode, pixel_step, depth);
         let (w, h) = (usize::from(lattice.0), usize::from(lattice.1));
         let padding = padding::Padder::new(w, h, &atlas.fixed_mask(), &padding)?;
         Ok(Self {
             lattice,
             atlas,
             pixel_step,
-            ranges,
-            corrections,
+            ranges: chosen.ranges,
+            corrections: chosen.corrections,
             padding,
             gop: mode.group(),
             depth,
+            spread: chosen.spread,
         })
     }
 

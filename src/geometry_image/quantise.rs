@@ -131,27 +131,61 @@ impl RangeMode {
 }
 
 /// Every frame's ranges at pixel step `pixel_step` and `depth` bits a sample (`residuals[f][v]`,
-/// grouped as `mode` says), and the corrections of the values they clip.
+/// grouped as `mode` says), the corrections of the values they clip, and the residuals'
+/// [`spread`](Chosen::spread).
 pub fn choose(
     residuals: &[Vec<[f32; 3]>],
     mode: RangeMode,
     pixel_step: f32,
     depth: u8,
-) -> (Vec<FrameRanges>, Corrections) {
+) -> Chosen {
     let n = mode.group();
     let mut ranges = Vec::with_capacity(residuals.len());
+    let mut spread = 0.0f64;
     for group in residuals.chunks(n) {
-        let shared: FrameRanges = std::array::from_fn(|a| group_range(group, a, pixel_step, depth));
+        let shared: FrameRanges = std::array::from_fn(|a| {
+            let (range, width) = group_range(group, a, pixel_step, depth);
+            spread = spread.max(width);
+            range
+        });
         ranges.extend(std::iter::repeat_n(shared, group.len()));
     }
     let corrections = Corrections::of_clipped(residuals, &ranges, pixel_step);
-    (ranges, corrections)
+    Chosen {
+        ranges,
+        corrections,
+        spread,
+    }
+}
+
+/// What [`choose`] found.
+pub struct Chosen {
+    /// Every frame's ranges.
+    pub ranges: Vec<FrameRanges>,
+    /// The residuals the ranges clip.
+    pub corrections: Corrections,
+    /// The widest of the narrowest windows that hold all but [`CORRECTION_SHARE`] of a group's
+    /// values of one coordinate, in model units: below [`unwidened_step`] of it no group's step
+    /// is widened. The depth a sample needs is read off it (a budget search's, `encoder::budget`).
+    pub spread: f64,
+}
+
+/// The finest pixel step at which `depth`-bit samples hold residuals of [`Chosen::spread`]
+/// `spread` without widening any group's step.
+pub fn unwidened_step(spread: f64, depth: u8) -> f64 {
+    spread / span(depth)
 }
 
 /// The step and offset of axis `a` over a group: at the pixel step, centred on the [`span`]-level
 /// window that holds most of the group's values, if it leaves out at most [`CORRECTION_SHARE`] of
 /// them; else centred on the narrowest window that does, at the step that makes it [`span`] levels.
-fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32, depth: u8) -> AxisRange {
+/// With it, the width of that narrowest window in model units.
+fn group_range(
+    group: &[Vec<[f32; 3]>],
+    a: usize,
+    pixel_step: f32,
+    depth: u8,
+) -> (AxisRange, f64) {
     let mut values: Vec<f64> = group
         .iter()
         .flatten()
@@ -159,20 +193,18 @@ fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32, depth: u8) ->
         .filter(|v| v.is_finite())
         .collect();
     if values.is_empty() {
-        return AxisRange::at_depth(pixel_step, 0, depth);
+        return (AxisRange::at_depth(pixel_step, 0, depth), 0.0);
     }
     values.sort_by(f64::total_cmp);
     let n = values.len();
     let keep = n - (n as f64 * CORRECTION_SHARE).floor() as usize;
     let (held, lo, hi) = fullest_window(&values, span(depth));
-    let (lo, hi) = if held >= keep {
-        (lo, hi)
-    } else {
-        (0..=n - keep)
-            .map(|i| (values[i], values[i + keep - 1]))
-            .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
-            .unwrap_or((values[0], values[n - 1]))
-    };
+    let narrowest = (0..=n - keep)
+        .map(|i| (values[i], values[i + keep - 1]))
+        .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+        .unwrap_or((values[0], values[n - 1]));
+    let width = (narrowest.1 - narrowest.0) * f64::from(pixel_step);
+    let (lo, hi) = if held >= keep { (lo, hi) } else { narrowest };
     let scale = ((hi - lo) / span(depth)).max(1.0);
     // f32 rounding must not narrow the step below what the window needs.
     let mut step = (f64::from(pixel_step) * scale) as f32;
@@ -181,7 +213,7 @@ fn group_range(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32, depth: u8) ->
     }
     let mid = 0.5 * (lo + hi) * f64::from(pixel_step) / f64::from(step);
     let offset = mid.round().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
-    AxisRange::at_depth(step, offset, depth)
+    (AxisRange::at_depth(step, offset, depth), width)
 }
 
 /// The window of at most `span` pixel steps that holds most of the sorted `values` (in pixel
@@ -228,17 +260,32 @@ mod tests {
             .map(|i| [(i as f32 / 500.0 - 1.0), 0.0, 0.5])
             .collect();
         frame[3][0] = 50.0;
-        let (ranges, corrections) = choose(&[frame.clone()], RangeMode::PerFrame, step, 8);
+        let Chosen {
+            ranges,
+            corrections,
+            spread,
+        } = choose(&[frame.clone()], RangeMode::PerFrame, step, 8);
         assert_eq!(ranges[0][0].step, step, "{:?}", ranges[0][0]);
+        // x's narrowest window of all but 3 values (1/256 of 1000: the outlier and two at an
+        // end) is 997 of its steps of 0.002 wide; y and z spread nowhere.
+        assert!((spread - 1.994).abs() < 1e-5, "{spread}");
+        assert!(unwidened_step(spread, 8) < f64::from(step));
         assert_eq!(ranges[0][2].offset, 50);
         assert_eq!(corrections.frame(0).len(), 1);
         assert_eq!(corrections.frame(0)[0].vertex, 3);
         // Values over ±300 steps: the step widens to fit them in 254 levels, one outlier aside.
         let wide: Vec<[f32; 3]> = frame.iter().map(|r| [3.0 * r[0], 0.0, 0.0]).collect();
-        let (ranges, corrections) =
-            choose(std::slice::from_ref(&wide), RangeMode::PerFrame, step, 8);
+        let Chosen {
+            ranges,
+            corrections,
+            spread,
+        } = choose(std::slice::from_ref(&wide), RangeMode::PerFrame, step, 8);
         let r = ranges[0][0];
         assert!(r.step > 2.3 * step && r.step < 2.4 * step, "{r:?}");
+        // The widened step is the one that holds the spread, whatever the pixel step asked.
+        assert!((unwidened_step(spread, 8) - f64::from(r.step)).abs() < 1e-6 * spread);
+        let coarse = choose(std::slice::from_ref(&wide), RangeMode::PerFrame, 1.0, 8);
+        assert_eq!(coarse.spread, spread);
         let corrected = corrections.frame(0);
         assert!(corrected.len() <= 3 && corrected.iter().any(|c| c.vertex == 3));
         assert!(wide.iter().skip(4).take(900).all(|v| r.fits(v[0])));
@@ -251,7 +298,7 @@ mod tests {
             vec![[-1.0, 1.5, 2.0]],
             vec![[4.0, 0.0, 0.0]],
         ];
-        let (g, _) = choose(&res, RangeMode::PerGroup(2), 0.25, 8);
+        let g = choose(&res, RangeMode::PerGroup(2), 0.25, 8).ranges;
         assert_eq!(g[0], g[1]);
         assert_eq!(g[0][0].offset, -2);
         assert_eq!(g[2][0].offset, 16);
@@ -269,9 +316,15 @@ mod tests {
         let frame: Vec<[f32; 3]> = (0..1000)
             .map(|i| [i as f32 * 0.006 - 3.0, 0.0, 0.0])
             .collect();
-        let (eight, _) = choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 8);
-        let (ten, corrections) =
-            choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 10);
+        let eight = choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 8).ranges;
+        let Chosen {
+            ranges: ten,
+            corrections,
+            spread,
+        } = choose(std::slice::from_ref(&frame), RangeMode::PerFrame, step, 10);
+        // 10 bits hold the whole ±3 at this step, 8 bits from a step a quarter coarser on.
+        let step64 = f64::from(step);
+        assert!(unwidened_step(spread, 10) < step64 && unwidened_step(spread, 8) > 2.0 * step64);
         assert!(eight[0][0].step > 2.0 * step);
         assert_eq!(ten[0][0].step, step);
         assert!(corrections.is_empty());

@@ -232,7 +232,8 @@ mod tests {
     fn ranges_and_corrections_round_trip_smaller_than_raw() {
         let (residuals, step) = sample();
         for (mode, depth) in [(RangeMode::PerFrame, 8), (RangeMode::PerGroup(8), 10)] {
-            let (ranges, corrections) = choose(&residuals, mode, step, depth);
+            let chosen = choose(&residuals, mode, step, depth);
+            let (ranges, corrections) = (chosen.ranges, chosen.corrections);
             assert!(!corrections.is_empty());
             let bytes = encode_ranges(step, &ranges, &corrections, 300).unwrap();
             let (back_step, back, back_corr) = decode_ranges(&bytes, 40, 300, depth).unwrap();
@@ -246,7 +247,8 @@ mod tests {
     #[test]
     fn damaged_ranges_are_errors() {
         let (residuals, step) = sample();
-        let (ranges, corrections) = choose(&residuals, RangeMode::PerFrame, step, 8);
+        let chosen = choose(&residuals, RangeMode::PerFrame, step, 8);
+        let (ranges, corrections) = (chosen.ranges, chosen.corrections);
         let bytes = encode_ranges(step, &ranges, &corrections, 300).unwrap();
         assert!(decode_ranges(&bytes, 41, 300, 8).is_err());
         assert!(decode_ranges(&bytes, 40, 3, 8).is_err());

@@ -123,6 +123,29 @@ fn av1_lands_under_a_size_and_an_error() {
 }
 
 #[test]
+fn picture_codecs_report_the_spread_their_samples_must_hold() {
+    // What a search reads the depth of HEVC's and AV1's pictures off (`deeper_from`).
+    let mesh = read_media("CesiumMan.glb");
+    let encode = |opts: &EncodeOptions| mcgv_video::encode(&mesh, opts).expect("encodes");
+    assert_eq!(encode(&fixed(Codec::Tdct)).report.residual_spread, None);
+    let whole = encode(&fixed(Codec::Jpeg)).report.residual_spread;
+    let whole = whole.expect("a picture codec's spread");
+    // Residuals spread over a small share of the first frame's diagonal.
+    assert!(whole > 1e-4 * mesh.bbox_diagonal() && whole < 0.1 * mesh.bbox_diagonal());
+    // A segmented encoding's is the widest of its segments'; the first frames' pictures alone
+    // spread less.
+    let segmented = EncodeOptions {
+        segment_frames: Some(16),
+        ..fixed(Codec::Jpeg)
+    };
+    let segmented = encode(&segmented).report.residual_spread;
+    assert!(segmented.is_some_and(|s| s > 0.5 * whole && s < 2.0 * whole));
+    let first_frames = mesh.clip(0..4).expect("four frames");
+    let short = mcgv_video::encode(&first_frames, &fixed(Codec::Jpeg)).expect("encodes");
+    assert!(short.report.residual_spread.is_some_and(|s| s <= whole));
+}
+
+#[test]
 fn the_later_encodes_keep_the_first_ones_partition_and_atlas_and_make_its_streams() {
     // The first encode chooses the model; the later ones reuse its partition and atlas (of the
     // analysis clip when segmented) instead of finding them again. The stream kept is the one a

@@ -503,8 +503,13 @@ fn budget_line(search: &BudgetReport) -> String {
         .iter()
         .map(
             |t| match t.vertex_rmse.filter(|_| !matches!(what, "bytes")) {
-                Some(e) => format!("q{} {} bytes {e:.4e}", t.quality, t.bytes),
-                None => format!("q{} {} bytes", t.quality, t.bytes),
+                Some(e) => format!(
+                    "q{}{} {} bytes {e:.4e}",
+                    t.quality,
+                    depth(t.bit_depth),
+                    t.bytes
+                ),
+                None => format!("q{}{} {} bytes", t.quality, depth(t.bit_depth), t.bytes),
             },
         )
         .collect();
@@ -517,9 +522,10 @@ fn budget_line(search: &BudgetReport) -> String {
         )
     });
     format!(
-        "budget: {what} <= {bound}: quality {} in {} encodes ({}); {kept}{}; model kept from the \
+        "budget: {what} <= {bound}: quality {}{} in {} encodes ({}); {kept}{}; model kept from the \
          first encode: {}",
         search.quality,
+        depth(search.bit_depth),
         search.encodes,
         trials.join(", "),
         if search.within_tolerance {
@@ -529,6 +535,11 @@ fn budget_line(search: &BudgetReport) -> String {
         },
         search.model
     )
+}
+
+/// HEVC's and AV1's bits a sample as a budget line names them (` 12-bit`), nothing for the others.
+fn depth(bit_depth: Option<u8>) -> String {
+    bit_depth.map_or_else(String::new, |d| format!(" {d}-bit"))
 }
 
 /// The candidates' sizes are their trials' (estimated from a sample of frames, or before the

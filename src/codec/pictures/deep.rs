@@ -106,7 +106,7 @@ pub fn auto_depth(quality: u8) -> u8 {
 }
 
 /// [`auto_depth`] at a quality between the integers too.
-fn auto_depth_at(quality: f64) -> u8 {
+pub(crate) fn auto_depth_at(quality: f64) -> u8 {
     if quality >= f64::from(DEEPER_FROM_QUALITY) {
         12
     } else {

@@ -100,6 +100,7 @@ impl ResidualEncoder for Encoder {
         Ok(CodedResiduals {
             setup: vec![SETUP_VERSION],
             atlas: None,
+            residual_spread: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
                 Part::whole(Tag::TDCT_INDEX, index.to_bytes()?),

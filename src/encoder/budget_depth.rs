@@ -1,0 +1,108 @@
+//! An error budget search's sample depth for HEVC and AV1: 12 bits from the quality where
+//! 10-bit pictures would widen a group's step (docs/design.md, "Budgets"). Size budgets keep the
+//! automatic depth: where the depth turns the bytes jump (HEVC chickenCrossing: 229 733 bytes at
+//! quality 50 with 10 bits, 253 240 at 51.02 with 12), so no size there would land.
+
+use super::budget::at_quality;
+use super::EncodeOptions;
+use crate::error::Result;
+use crate::geometry_image::quantise::unwidened_step;
+use crate::mesh::AnimatedMesh;
+
+/// HEVC and AV1 at the automatic depth (`opts`'s `bit_depth` open): the lowest quality (in
+/// hundredths, below the automatic depth's 12 bits) whose 10-bit pixel step is finer than
+/// residuals of `spread` fit in 10-bit samples ([`EncodeReport::residual_spread`]), from which a
+/// search codes 12-bit pictures. There groups' steps widen, the error stops following the
+/// quality (pcow's AV1 vertex RMSE stayed at 1.22e-4 from quality 88.67 to 89.42, then fell to
+/// 4.4e-5 at 12 bits from 90) and no quality near the aim lands; where no group widens, 10 and 12 bits give about the
+/// same error and bytes (docs/design.md, "Budgets"). The lowest such quality, not each
+/// quality's own test: the pixel step is not monotone in the quality (it takes the rest of the
+/// codec's integer quantiser), and a depth that flipped back would make the error jump back.
+/// `None` for other codecs, a depth the caller gave, or residuals 10 bits hold at any quality.
+///
+/// [`EncodeReport::residual_spread`]: super::EncodeReport::residual_spread
+pub(super) fn deeper_from(
+    mesh: &AnimatedMesh,
+    opts: &EncodeOptions,
+    spread: f64,
+) -> Result<Option<f64>> {
+    let mut ten = opts.clone();
+    match ten.codec.bit_depth_mut() {
+        Some(depth @ None) => *depth = Some(10),
+        _ => return Ok(None),
+    }
+    let unwidened = unwidened_step(spread, 10);
+    let diagonal = mesh.bbox_diagonal();
+    let deepest = 100 * u32::from(crate::codec::pictures::deep::DEEPER_FROM_QUALITY);
+    for hundredths in 100..deepest {
+        let quality = f64::from(hundredths) / 100.0;
+        if f64::from(at_quality(&ten, quality).plan(diagonal)?.step) < unwidened {
+            return Ok(Some(quality));
+        }
+    }
+    Ok(None)
+}
+
+/// `opts` (at `quality`) with 12-bit pictures from quality `deeper_from` on, where its depth is
+/// the automatic one: what a search codes ([`deeper_from`]).
+pub(super) fn deeper_at(
+    mut opts: EncodeOptions,
+    quality: f64,
+    deeper_from: Option<f64>,
+) -> EncodeOptions {
+    if deeper_from.is_some_and(|from| quality >= from) {
+        if let Some(depth @ None) = opts.codec.bit_depth_mut() {
+            *depth = Some(12);
+        }
+    }
+    opts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::codec::Codec;
+
+    #[test]
+    fn pictures_are_12_bits_deep_where_10_bit_ones_would_widen_a_group() {
+        let mesh = AnimatedMesh::new(
+            vec![[0, 1, 2]],
+            vec![vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; 2],
+        );
+        let mesh = mesh.expect("a triangle");
+        let av1 = EncodeOptions {
+            codec: Codec::Av1.into(),
+            ..EncodeOptions::default()
+        };
+        let pixel_step = |quality: f64| {
+            let mut opts = at_quality(&av1, quality);
+            *opts.codec.bit_depth_mut().expect("AV1 has a depth") = Some(10);
+            f64::from(opts.plan(mesh.bbox_diagonal()).expect("a plan").step)
+        };
+        // Residuals that 10-bit samples hold at quality 75's pixel step, not beyond.
+        let spread = pixel_step(75.0) / unwidened_step(1.0, 10);
+        let from = deeper_from(&mesh, &av1, spread).expect("plans");
+        let from = from.expect("a quality that widens");
+        assert!((50.0..=75.01).contains(&from), "{from}");
+        assert!(pixel_step(from) < pixel_step(75.0));
+        let depth = |from: Option<f64>, opts: &EncodeOptions, quality| {
+            let opts = deeper_at(at_quality(opts, quality), quality, from);
+            opts.codec.picture_depth(quality)
+        };
+        // From there on, 12 bits, though the pixel step climbs back at a few qualities above.
+        assert_eq!(depth(Some(from), &av1, from - 0.01), Some(10));
+        for quality in [from, from + 0.5, 89.99, 95.0] {
+            assert_eq!(depth(Some(from), &av1, quality), Some(12), "{quality}");
+        }
+        // A depth the caller gave stays, and has no quality to switch at.
+        let mut ten = av1.clone();
+        *ten.codec.bit_depth_mut().expect("AV1 has a depth") = Some(10);
+        assert_eq!(depth(Some(from), &ten, 95.0), Some(10));
+        assert_eq!(deeper_from(&mesh, &ten, spread).ok(), Some(None));
+        // Residuals 10 bits hold at every quality below 90, and tdct, which has no pictures.
+        assert_eq!(deeper_from(&mesh, &av1, 1e-9).ok(), Some(None));
+        let tdct = EncodeOptions::default();
+        assert_eq!(deeper_from(&mesh, &tdct, spread).ok(), Some(None));
+        assert_eq!(depth(Some(from), &tdct, 80.0), None);
+    }
+}
