@@ -3,9 +3,10 @@
 
 The curves are `scripts/budget_curves.sh` CSVs (name,bit depth,quality,vertex RMSE,bytes); a clip's
 error at a quality is interpolated log-linearly between its points in the log of the IJG scale.
-`--switch NAME=Q` says from which quality the search codes 12-bit pictures on that clip (the
-`deeper_from` of its search's `--json` `budget`; 90 without one): points at the other depth are
-left out. The search is `src/encoder/budget.rs` and `budget_line.rs` for an error budget, rewritten
+`--switch NAME=Q` says from which quality 10-bit pictures widen on that clip (90 without one); the
+search codes 12-bit ones from there, but never at or below its first encode's quality 50, which is
+coded at 10 bits (`deeper_from`): points at the other depth are left out. `--from-second` follows
+the bend from the second encode only (as JPEG's). The search is `src/encoder/budget.rs` and `budget_line.rs` for an error budget, rewritten
 here to replay it (first encode at quality 50, aim 1.5 % under the bound, the prior slope and bend
 after one encode, the secant and bend after two, inside a bracket the bent root, the nearest
 secant or regula falsi; the jump stop; qualities in hundredths): keep the two in step.
@@ -50,7 +51,7 @@ def bracket(points, aim):
     return best and best[1:]
 
 
-def next_log_scale(points, aim, prior, bend, top):
+def next_log_scale(points, aim, prior, bend, top, from_first=True):
     """Where the search's model puts the aim; `bend` holds at log scales up to `top`."""
     curvature = lambda a, b: bend if max(a, b) <= top + 1e-12 else 0.0
     found = bracket(points, aim)
@@ -83,7 +84,7 @@ def next_log_scale(points, aim, prior, bend, top):
         slope = math.copysign(min(abs(prior) * 4, max(abs(prior) / 4, abs(s))), prior) if s * prior > 0 else prior
         return last[0] + (aim - last[1]) / slope
     straight = (aim - last[1]) / prior
-    if bend:
+    if bend and from_first:
         a, b, c = 0.5 * bend, prior, last[1] - aim
         disc = b * b - 4 * a * c
         if disc >= 0:
@@ -104,7 +105,7 @@ def jumps(points, aim, prior):
     return 0 < width < 0.04 and abs(above[1] - below[1]) > 3 * abs(prior) * width
 
 
-def search(error, limit, prior, bend):
+def search(error, limit, prior, bend, from_first=True):
     """Encodes made, the error kept, whether it landed within 3 %."""
     aim, top = math.log(limit * 0.985), log_scale(50)
     points, qualities, best, q = [], [], None, 50.0
@@ -118,7 +119,7 @@ def search(error, limit, prior, bend):
             return len(qualities), best, True
         if len(qualities) >= 10 or (best and jumps(points, aim, prior)):
             return len(qualities), best, False
-        u = next_log_scale(points, aim, prior, bend, top)
+        u = next_log_scale(points, aim, prior, bend, top, from_first)
         q = quality_of(min(log_scale(1), max(log_scale(100), u)))
         while q in qualities:
             q = round((q + 0.01) * 100) / 100
@@ -132,7 +133,7 @@ def curves(paths, switch):
         for line in open(path):
             name, depth, q, e, _ = line.strip().split(",")
             q = float(q)
-            wanted = 12 if q >= switch.get(name, 90.0) else 10
+            wanted = 12 if q >= max(switch.get(name, 90.0), 50.01) else 10
             if depth == "auto" or int(depth) == wanted:
                 points[name].append((log_scale(q), math.log(float(e))))
 
@@ -155,6 +156,7 @@ def main():
     parser.add_argument("--switch", nargs="*", default=[], metavar="NAME=Q")
     parser.add_argument("--limits", default="3e-4,2e-4,1.5e-4,1e-4,7e-5")
     parser.add_argument("--try", dest="tries", nargs="+", default=["1.0,0"], metavar="PRIOR,BEND")
+    parser.add_argument("--from-second", action="store_true")
     args = parser.parse_args()
     switch = {k: float(v) for k, v in (s.split("=") for s in args.switch)}
     errors = curves(args.curves, switch)
@@ -164,7 +166,7 @@ def main():
         total, missed, over = 0, 0, []
         for name, error in errors.items():
             for limit in limits:
-                encodes, _, landed = search(error, limit, prior, bend)
+                encodes, _, landed = search(error, limit, prior, bend, not args.from_second)
                 total += encodes
                 missed += not landed
                 if encodes > 3 or not landed:

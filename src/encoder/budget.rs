@@ -2,24 +2,24 @@
 //!
 //! Users budget in bytes ("this must fit in 200 KB") or in error ("no vertex may move visibly"),
 //! not in a quality whose error differs per codec and clip. [`encode_to_budget`] searches the
-//! quality — between the integers too ([`EncodeOptions::fine_quality`]) — whose stream stays
-//! within the budget and lands within [`Budget::tolerance`] of it, in as few full encodes as it
-//! can: the first at the caller's quality (with the automatic choices, which the later encodes
-//! keep), then a model of the measure — a size's bytes beyond its fixed parts — against the log
-//! of the target step (a straight line: its slope a prior per measure and codec, then the secant
-//! through the encodes made; JPEG's bytes and AV1's error bent by a prior curvature), then
-//! regula falsi inside the bracket if the model misses. Under an error budget HEVC and AV1 at the
-//! automatic depth code 12-bit pictures from the quality where 10-bit ones would widen a group's
-//! step ([`super::budget_depth`]). It never returns a stream over the budget (docs/design.md, "Budgets").
+//! quality — between the integers too ([`EncodeOptions::fine_quality`]) — whose stream stays within
+//! the budget and lands within [`Budget::tolerance`] of it, in as few full encodes as it can: the
+//! first at the caller's quality (with the automatic choices, which the later encodes keep), then a
+//! model of the measure — a size's bytes beyond its fixed parts — against the log of the target
+//! step (a straight line: its slope a prior per measure and codec, then the secant through the
+//! encodes made; JPEG's bytes and AV1's error bent by a prior curvature), then regula falsi inside
+//! the bracket if the model misses. Under an error budget HEVC and AV1 at the automatic depth code
+//! 12-bit pictures from the quality where 10-bit ones would widen a group's step
+//! ([`super::budget_depth`]). It never returns a stream over the budget (docs/design.md,
+//! "Budgets").
 
 use super::budget_depth::{deeper_at, deeper_from};
-use super::budget_line::{interpolated, jumps, next_log_scale, Bend};
+use super::budget_line::{interpolated, jumps, log_scale, next_log_scale, quality_of, Bend};
 use super::{
     encode_reusing, encode_with_progress, EncodeOptions, Encoded, PredictorChoice, Reuse,
     SegmentationChoice,
 };
 use crate::codec::Codec;
-use crate::codec::{fine_scale_percent, ijg_scale_percent};
 use crate::error::{Error, Result};
 use crate::mesh::AnimatedMesh;
 use crate::progress::{Progress, Silent};
@@ -113,13 +113,13 @@ impl Budget {
     /// beyond the fixed ones: the temporal DCT's fall about as the step to the power 0.75, the
     /// picture codecs' as its power 1.3 (JPEG) to 1.9 (MPEG-4), each the median of six searches
     /// (AV1's ranged 0.7 to 1.9, JPEG's 1.0 to 2.4); the temporal DCT's error follows the step
-    /// nearly in proportion, and so does AV1's near quality 50, whose quantiser follows it
-    /// (0.8-1.5 from 50 to 59 on seven clips, at the depth a search codes), steeper above (its
-    /// bend, [`Budget::prior_bend`]); HEVC's falls faster, as its power 1.5 (the median from
-    /// quality 50 to 80 on seven clips at the depth a search codes, 1.03-1.81: 12-bit pictures
-    /// where 10-bit ones would widen steepen it; 1.3 before 2026-12-05, the median at 10 bits,
-    /// made 51 encodes of 14 searches, 1.5 makes 48; 1.0 before 2026-12-04); JPEG's as its power 1.1 (0.9-1.6
-    /// from quality 50 to 90 on five clips; 0.6, the first guess before, made its second encode
+    /// nearly in proportion, and so does AV1's near quality 50, whose quantiser follows it (0.8-1.5
+    /// from 50 to 59 on seven clips, at the depth a search codes), steeper above (its bend,
+    /// [`Budget::prior_bend`]); HEVC's falls faster, as its power 1.5 (the median from quality 50
+    /// to 80 on seven clips at the depth a search codes, 1.03-1.81: 12-bit pictures where 10-bit
+    /// ones would widen steepen it; 1.3 before 2026-12-05, the median at 10 bits, made 51 encodes
+    /// of 14 searches, 1.5 makes 48; 1.0 before 2026-12-04); JPEG's as its power 1.1 (0.9-1.6 from
+    /// quality 50 to 90 on five clips; 0.6, the first guess before, made its second encode
     /// overshoot), MPEG-4's, whose 8-bit range flattens it from 90, 0.6 (docs/design.md,
     /// "Budgets").
     fn prior_slope(&self, codec: Codec) -> f64 {
@@ -137,14 +137,13 @@ impl Budget {
         }
     }
 
-    /// The prior curvature of the modelled measure, where one is known: JPEG's bytes below
-    /// quality 50, whose slope flattens from about 2 to under 0.5 by quality 12 (pdance,
-    /// walking_cat, horse-gallop: 1.3-1.9 per unit of log step) as the pictures near the bytes
-    /// of their block headers; AV1's error above quality 50, whose slope grows from 0.8-1.5
-    /// between qualities 50 and 59 to 1.5-2.2 between 79 and 87 on seven clips (-1.0 per unit of
-    /// log step, followed from the first encode: 140 encodes of 35 simulated searches → 114); the
-    /// other codecs' searches did as
-    /// well or better without one (docs/design.md, "Budgets").
+    /// The prior curvature of the modelled measure, where one is known: JPEG's bytes below quality
+    /// 50, whose slope flattens from about 2 to under 0.5 by quality 12 (pdance, walking_cat,
+    /// horse-gallop: 1.3-1.9 per unit of log step) as the pictures near the bytes of their block
+    /// headers; AV1's error above quality 50, whose slope grows from 0.8-1.5 between qualities 50
+    /// and 59 to 1.5-2.2 between 79 and 87 on seven clips (-1.0 per unit of log step, followed from
+    /// the first encode: 143 encodes of 35 simulated searches → 116); the other codecs' searches
+    /// did as well or better without one (docs/design.md, "Budgets").
     fn prior_bend(&self, codec: Codec) -> Option<Bend> {
         match (self.is_size(), codec) {
             (true, Codec::Jpeg) => Some(Bend {
@@ -259,7 +258,7 @@ pub fn encode_to_budget_with_progress(
     // Error budgets only: where the depth turns, the bytes jump (HEVC's 12-bit pictures cost
     // 10 % more at the same quality on chickenCrossing), and no size there lands.
     if let Some(spread) = first.report.residual_spread.filter(|_| !budget.is_size()) {
-        search.deeper_from = deeper_from(mesh, &pinned, spread)?;
+        search.deeper_from = deeper_from(mesh, &pinned, spread, start);
     }
     // The later encodes keep the first one's partition and atlas: no quality changes them.
     let reuse = Reuse::take(&mut first);
@@ -303,22 +302,6 @@ fn model_name(pinned: &EncodeOptions, clusters: usize) -> String {
         "{name}, K {clusters}, first frame {} bits",
         pinned.first_frame_bits_or_default()
     )
-}
-
-/// The log of the target step's scale at a quality: what the search's model is linear in.
-fn log_scale(quality: f64) -> f64 {
-    fine_scale_percent(quality).ln()
-}
-
-/// The quality (rounded to hundredths, so that a report's figure codes the same stream) whose
-/// log scale is `u`, within 1..=100.
-fn quality_of(u: f64) -> f64 {
-    let scale = |q: u8| f64::from(ijg_scale_percent(q).max(1)).ln();
-    let q = (1..100u8).find(|&q| scale(q + 1) <= u).unwrap_or(99);
-    let (a, b) = (scale(q), scale(q + 1));
-    let t = if a > b { (a - u) / (a - b) } else { 0.0 };
-    let x = f64::from(q) + t.clamp(0.0, 1.0);
-    ((x * 100.0).round() / 100.0).clamp(1.0, 100.0)
 }
 
 /// The state of one search: every encode's measure, and the best stream within the budget.

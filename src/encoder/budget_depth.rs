@@ -5,42 +5,46 @@
 
 use super::budget::at_quality;
 use super::EncodeOptions;
-use crate::error::Result;
 use crate::geometry_image::quantise::unwidened_step;
 use crate::mesh::AnimatedMesh;
 
 /// HEVC and AV1 at the automatic depth (`opts`'s `bit_depth` open): the lowest quality (in
-/// hundredths, below the automatic depth's 12 bits) whose 10-bit pixel step is finer than
-/// residuals of `spread` fit in 10-bit samples ([`EncodeReport::residual_spread`]), from which a
-/// search codes 12-bit pictures. There groups' steps widen, the error stops following the
-/// quality (pcow's AV1 vertex RMSE stayed at 1.22e-4 from quality 88.67 to 89.42, then fell to
-/// 4.4e-5 at 12 bits from 90) and no quality near the aim lands; where no group widens, 10 and 12 bits give about the
-/// same error and bytes (docs/design.md, "Budgets"). The lowest such quality, not each
-/// quality's own test: the pixel step is not monotone in the quality (it takes the rest of the
-/// codec's integer quantiser), and a depth that flipped back would make the error jump back.
-/// `None` for other codecs, a depth the caller gave, or residuals 10 bits hold at any quality.
+/// hundredths, below the automatic depth's 12 bits) whose 10-bit pixel step is finer than residuals
+/// of `spread` fit in 10-bit samples ([`EncodeReport::residual_spread`]), from which a search whose
+/// first encode was at quality `start` codes 12-bit pictures — never at or below `start` (that
+/// encode was coded at 10 bits: a switch below it would flip back there). There groups' steps
+/// widen, the error stops following the quality (pcow's AV1 vertex RMSE stayed at 1.22e-4 from
+/// quality 88.67 to 89.42, then fell to 4.4e-5 at 12 bits from 90) and no quality near the aim
+/// lands; where no group widens, 10 and 12 bits give about the same error and bytes
+/// (docs/design.md, "Budgets"). The lowest such quality, not each quality's own test: the pixel
+/// step is not monotone in the quality (it takes the rest of the codec's integer quantiser), and a
+/// depth that flipped back would make the error jump back. `None` for other codecs, a depth the
+/// caller gave, or residuals 10 bits hold at any quality.
 ///
 /// [`EncodeReport::residual_spread`]: super::EncodeReport::residual_spread
 pub(super) fn deeper_from(
     mesh: &AnimatedMesh,
     opts: &EncodeOptions,
     spread: f64,
-) -> Result<Option<f64>> {
+    start: f64,
+) -> Option<f64> {
     let mut ten = opts.clone();
     match ten.codec.bit_depth_mut() {
         Some(depth @ None) => *depth = Some(10),
-        _ => return Ok(None),
+        _ => return None,
     }
     let unwidened = unwidened_step(spread, 10);
     let diagonal = mesh.bbox_diagonal();
+    let above_start = (start * 100.0).floor() as u32 + 1;
     let deepest = 100 * u32::from(crate::codec::pictures::deep::DEEPER_FROM_QUALITY);
-    for hundredths in 100..deepest {
+    let widens = |hundredths: u32| {
         let quality = f64::from(hundredths) / 100.0;
-        if f64::from(at_quality(&ten, quality).plan(diagonal)?.step) < unwidened {
-            return Ok(Some(quality));
-        }
-    }
-    Ok(None)
+        // A quality without a plan (a step too fine for the diagonal) is left to its encode.
+        let plan = at_quality(&ten, quality).plan(diagonal).ok();
+        plan.is_some_and(|p| f64::from(p.step) < unwidened)
+    };
+    let from = (100..deepest).find(|&h| widens(h))?;
+    Some(f64::from(from.max(above_start)) / 100.0).filter(|&q| q < f64::from(deepest) / 100.0)
 }
 
 /// `opts` (at `quality`) with 12-bit pictures from quality `deeper_from` on, where its depth is
@@ -81,8 +85,7 @@ mod tests {
         };
         // Residuals that 10-bit samples hold at quality 75's pixel step, not beyond.
         let spread = pixel_step(75.0) / unwidened_step(1.0, 10);
-        let from = deeper_from(&mesh, &av1, spread).expect("plans");
-        let from = from.expect("a quality that widens");
+        let from = deeper_from(&mesh, &av1, spread, 50.0).expect("a quality that widens");
         assert!((50.0..=75.01).contains(&from), "{from}");
         assert!(pixel_step(from) < pixel_step(75.0));
         let depth = |from: Option<f64>, opts: &EncodeOptions, quality| {
@@ -98,11 +101,23 @@ mod tests {
         let mut ten = av1.clone();
         *ten.codec.bit_depth_mut().expect("AV1 has a depth") = Some(10);
         assert_eq!(depth(Some(from), &ten, 95.0), Some(10));
-        assert_eq!(deeper_from(&mesh, &ten, spread).ok(), Some(None));
+        assert_eq!(deeper_from(&mesh, &ten, spread, 50.0), None);
         // Residuals 10 bits hold at every quality below 90, and tdct, which has no pictures.
-        assert_eq!(deeper_from(&mesh, &av1, 1e-9).ok(), Some(None));
+        assert_eq!(deeper_from(&mesh, &av1, 1e-9, 50.0), None);
         let tdct = EncodeOptions::default();
-        assert_eq!(deeper_from(&mesh, &tdct, spread).ok(), Some(None));
+        assert_eq!(deeper_from(&mesh, &tdct, spread, 50.0), None);
         assert_eq!(depth(Some(from), &tdct, 80.0), None);
+        // A search that started above the quality where 10 bits widen coded its first encode at
+        // 10 bits: the depth turns just above it, never below (it would flip back at the start);
+        // one that started below keeps the lowest such quality, and one that started at 90 or
+        // more, at 12 bits, has nothing to turn.
+        assert_eq!(deeper_from(&mesh, &av1, spread, 80.0), Some(80.01));
+        assert_eq!(
+            deeper_from(&mesh, &av1, spread, 62.5),
+            Some(from.max(62.51))
+        );
+        assert_eq!(deeper_from(&mesh, &av1, spread, 30.0), Some(from));
+        assert_eq!(deeper_from(&mesh, &av1, spread, 90.0), None);
+        assert_eq!(deeper_from(&mesh, &av1, spread, 89.995), None);
     }
 }

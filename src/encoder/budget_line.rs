@@ -4,6 +4,24 @@
 //! the codec's prior curvature where it has one), and inside a bracket that curve through its two
 //! ends, the secant nearest the aim, or regula falsi (docs/design.md, "Budgets").
 
+use crate::codec::{fine_scale_percent, ijg_scale_percent};
+
+/// The log of the target step's scale at a quality: what the search's model is linear in.
+pub(super) fn log_scale(quality: f64) -> f64 {
+    fine_scale_percent(quality).ln()
+}
+
+/// The quality (rounded to hundredths, so that a report's figure codes the same stream) whose
+/// log scale is `u`, within 1..=100.
+pub(super) fn quality_of(u: f64) -> f64 {
+    let scale = |q: u8| f64::from(ijg_scale_percent(q).max(1)).ln();
+    let q = (1..100u8).find(|&q| scale(q + 1) <= u).unwrap_or(99);
+    let (a, b) = (scale(q), scale(q + 1));
+    let t = if a > b { (a - u) / (a - b) } else { 0.0 };
+    let x = f64::from(q) + t.clamp(0.0, 1.0);
+    ((x * 100.0).round() / 100.0).clamp(1.0, 100.0)
+}
+
 /// A codec's prior curvature of the modelled measure: its second derivative against the log
 /// step over a range of log steps (JPEG's bytes flatten below quality 50 as its pictures near
 /// their floor of block headers; AV1's error falls faster and faster above quality 50).
@@ -32,17 +50,15 @@ impl Bend {
         let straight = (aim - p.1) / prior;
         let (a, b, c) = (0.5 * self.curvature, prior, p.1 - aim);
         let disc = b * b - 4.0 * a * c;
-        let d = if a == 0.0 {
-            straight
-        } else {
-            let roots = [
-                (-b + disc.sqrt()) / (2.0 * a),
-                (-b - disc.sqrt()) / (2.0 * a),
-            ];
-            (roots.into_iter())
-                .filter(|d| d.is_finite() && d * straight > 0.0)
-                .min_by(|x, y| x.abs().total_cmp(&y.abs()))?
-        };
+        // A curvature of 0 (roots of 0/0 and ±∞) or a parabola that never meets the aim (a
+        // negative discriminant's NaN roots) has no bent step.
+        let roots = [
+            (-b + disc.sqrt()) / (2.0 * a),
+            (-b - disc.sqrt()) / (2.0 * a),
+        ];
+        let d = (roots.into_iter())
+            .filter(|d| d.is_finite() && d * straight > 0.0)
+            .min_by(|x, y| x.abs().total_cmp(&y.abs()))?;
         (Bend::between(Some(self), p.0, p.0 + d) != 0.0).then_some(p.0 + d)
     }
 }

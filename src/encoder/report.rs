@@ -43,7 +43,7 @@ pub struct EncodeReport {
     /// (model units; all but the share sent as corrections), over every group and segment coded
     /// by this encoding; a pixel step finer than it over a sample's levels widens a group's step,
     /// and the error stops following the quality. `None` for tdct, and for a segmented encoding
-    /// resumed from a shipped analysis.
+    /// one of whose segments came in as bytes ([`super::CodedSegment::from_bytes`]).
     pub residual_spread: Option<f64>,
     /// Temporal segments the stream is cut into (1: not cut). The choices above were made on the
     /// first segment.
