@@ -373,10 +373,7 @@ impl CodecConfig {
     /// automatic depth (`None` for codecs without deeper pictures).
     pub(crate) fn picture_depth(&self, quality: f64) -> Option<u8> {
         match self {
-            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(
-                c.bit_depth
-                    .unwrap_or_else(|| pictures::deep::auto_depth_at(quality)),
-            ),
+            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(c.depth_at(quality)),
             _ => None,
         }
     }

@@ -461,9 +461,8 @@ impl SegmentedEncoder {
         report.bpvf = report.bytes as f64 * 8.0 / (header.vertices as f64 * self.frames as f64);
         report.segments = segments;
         // Known when every segment's is (one shipped as bytes does not carry it).
-        report.residual_spread = (self.spreads.iter())
-            .try_fold(None, |m: Option<f64>, s| s.map(|s| Some(m.map_or(s, |m| m.max(s)))))
-            .flatten();
+        let spreads: Option<Vec<f64>> = self.spreads.iter().copied().collect();
+        report.residual_spread = spreads.and_then(|s| s.into_iter().reduce(f64::max));
         report.header = header;
         Ok(Encoded {
             container,

@@ -64,6 +64,12 @@ impl DeepConfig {
         self.pictures.check(codec)
     }
 
+    /// The bits a sample of an encoding at `quality` (between the integers too): `bit_depth`,
+    /// else [`auto_depth`]'s.
+    pub(crate) fn depth_at(&self, quality: f64) -> u8 {
+        self.bit_depth.unwrap_or_else(|| auto_depth_at(quality))
+    }
+
     /// The plan of `rate` for `codec` on a first frame of bounding-box diagonal `diagonal`: the
     /// depth ([`auto_depth`] unless given), `law`'s pixel step and quantiser at that depth, ranges
     /// per group, [`deep_padding`], and the codec's `affine_precision` unless asked otherwise.
@@ -74,9 +80,7 @@ impl DeepConfig {
         rate: &Rate,
         diagonal: f64,
     ) -> Result<RatePlan> {
-        let depth = self.bit_depth.unwrap_or_else(|| {
-            auto_depth_at(rate.level())
-        });
+        let depth = self.depth_at(rate.level());
         let law = law(rate.scale_percent(), depth);
         let resolved = Resolved {
             codec,
@@ -106,7 +110,7 @@ pub fn auto_depth(quality: u8) -> u8 {
 }
 
 /// [`auto_depth`] at a quality between the integers too.
-pub(crate) fn auto_depth_at(quality: f64) -> u8 {
+fn auto_depth_at(quality: f64) -> u8 {
     if quality >= f64::from(DEEPER_FROM_QUALITY) {
         12
     } else {
