@@ -4,6 +4,7 @@
 use mcgv_video::codec::tdct::coefficients::{forward, quantise, BandCoder, Rounding, DEAD_ZONE};
 use mcgv_video::codec::tdct::spatial::{Neighbourhood, Spatial};
 use mcgv_video::encoder::analysis::{self, Segmenter};
+use mcgv_video::encoder::weights_rd::WeightPlan;
 use mcgv_video::encoder::{analysis_frames, EncodeOptions};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::{read_animation, AnimatedMesh, ReadOptions};
@@ -99,6 +100,7 @@ fn main() {
         };
         let plan = opts.plan(mesh.bbox_diagonal()).unwrap();
         let step = f64::from(plan.step);
+        let weights = WeightPlan::new(16, plan.affine_precision, plan.codec);
         let ff = first_frame::encode(
             mesh.frame(0),
             mesh.triangles(),
@@ -121,9 +123,15 @@ fn main() {
             let t0 = Instant::now();
             let track =
                 analysis::fit_track(&mesh, reference, &partition, plan.affine_step).unwrap();
-            let pred =
-                analysis::predict_on(&mesh, reference, &partition, 16, model.predictor, track)
-                    .unwrap();
+            let pred = analysis::predict_on(
+                &mesh,
+                reference,
+                &partition,
+                weights,
+                model.predictor,
+                track,
+            )
+            .unwrap();
             let t_pred = t0.elapsed().as_secs_f64();
             let mut side = side_info::encode_partition(
                 partition.labels(),

@@ -3,6 +3,7 @@
 //! redoes it on a stream's own partition to show the images the encoder coded.
 
 use super::options::{EncodeOptions, Segmentation};
+use super::weights_rd::{self, WeightPlan};
 use crate::error::{Error, Result};
 use crate::first_frame::{self, EncodedFirstFrame, FirstFrameOptions};
 use crate::mesh::{AnimatedMesh, Point};
@@ -184,18 +185,18 @@ impl<'a> Segmenter<'a> {
     }
 }
 
-/// The quantised predictor `kind` (affine track at base step `affine_step`, skinning weights of
-/// `weight_bits`) and every frame's residuals against it, as the decoder will rebuild them:
+/// The quantised predictor `kind` (affine track at base step `affine_step`, skinning weights as
+/// `weights` plans them) and every frame's residuals against it, as the decoder will rebuild them:
 /// closed loop.
 pub fn predict(
     mesh: &AnimatedMesh,
     reference: &[Point],
     partition: &Partition,
-    (affine_step, weight_bits): (f64, u8),
+    (affine_step, weights): (f64, WeightPlan),
     kind: PredictorKind,
 ) -> Result<Prediction> {
     let track = fit_track(mesh, reference, partition, affine_step)?;
-    predict_on(mesh, reference, partition, weight_bits, kind, track)
+    predict_on(mesh, reference, partition, weights, kind, track)
 }
 
 /// The quantised affine track every predictor builds on (skinning blends its maps), at base step
@@ -210,25 +211,19 @@ pub fn fit_track(
 }
 
 /// [`predict`] on an affine track already fitted to `partition` ([`fit_track`]), skinning weights
-/// of `weight_bits`.
+/// as `weights` plans them.
 pub fn predict_on(
     mesh: &AnimatedMesh,
     reference: &[Point],
     partition: &Partition,
-    weight_bits: u8,
+    weights: WeightPlan,
     kind: PredictorKind,
     track: AffineTrack,
 ) -> Result<Prediction> {
     let weights = match kind {
         PredictorKind::Affine => None,
-        PredictorKind::Skinning => Some(SkinningWeights::fit_with(
-            mesh.frames(),
-            reference,
-            partition,
-            mesh.triangles(),
-            &track,
-            motion::DEFAULT_RIDGE,
-            weight_bits,
+        PredictorKind::Skinning => Some(weights_rd::fit(
+            mesh, reference, partition, &track, weights,
         )?),
     };
     let residuals = residuals_of(mesh, reference, partition, &track, weights.as_ref())?;
@@ -275,8 +270,8 @@ pub struct StreamChoices<'a> {
     pub predictor: PredictorKind,
     /// The affine track's base step (a fraction of the bounding-box diagonal).
     pub affine_step: f64,
-    /// Bits per skinning weight.
-    pub weight_bits: u8,
+    /// How the skinning weights were quantised.
+    pub weights: WeightPlan,
 }
 
 /// Redoes the encoder's analysis of `original` with a stream's recorded choices: the residuals
@@ -302,8 +297,8 @@ pub fn redo(original: &AnimatedMesh, choices: &StreamChoices) -> Result<Redone> 
     }
     let reference = &ff.decoded_positions;
     let track = fit_track(mesh, reference, partition, choices.affine_step)?;
-    let (bits, kind) = (choices.weight_bits, choices.predictor);
-    let prediction = predict_on(mesh, reference, partition, bits, kind, track)?;
+    let (weights, kind) = (choices.weights, choices.predictor);
+    let prediction = predict_on(mesh, reference, partition, weights, kind, track)?;
     Ok(Redone {
         triangles: mesh.triangles().to_vec(),
         reference: ff.decoded_positions,

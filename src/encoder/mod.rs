@@ -25,6 +25,7 @@ internal! {
     sampled_trial;
     segment_runs;
     segments;
+    weights_rd;
 }
 
 pub use crate::motion::DEFAULT_E0;
@@ -177,6 +178,12 @@ impl<'a> Settings<'a> {
             keep: Keep::Whole,
         }
     }
+
+    /// How the skinning weights are quantised: the options' bits, the plan's affine precision.
+    pub fn weight_plan(&self) -> weights_rd::WeightPlan {
+        let (bits, plan) = (self.opts.weight_bits, self.plan);
+        weights_rd::WeightPlan::new(bits, plan.affine_precision, plan.codec)
+    }
 }
 
 /// Encodes an animation at one first-frame precision (the default if `opts` leaves it open); a
@@ -251,7 +258,7 @@ impl Once {
         };
         clock.lap("segmentation");
         let reference = &ff.decoded_positions;
-        let steps = (settings.plan.affine_step, settings.opts.weight_bits);
+        let steps = (settings.plan.affine_step, settings.weight_plan());
         let prediction = analysis::predict(mesh, reference, &partition, steps, model.predictor)?;
         clock.lap("motion");
         Ok(Self {

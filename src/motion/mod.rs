@@ -17,6 +17,7 @@
 //! - `linear_form`: how a map's linear part is stored: its entries, or a rotation and a stretch
 //! - `trajectory`: temporal prediction of a coefficient's levels, and the estimate of their bits
 //! - `skinning`: the skinning predictor's per-vertex weights (follow-up paper §3.2)
+//! - `weight_fits`: what moving a quantised weight away from its fit costs in prediction error
 //! - `predictor`: which predictor a stream uses, and the one prediction both codec sides call
 //! - `residual`: prediction residuals and their energy
 
@@ -39,6 +40,8 @@ mod linear_form;
 mod sampled_motion;
 mod skinning;
 pub(crate) mod trajectory;
+#[cfg(feature = "encode")]
+mod weight_fits;
 
 pub use linear_form::LinearForm;
 pub use affine::{
@@ -58,3 +61,5 @@ pub use residual::energy;
 #[cfg(feature = "encode")]
 pub use residual::residuals;
 pub use skinning::{cluster_neighbours, SkinningWeights, DEFAULT_RIDGE, WEIGHT_BITS};
+#[cfg(feature = "encode")]
+pub use weight_fits::WeightFits;

@@ -26,6 +26,8 @@
 use super::affine::AffineTrack;
 use super::fit::{apply, AffineCoefficients, UnitFrame};
 use super::partition::Partition;
+#[cfg(feature = "encode")]
+use super::weight_fits::WeightFits;
 use crate::error::{Error, Result};
 use crate::mesh::{Point, Triangle};
 #[cfg(feature = "encode")]
@@ -65,6 +67,17 @@ pub fn cluster_neighbours(partition: &Partition, triangles: &[Triangle]) -> Vec<
     }
     out
 }
+
+/// What a weight fit reads: the original frames, the decoded frame 0, the clusters, the
+/// connectivity and the quantised affine track.
+#[cfg(feature = "encode")]
+pub type FitInput<'a> = (
+    &'a [Vec<Point>],
+    &'a [Point],
+    &'a Partition,
+    &'a [Triangle],
+    &'a AffineTrack,
+);
 
 /// The quantised skinning weights: for each vertex, one signed integer per neighbouring cluster of
 /// its own cluster (in the order of [`cluster_neighbours`]); the own cluster's weight is implied.
@@ -169,6 +182,15 @@ impl SkinningWeights {
         ridge: f64,
         bits: u8,
     ) -> Result<Self> {
+        let input = (frames, reference, partition, triangles, track);
+        Ok(Self::fit_exact(input, ridge, bits)?.0)
+    }
+
+    /// [`SkinningWeights::fit_with`], and the fits the weights were quantised from, which say
+    /// what moving a weight costs ([`WeightFits::growth`]).
+    #[cfg(feature = "encode")]
+    pub fn fit_exact(input: FitInput, ridge: f64, bits: u8) -> Result<(Self, WeightFits)> {
+        let (frames, reference, partition, triangles, track) = input;
         if !(2..=31).contains(&bits) {
             return Err(Error::Usage(format!(
                 "skinning weights: {bits} bits is outside 2..=31"
@@ -195,7 +217,7 @@ impl SkinningWeights {
         let neighbours = cluster_neighbours(partition, triangles);
         let unit = UnitFrame::of(reference);
         let maps = track.maps();
-        let fitted: Vec<(Vec<f64>, f64)> = (0..reference.len())
+        let fitted: Vec<Solved> = (0..reference.len())
             .into_par_iter()
             .map(|v| {
                 let k = partition.labels()[v] as usize;
@@ -210,8 +232,9 @@ impl SkinningWeights {
                 problem.solve(v, k, &neighbours[k])
             })
             .collect();
-        let effect: f64 = fitted.iter().map(|f| f.1).sum();
-        let exact: Vec<Vec<f64>> = fitted.into_iter().map(|f| f.0).collect();
+        let effect: f64 = fitted.iter().map(|f| f.effect).sum();
+        let (exact, grams): (Vec<Vec<f64>>, Vec<Vec<f64>>) =
+            fitted.into_iter().map(|f| (f.weights, f.normal)).unzip();
         let largest = exact
             .iter()
             .flatten()
@@ -234,7 +257,8 @@ impl SkinningWeights {
             values,
         };
         weights.check(partition)?;
-        Ok(weights)
+        let fits = WeightFits { exact, grams, step };
+        Ok((weights, fits))
     }
 
     /// Predicts frame `frame` (eq. 7) from the quantised weights and `track`'s dequantised maps.
@@ -330,6 +354,16 @@ fn bits_by_effect(
     (bits, widened.max(limit))
 }
 
+/// One vertex's fit: its weights, what an error of one in every weight moves it by (squared,
+/// summed over the frames), and the normal matrix without the ridge (row-major).
+#[cfg(feature = "encode")]
+#[derive(Default)]
+struct Solved {
+    weights: Vec<f64>,
+    effect: f64,
+    normal: Vec<f64>,
+}
+
 /// What every vertex's weight fit shares.
 #[cfg(feature = "encode")]
 struct VertexFit<'a> {
@@ -345,10 +379,10 @@ struct VertexFit<'a> {
 #[cfg(feature = "encode")]
 impl VertexFit<'_> {
     /// The unconstrained weights `β` of vertex `v` of cluster `k`: least squares of
-    /// `Σ_i ‖Σ_j β_j (p_j^i − p_k^i) − (x_i − p_k^i)‖²` plus the ridge; and `Σ_j Σ_i ‖p_j^i −
+    /// `Σ_i ‖Σ_j β_j (p_j^i − p_k^i) − (x_i − p_k^i)‖²` plus the ridge; `Σ_j Σ_i ‖p_j^i −
     /// p_k^i‖²`, what an error of one in every weight would move the vertex by (squared, summed
-    /// over the frames).
-    fn solve(&self, v: usize, k: usize, neighbours: &[u32]) -> (Vec<f64>, f64) {
+    /// over the frames); and the normal matrix.
+    fn solve(&self, v: usize, k: usize, neighbours: &[u32]) -> Solved {
         let Self {
             frames,
             reference,
@@ -359,7 +393,7 @@ impl VertexFit<'_> {
         } = *self;
         let m = neighbours.len();
         if m == 0 {
-            return (Vec::new(), 0.0);
+            return Solved::default();
         }
         let x0 = unit.to_unit(&reference[v]);
         let mut gram = DMatrix::<f64>::zeros(m, m);
@@ -388,6 +422,7 @@ impl VertexFit<'_> {
             }
         }
         let effect = gram.trace();
+        let normal: Vec<f64> = gram.iter().copied().collect();
         let lambda = ridge * effect / m as f64 + 1e-30;
         for a in 0..m {
             gram[(a, a)] += lambda;
@@ -407,7 +442,11 @@ impl VertexFit<'_> {
             // Not positive definite only if the maps are non-finite: keep the piecewise affine prediction.
             None => vec![0.0; m],
         };
-        (weights, if effect.is_finite() { effect } else { 0.0 })
+        Solved {
+            weights,
+            effect: if effect.is_finite() { effect } else { 0.0 },
+            normal,
+        }
     }
 }
 

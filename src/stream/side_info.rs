@@ -118,11 +118,31 @@ pub fn decode_partition(
 /// vertex's 1-ring (seam vertices carry the large weights), and how far apart those neighbours'
 /// weights are (all zero, all equal, then by powers of two: a smooth stretch of surface leaves
 /// small corrections; stream version 7, −2 … −8 % of the part).
+/// One weight as the coder meets it: what an encoder that chooses the weights by their bits sees
+/// ([`choose_weights`]).
+pub struct WeightSlot<'a> {
+    /// The vertex.
+    pub vertex: usize,
+    /// The weight's place among the vertex's.
+    pub index: usize,
+    /// The coder's guess of it.
+    pub guess: i64,
+    /// The adaptive model that codes its difference from the guess, as it stands.
+    pub model: &'a IntModel,
+    /// The vertex's weights as they stand (those before `index` already chosen).
+    pub values: &'a [i32],
+}
+
+/// Picks the value a weight is coded as.
+pub type ChooseWeight<'a> = &'a mut dyn FnMut(WeightSlot) -> i64;
+
+/// The weights' traversal; with `choose`, each weight first becomes what it picks (encoder only).
 fn code_weight_values<C: SymbolCoder>(
     c: &mut C,
     w: &mut SkinningWeights,
     labels: &[u32],
     (adj, coincident): (&VertexAdjacency, &[Option<u32>]),
+    mut choose: Option<ChooseWeight>,
 ) -> Result<()> {
     let mut models: [[[IntModel; SPREADS]; 2]; 3] = Default::default();
     let top = SkinningWeights::top(w.bits) as i64;
@@ -169,6 +189,12 @@ fn code_weight_values<C: SymbolCoder>(
             let touches = ring.iter().any(|&u| labels[u as usize] == j);
             let model = &mut models[kind][touches as usize][spread];
             let slot = offsets[v] + idx;
+            if let Some(choose) = choose.as_mut() {
+                let values = &w.values[offsets[v]..offsets[v] + neighbours.len()];
+                let (vertex, index, guess) = (v, idx, guess);
+                let picked = choose(WeightSlot { vertex, index, guess, model, values });
+                w.values[slot] = picked.clamp(-top, top) as i32;
+            }
             let value = guess + c.signed(w.values[slot] as i64 - guess, model)?;
             if value.abs() > top {
                 return Err(Error::Stream(format!(
@@ -217,9 +243,27 @@ pub fn encode_weights(
     w.u8(weights.bits).f32(weights.limit);
     let mut enc = Encoder::new();
     let mesh = (&adj, &coincident[..]);
-    code_weight_values(&mut enc, &mut weights.clone(), partition.labels(), mesh)?;
+    code_weight_values(&mut enc, &mut weights.clone(), partition.labels(), mesh, None)?;
     w.raw(&enc.finish()?);
     Ok(w.into_bytes())
+}
+
+/// Goes through `weights` in the order [`encode_weights`] codes them, each weight becoming what
+/// `choose` picks from the coder's guess and model at that point: an encoder's rate–distortion
+/// choice with the coder's own costs.
+#[cfg(feature = "encode")]
+pub fn choose_weights(
+    weights: &mut SkinningWeights,
+    partition: &Partition,
+    (triangles, reference): (&[Triangle], &[Point]),
+    choose: ChooseWeight,
+) -> Result<()> {
+    weights.check(partition)?;
+    let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
+    let coincident = coincident_first(reference);
+    let mesh = (&adj, &coincident[..]);
+    let mut dry = Encoder::new();
+    code_weight_values(&mut dry, weights, partition.labels(), mesh, Some(choose))
 }
 
 /// Decodes the skinning weights of `partition` on the decoded first frame.
@@ -248,7 +292,7 @@ pub fn decode_weights(
     let coincident = coincident_first(reference);
     let mut dec = Decoder::new(rest)?;
     let mesh = (&adj, &coincident[..]);
-    code_weight_values(&mut dec, &mut weights, partition.labels(), mesh)?;
+    code_weight_values(&mut dec, &mut weights, partition.labels(), mesh, None)?;
     weights.check(partition)?;
     Ok(weights)
 }

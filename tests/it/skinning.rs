@@ -5,10 +5,12 @@ use crate::common::{
     canonical, config, decode_all, decoder, encode_bytes, parts, read_media, rebuild,
 };
 use mcgv_video::codec::Codec;
+use mcgv_video::encoder::weights_rd::{self, WeightPlan};
 use mcgv_video::encoder::{analysis, EncodeOptions, Segmentation};
 use mcgv_video::metrics::compare;
 use mcgv_video::motion::{self, PredictorKind};
 use mcgv_video::stream::container::{Checksum, ContainerReader, Tag};
+use mcgv_video::stream::side_info;
 use mcgv_video::PaddingMethod;
 use std::io::Cursor;
 
@@ -140,10 +142,9 @@ fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
         let options = opts(Codec::Jpeg, 50, predictor);
         let (partition, _) =
             analysis::segment(&mesh, Segmentation::KMeans, options.clusters).unwrap();
-        let steps = (
-            options.plan(mesh.bbox_diagonal()).unwrap().affine_step,
-            options.weight_bits,
-        );
+        let plan = options.plan(mesh.bbox_diagonal()).unwrap();
+        let weights = WeightPlan::new(options.weight_bits, plan.affine_precision, plan.codec);
+        let steps = (plan.affine_step, weights);
         let a = analysis::predict(&mesh, &reference, &partition, steps, predictor).unwrap();
         assert_eq!(a.weights.is_some(), predictor == PredictorKind::Skinning);
         a.residuals.iter().map(|r| motion::energy(r)).sum::<f64>()
@@ -156,5 +157,57 @@ fn skinning_lowers_the_residual_energy_of_a_skinned_figure() {
     assert!(
         skinning < 0.9 * affine,
         "skinning {skinning}, affine {affine}"
+    );
+}
+
+#[test]
+fn weights_chosen_by_their_bits_cost_less_than_rounded_ones() {
+    // RiggedFigure's skinned joints give every border vertex weights worth choosing.
+    let mesh = read_media("RiggedFigure.glb");
+    let options = opts(Codec::Tdct, 50, PredictorKind::Skinning);
+    let plan = options.plan(mesh.bbox_diagonal()).unwrap();
+    let (partition, _) = analysis::segment(&mesh, Segmentation::KMeans, options.clusters).unwrap();
+    let reference = mesh.frame(0).to_vec();
+    let track = analysis::fit_track(&mesh, &reference, &partition, plan.affine_step).unwrap();
+    let rounded = motion::SkinningWeights::fit_with(
+        mesh.frames(),
+        &reference,
+        &partition,
+        mesh.triangles(),
+        &track,
+        motion::DEFAULT_RIDGE,
+        options.weight_bits,
+    )
+    .unwrap();
+    let weights = WeightPlan::new(options.weight_bits, plan.affine_precision, plan.codec);
+    let chosen = weights_rd::fit(&mesh, &reference, &partition, &track, weights).unwrap();
+    assert_eq!((chosen.bits, chosen.limit), (rounded.bits, rounded.limit));
+    assert_ne!(chosen.values, rounded.values);
+    // The picture codecs keep the rounded weights.
+    let pictures = WeightPlan::new(options.weight_bits, plan.affine_precision, Codec::Av1);
+    let kept = weights_rd::fit(&mesh, &reference, &partition, &track, pictures).unwrap();
+    assert_eq!(kept, rounded);
+    // The price the choice minimises, summed: squared residual steps of prediction error plus a
+    // tenth of a step² per bit.
+    let step = f64::from(plan.step);
+    let price = |w: &motion::SkinningWeights| {
+        let shape = (mesh.triangles(), reference.as_slice());
+        let bits = 8 * side_info::encode_weights(w, &partition, shape)
+            .unwrap()
+            .len();
+        let residuals =
+            analysis::residuals_of(&mesh, &reference, &partition, &track, Some(w)).unwrap();
+        let energy: f64 = residuals.iter().map(|r| motion::energy(r)).sum();
+        (bits, energy / (step * step) + 0.1 * bits as f64)
+    };
+    let ((bits_rounded, price_rounded), (bits_chosen, price_chosen)) =
+        (price(&rounded), price(&chosen));
+    assert!(
+        bits_chosen < bits_rounded,
+        "{bits_chosen} bits against {bits_rounded}"
+    );
+    assert!(
+        price_chosen < price_rounded,
+        "{price_chosen} against {price_rounded}"
     );
 }

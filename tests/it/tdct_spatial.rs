@@ -6,6 +6,7 @@ use mcgv_video::codec::tdct::coefficients::{forward, quantise, BandCoder, DEAD_Z
 use mcgv_video::codec::tdct::spatial::{Neighbourhood, Spatial};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::analysis::{predict, segment};
+use mcgv_video::encoder::weights_rd::WeightPlan;
 use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::first_frame::{self, FirstFrameOptions};
 use mcgv_video::mesh::AnimatedMesh;
@@ -28,10 +29,9 @@ pub fn coefficients_of(mesh: &AnimatedMesh, opts: &EncodeOptions) -> Vec<Vec<f64
     )
     .unwrap();
     let (partition, _) = segment(mesh, Segmentation::KMeans, opts.clusters).unwrap();
-    let steps = (
-        opts.plan(mesh.bbox_diagonal()).unwrap().affine_step,
-        opts.weight_bits,
-    );
+    let plan = opts.plan(mesh.bbox_diagonal()).unwrap();
+    let weights = WeightPlan::new(opts.weight_bits, plan.affine_precision, plan.codec);
+    let steps = (plan.affine_step, weights);
     let residuals = predict(
         mesh,
         &ff.decoded_positions,

@@ -420,7 +420,7 @@ impl<'a> Job<'a> {
             label: model.name(),
         };
         progress.stage("motion");
-        let (reference, bits) = (&shared.ff.decoded_positions, settings.opts.weight_bits);
+        let (reference, bits) = (&shared.ff.decoded_positions, settings.weight_plan());
         let (kind, track) = (model.predictor, track.clone());
         let prediction = analysis::predict_on(mesh, reference, partition, bits, kind, track)?;
         let analysed = Analysed {

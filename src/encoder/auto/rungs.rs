@@ -267,7 +267,7 @@ pub(super) fn only(
     progress.total(mesh.frame_count() as u64);
     let (partition, segmentation, track, stages) = job.prepare(shared, segmenter, progress)?;
     clock.stages.extend(stages);
-    let (reference, bits) = (&shared.ff.decoded_positions, settings.opts.weight_bits);
+    let (reference, bits) = (&shared.ff.decoded_positions, settings.weight_plan());
     let kind = model.predictor;
     let prediction = analysis::predict_on(mesh, reference, &partition, bits, kind, track)?;
     let seconds = start.elapsed().as_secs_f64();

@@ -269,7 +269,6 @@ impl UIntModel {
 }
 
 impl IntModel {
-    #[cfg(any(test, feature = "internals"))]
     /// Bits that coding `value` would cost now, without coding it.
     pub fn cost(&self, value: i64) -> f64 {
         signed_cost(value, &self.magnitude, &self.sign)
