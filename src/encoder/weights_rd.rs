@@ -1,4 +1,4 @@
-//! Skinning weights chosen by their bits and the prediction error they cause.
+//! Skinning weights chosen by their bits and the prediction error they add.
 //!
 //! The weights are fitted per vertex by least squares and quantised at the step their effect
 //! allows (`motion/skinning.rs`). Rounding each on its own ignores two things the encoder knows:
@@ -7,15 +7,10 @@
 //! vertex's coded neighbours and the adaptive model, [`side_info::choose_weights`]). Going through
 //! the weights in coding order, each takes, among its rounded value, the coder's guess and the
 //! value one step from the rounded one toward the guess, the one with the least
-//! `growth / Δ² + λ · bits`: `Δ` the residual step, `λ` the temporal DCT's price of a bit
-//! ([`ROUNDING_LAMBDA`]), since the prediction error a weight adds meets the residual coder at
-//! that price. The decoder reads the weights as always: only the encoder's choice changed.
-//!
-//! Only the temporal DCT's encodings choose so: its price is that of the coder that meets the
-//! error. The picture codecs pay more bits for the same error energy, and their price is not
-//! known: at the temporal DCT's, AV1's streams of the glTF characters grew at equal error (the
-//! error of RiggedFigure's +21 % for 2 % fewer bytes, BrainStem's pictures twice as large; see
-//! docs/design.md, "Skinning weights"), so they keep the rounded weights.
+//! `growth / Δ² + λ · bits`, `Δ` the residual step and `λ` the price of a bit in squared residual
+//! steps, at which the residual coder meets the error a weight adds: the temporal DCT's rounding
+//! price ([`ROUNDING_LAMBDA`]), a quarter of it for the picture codecs ([`PICTURE_PRICE`]). The
+//! decoder reads the weights as always: only the encoder's choice changed.
 
 use crate::codec::tdct::ROUNDING_LAMBDA;
 use crate::codec::Codec;
@@ -23,6 +18,13 @@ use crate::error::Result;
 use crate::mesh::{AnimatedMesh, Point};
 use crate::motion::{self, AffineTrack, Partition, SkinningWeights, WeightFits};
 use crate::stream::side_info::{self, WeightSlot};
+
+/// The price of a bit for the picture codecs, as a share of the temporal DCT's: they pay more
+/// bits for the same error energy. At the temporal DCT's price AV1's streams of the glTF
+/// characters grew at equal error (RiggedFigure's error +21 % for 2 % fewer bytes, BrainStem's
+/// pictures twice as large); at a quarter every AV1 stream measured shrank, a tenth gained less
+/// on the larger clips (docs/design.md, "Skinning weights").
+pub const PICTURE_PRICE: f64 = 0.25;
 
 /// How an encoding quantises its skinning weights.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,8 +34,9 @@ pub struct WeightPlan {
     /// The affine step over the residual step (the plan's affine precision): the track knows
     /// its own step, the price of an error is in residual steps.
     pub affine_precision: f64,
-    /// Whether the weights are chosen by their bits (the temporal DCT) or rounded.
-    pub chosen: bool,
+    /// The price of a bit in squared residual steps of prediction error (0: the weights are
+    /// rounded).
+    pub price: f64,
 }
 
 impl WeightPlan {
@@ -43,13 +46,16 @@ impl WeightPlan {
         Self {
             bits,
             affine_precision: f64::from(affine_precision.max(1)) / 16.0,
-            chosen: codec == Codec::Tdct,
+            price: match codec {
+                Codec::Tdct => ROUNDING_LAMBDA,
+                _ => ROUNDING_LAMBDA * PICTURE_PRICE,
+            },
         }
     }
 }
 
-/// Fits `mesh`'s skinning weights on `track`; chooses each by its bits and the prediction error
-/// it adds when `plan` says so, else rounds them (see the module notes).
+/// Fits `mesh`'s skinning weights on `track` and chooses each by its bits and the prediction
+/// error it adds at `plan`'s price (rounds them at a price of 0; see the module notes).
 pub fn fit(
     mesh: &AnimatedMesh,
     reference: &[Point],
@@ -61,20 +67,21 @@ pub fn fit(
     let ridge = motion::DEFAULT_RIDGE;
     let input = (mesh.frames(), reference, partition, triangles, track);
     let (mut weights, fits) = SkinningWeights::fit_exact(input, ridge, plan.bits)?;
-    if !plan.chosen {
+    if plan.price <= 0.0 || plan.price.is_nan() {
         return Ok(weights);
     }
     // Growth is in the unit frame, as the track's step: Δ = step / precision.
     let residual_step = f64::from(track.quantised().step) / plan.affine_precision;
     let per_growth = 1.0 / (residual_step * residual_step);
-    let mut choose = |slot: WeightSlot| i64::from(cheapest(&fits, &slot, per_growth));
+    let price = (per_growth, plan.price);
+    let mut choose = |slot: WeightSlot| i64::from(cheapest(&fits, &slot, price));
     side_info::choose_weights(&mut weights, partition, (triangles, reference), &mut choose)?;
     Ok(weights)
 }
 
-/// The value of `slot` with the least `growth × per_growth + λ · bits`: its value now (the
+/// The value of `slot` with the least `growth × per_growth + price × bits`: its value now (the
 /// rounded fit), the coder's guess, or one step from the value now toward the guess.
-fn cheapest(fits: &WeightFits, slot: &WeightSlot, per_growth: f64) -> i32 {
+fn cheapest(fits: &WeightFits, slot: &WeightSlot, (per_growth, price): (f64, f64)) -> i32 {
     let now = slot.values[slot.index];
     let Ok(guess) = i32::try_from(slot.guess) else {
         return now;
@@ -84,7 +91,7 @@ fn cheapest(fits: &WeightFits, slot: &WeightSlot, per_growth: f64) -> i32 {
     }
     let price = |q: i32| {
         let growth = fits.growth(slot.vertex, slot.index, slot.values, q);
-        growth * per_growth + ROUNDING_LAMBDA * slot.model.cost(i64::from(q) - slot.guess)
+        growth * per_growth + price * slot.model.cost(i64::from(q) - slot.guess)
     };
     let toward = now + (guess - now).signum();
     [now, toward, guess]

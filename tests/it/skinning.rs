@@ -183,10 +183,21 @@ fn weights_chosen_by_their_bits_cost_less_than_rounded_ones() {
     let chosen = weights_rd::fit(&mesh, &reference, &partition, &track, weights).unwrap();
     assert_eq!((chosen.bits, chosen.limit), (rounded.bits, rounded.limit));
     assert_ne!(chosen.values, rounded.values);
-    // The picture codecs keep the rounded weights.
-    let pictures = WeightPlan::new(options.weight_bits, plan.affine_precision, Codec::Av1);
-    let kept = weights_rd::fit(&mesh, &reference, &partition, &track, pictures).unwrap();
+    // At no price the weights are rounded; at the picture codecs' quarter price fewer move.
+    let free = WeightPlan {
+        price: 0.0,
+        ..weights
+    };
+    let kept = weights_rd::fit(&mesh, &reference, &partition, &track, free).unwrap();
     assert_eq!(kept, rounded);
+    let pictures = WeightPlan::new(options.weight_bits, plan.affine_precision, Codec::Av1);
+    assert_eq!(pictures.price, 0.25 * weights.price);
+    let moved = |w: &motion::SkinningWeights| {
+        let pairs = w.values.iter().zip(&rounded.values);
+        pairs.filter(|(a, b)| a != b).count()
+    };
+    let cheaper = weights_rd::fit(&mesh, &reference, &partition, &track, pictures).unwrap();
+    assert!(0 < moved(&cheaper) && moved(&cheaper) < moved(&chosen));
     // The price the choice minimises, summed: squared residual steps of prediction error plus a
     // tenth of a step² per bit.
     let step = f64::from(plan.step);
