@@ -7,7 +7,6 @@ use crate::codec::pictures::geometry_video;
 pub use crate::codec::Plane;
 use crate::decoder::Decoder;
 use crate::encoder::analysis::{self, StreamChoices};
-use crate::encoder::weights_rd::WeightPlan;
 use crate::error::{Error, Result};
 use crate::first_frame::FirstFrameOptions;
 use crate::geometry_image::tile;
@@ -76,13 +75,7 @@ pub fn encoder_images<R: Read + Seek>(
         partition: decoder.partition(),
         predictor: header.predictor,
         affine_step: decoder.affine_step().ok_or_else(closed)?,
-        weights: WeightPlan::new(
-            decoder
-                .weights()
-                .map_or(crate::motion::WEIGHT_BITS, |w| w.bits),
-            header.affine_precision,
-            codec,
-        ),
+        weights: decoder.weights(),
     };
     let redone = analysis::redo(original, &choices)?;
     let residuals = &redone.prediction.residuals;

@@ -270,8 +270,10 @@ pub struct StreamChoices<'a> {
     pub predictor: PredictorKind,
     /// The affine track's base step (a fraction of the bounding-box diagonal).
     pub affine_step: f64,
-    /// How the skinning weights were quantised.
-    pub weights: WeightPlan,
+    /// The stream's skinning weights (the skinning predictor's): the encoder's own choice, which
+    /// fitting them again would not find (the stream stores the bits it settled on, not the most
+    /// it was allowed).
+    pub weights: Option<&'a SkinningWeights>,
 }
 
 /// Redoes the encoder's analysis of `original` with a stream's recorded choices: the residuals
@@ -297,8 +299,18 @@ pub fn redo(original: &AnimatedMesh, choices: &StreamChoices) -> Result<Redone> 
     }
     let reference = &ff.decoded_positions;
     let track = fit_track(mesh, reference, partition, choices.affine_step)?;
-    let (weights, kind) = (choices.weights, choices.predictor);
-    let prediction = predict_on(mesh, reference, partition, weights, kind, track)?;
+    let weights = match choices.predictor {
+        PredictorKind::Affine => None,
+        PredictorKind::Skinning => Some(choices.weights.cloned().ok_or_else(|| {
+            Error::Usage("a skinning stream without skinning weights".into())
+        })?),
+    };
+    let residuals = residuals_of(mesh, reference, partition, &track, weights.as_ref())?;
+    let prediction = Prediction {
+        track,
+        weights,
+        residuals,
+    };
     Ok(Redone {
         triangles: mesh.triangles().to_vec(),
         reference: ff.decoded_positions,

@@ -7,10 +7,12 @@
 //! vertex's coded neighbours and the adaptive model, [`side_info::choose_weights`]). Going through
 //! the weights in coding order, each takes, among its rounded value, the coder's guess and the
 //! value one step from the rounded one toward the guess, the one with the least
-//! `growth / Δ² + λ · bits`, `Δ` the residual step and `λ` the price of a bit in squared residual
+//! `growth / Δ² + λ · bits`, `Δ` the quality's target step (the temporal DCT's quantiser step; a
+//! picture codec's pixel step is a fraction of it) and `λ` the price of a bit in squared target
 //! steps, at which the residual coder meets the error a weight adds: the temporal DCT's rounding
-//! price ([`ROUNDING_LAMBDA`]), a quarter of it for the picture codecs ([`PICTURE_PRICE`]). The
-//! decoder reads the weights as always: only the encoder's choice changed.
+//! price ([`ROUNDING_LAMBDA`]), a quarter of it for the picture codecs ([`PICTURE_PRICE`], which
+//! was measured, so it absorbs their pixel step too). The decoder reads the weights as always:
+//! only the encoder's choice changed.
 
 use crate::codec::tdct::ROUNDING_LAMBDA;
 use crate::codec::Codec;
@@ -48,7 +50,11 @@ impl WeightPlan {
             affine_precision: f64::from(affine_precision.max(1)) / 16.0,
             price: match codec {
                 Codec::Tdct => ROUNDING_LAMBDA,
-                _ => ROUNDING_LAMBDA * PICTURE_PRICE,
+                Codec::Jpeg | Codec::Mpeg4 | Codec::Hevc | Codec::Av1 => {
+                    ROUNDING_LAMBDA * PICTURE_PRICE
+                }
+                #[cfg(test)]
+                Codec::Raw => 0.0,
             },
         }
     }
@@ -70,7 +76,8 @@ pub fn fit(
     if plan.price <= 0.0 || plan.price.is_nan() {
         return Ok(weights);
     }
-    // Growth is in the unit frame, as the track's step: Δ = step / precision.
+    // Growth is in the unit frame, as the track's step: Δ = step / precision (the affine step is
+    // clamped only at absurd qualities and diagonals, where the price matters least).
     let residual_step = f64::from(track.quantised().step) / plan.affine_precision;
     let per_growth = 1.0 / (residual_step * residual_step);
     let price = (per_growth, plan.price);

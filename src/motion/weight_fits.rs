@@ -2,8 +2,9 @@
 //!
 //! Each vertex's weights `β` are the least-squares solution of `min Σ_i ‖D_i β − r_i‖²` over the
 //! frames (`motion/skinning.rs`), so the squared prediction error of any other `β̂` exceeds the
-//! fit's by exactly `(β̂ − β)ᵀ G (β̂ − β)`, `G = Σ_i D_iᵀ D_i` the fit's normal matrix (without
-//! its ridge). Rounding each weight on its own ignores `G`'s off-diagonal terms; choosing the
+//! fit's by `(β̂ − β)ᵀ G (β̂ − β)`, `G = Σ_i D_iᵀ D_i` the fit's normal matrix (without its
+//! ridge): exactly for the plain least-squares `β`, up to a term of the ridge's size for the
+//! ridged (or clamped) `β` the fit keeps. Rounding each weight on its own ignores `G`'s off-diagonal terms; choosing the
 //! weights one after the other with this growth in view (and the bits each costs, in the encoder)
 //! lands nearer the fit for fewer bits.
 
@@ -12,7 +13,7 @@
 #[derive(Debug, Clone, Default)]
 pub struct WeightFits {
     pub(super) exact: Vec<Vec<f64>>,
-    /// Row-major `m × m` per vertex, `m` its number of weights.
+    /// `m × m` per vertex, `m` its number of weights (symmetric, so row- and column-major alike).
     pub(super) grams: Vec<Vec<f64>>,
     pub(super) step: f64,
 }
@@ -65,10 +66,14 @@ mod tests {
             let got = fits.growth(0, 1, &values, candidate);
             assert!((got - want).abs() < 1e-12, "{candidate}: {got} against {want}");
         }
-        // The fit itself cannot be beaten: moving off the rounded values never shrinks the form
-        // below the exact optimum's 0.
-        assert!(form(values) + fits.growth(0, 0, &values, 2) >= 0.0);
+        for candidate in [0, 2, 4] {
+            let want = form([candidate, values[1]]) - form(values);
+            let got = fits.growth(0, 0, &values, candidate);
+            assert!((got - want).abs() < 1e-12, "{candidate}: {got} against {want}");
+        }
+        // Weights the fits do not know cost nothing: another index, vertex or length.
         assert_eq!(fits.growth(0, 2, &values, 1), 0.0);
         assert_eq!(fits.growth(1, 0, &values, 1), 0.0);
+        assert_eq!(fits.growth(0, 0, &[3, -1, 0], 1), 0.0);
     }
 }

@@ -111,13 +111,6 @@ pub fn decode_partition(
     Ok(labels)
 }
 
-/// Per vertex, the weight toward each neighbouring cluster as a difference from a guess: the same
-/// weight of the vertex's first copy at its first-frame position when that is in the same cluster,
-/// else the rounded mean of the same weight at the vertex's already-coded mesh neighbours of the
-/// same cluster (0 if none). Contexts: which guess, whether the target cluster touches the
-/// vertex's 1-ring (seam vertices carry the large weights), and how far apart those neighbours'
-/// weights are (all zero, all equal, then by powers of two: a smooth stretch of surface leaves
-/// small corrections; stream version 7, −2 … −8 % of the part).
 /// One weight as the coder meets it: what an encoder that chooses the weights by their bits sees
 /// ([`choose_weights`]).
 pub struct WeightSlot<'a> {
@@ -136,7 +129,15 @@ pub struct WeightSlot<'a> {
 /// Picks the value a weight is coded as.
 pub type ChooseWeight<'a> = &'a mut dyn FnMut(WeightSlot) -> i64;
 
-/// The weights' traversal; with `choose`, each weight first becomes what it picks (encoder only).
+/// Per vertex, the weight toward each neighbouring cluster as a difference from a guess: the same
+/// weight of the vertex's first copy at its first-frame position when that is in the same cluster,
+/// else the rounded mean of the same weight at the vertex's already-coded mesh neighbours of the
+/// same cluster (0 if none). Contexts: which guess, whether the target cluster touches the
+/// vertex's 1-ring (seam vertices carry the large weights), and how far apart those neighbours'
+/// weights are (all zero, all equal, then by powers of two: a smooth stretch of surface leaves
+/// small corrections; stream version 7, −2 … −8 % of the part).
+///
+/// With `choose` (an encoder's), each weight first becomes what it picks.
 fn code_weight_values<C: SymbolCoder>(
     c: &mut C,
     w: &mut SkinningWeights,

@@ -183,6 +183,11 @@ fn weights_chosen_by_their_bits_cost_less_than_rounded_ones() {
     let chosen = weights_rd::fit(&mesh, &reference, &partition, &track, weights).unwrap();
     assert_eq!((chosen.bits, chosen.limit), (rounded.bits, rounded.limit));
     assert_ne!(chosen.values, rounded.values);
+    // The decoder reads back exactly the weights the encoder chose and predicted with.
+    let shape = (mesh.triangles(), reference.as_slice());
+    let coded = side_info::encode_weights(&chosen, &partition, shape).unwrap();
+    let read = side_info::decode_weights(&coded, &partition, shape).unwrap();
+    assert_eq!(read, chosen);
     // At no price the weights are rounded; at the picture codecs' quarter price fewer move.
     let free = WeightPlan {
         price: 0.0,
