@@ -180,11 +180,13 @@ impl Comparison {
         let mut run = vec![unseen; n];
         let mut hausdorff = self.hausdorff;
         for (pass, stride) in STRIDES.into_iter().enumerate() {
+            // The bar counts each frame once, in the first pass; the stage says what the later
+            // passes, which measure more of the same frames, are doing.
+            progress.stage(&sample_stage(pass, stride));
             let which: Vec<usize> = sampled_at(stride, first, n)
                 .into_iter()
                 .filter(|&i| run[i].measured.is_none())
                 .collect();
-            // The bar counts each frame once: the first pass measures or bounds every frame.
             let bar = if pass == 0 { progress } else { &Silent };
             for (&i, d) in which
                 .iter()
@@ -273,6 +275,15 @@ fn measured(d: &FrameDistance) -> FrameValue {
     FrameValue {
         measured: Some(d.rms()),
         bound: d.forward.bound_rms.max(d.backward.bound_rms),
+    }
+}
+
+/// What a sampled comparison's pass `pass` (at `stride`) tells as its stage.
+fn sample_stage(pass: usize, stride: usize) -> String {
+    match (pass, stride) {
+        (0, _) => format!("1 frame in {stride} measured, the others bounded"),
+        (_, 1) => "refining: every frame measured".to_string(),
+        _ => format!("refining: 1 frame in {stride} measured"),
     }
 }
 
@@ -373,8 +384,13 @@ mod tests {
 
     #[test]
     fn a_sampled_comparison_tells_each_frame_once() {
-        struct Count(std::sync::atomic::AtomicU64);
+        struct Count(std::sync::atomic::AtomicU64, std::sync::Mutex<Vec<String>>);
         impl Progress for Count {
+            fn stage(&self, name: &str) {
+                if let Ok(mut stages) = self.1.lock() {
+                    stages.push(name.to_string());
+                }
+            }
             fn frames(&self, count: u64) {
                 self.0
                     .fetch_add(count, std::sync::atomic::Ordering::Relaxed);
@@ -386,9 +402,18 @@ mod tests {
             .with_frame_sampling(FrameSampling::Converged {
                 relative_error: 0.0,
             });
-        let count = Count(std::sync::atomic::AtomicU64::new(0));
+        let count = Count(std::sync::atomic::AtomicU64::new(0), Default::default());
         c.add_with_progress(a.frames(), b.frames(), &count)
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(count.0.load(std::sync::atomic::Ordering::Relaxed), 64);
+        // No tolerance: every pass runs, each telling its stage, though the bar is full.
+        let stages = count.1.lock().map(|s| s.clone()).unwrap_or_default();
+        let want = [
+            "1 frame in 8 measured, the others bounded",
+            "refining: 1 frame in 4 measured",
+            "refining: 1 frame in 2 measured",
+            "refining: every frame measured",
+        ];
+        assert_eq!(stages, want);
     }
 }
