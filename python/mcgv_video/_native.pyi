@@ -154,9 +154,17 @@ def read_animation(
     """Reads an OBJ folder or glob, a PC2 cache with its base OBJ, or a glTF/GLB clip."""
 
 @overload
-def eval(original: Animation, decoded: Union[Animation, Positions, bytes]) -> Measures: ...
+def eval(
+    original: Animation, decoded: Union[Animation, Positions, bytes], *, every_frame: bool = False
+) -> Measures: ...
 @overload
-def eval(original: Positions, decoded: Union[Animation, Positions, bytes], *, faces: Faces) -> Measures: ...
+def eval(
+    original: Positions,
+    decoded: Union[Animation, Positions, bytes],
+    *,
+    faces: Faces,
+    every_frame: bool = False,
+) -> Measures: ...
 
 class Decoder:
     """A ``.mcgv`` stream opened from its bytes; frames come out as ``float32`` arrays."""

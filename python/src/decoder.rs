@@ -4,7 +4,7 @@ use crate::arrays;
 use crate::errors::IntoPy;
 use crate::Animation;
 use mcgv_video::mesh::AnimatedMesh;
-use mcgv_video::metrics::{compare, Measures};
+use mcgv_video::metrics::{compare_sampled, FrameSampling, Measures};
 use mcgv_video::{DecodeOptions, Silent};
 use numpy::{PyArray2, PyArray3};
 use pyo3::exceptions::PyIndexError;
@@ -253,8 +253,12 @@ impl Decoder {
 }
 
 /// The measures of a stream against its original, as `mcgv-video eval` takes them: decoded in
-/// the input's vertex order, with the stream's bpvf.
-pub fn compare_stream(original: &AnimatedMesh, bytes: Vec<u8>) -> mcgv_video::Result<Measures> {
+/// the input's vertex order, with the stream's bpvf, the frames `sampling` says measured in full.
+pub fn compare_stream(
+    original: &AnimatedMesh,
+    bytes: Vec<u8>,
+    sampling: FrameSampling,
+) -> mcgv_video::Result<Measures> {
     let mut decoder = Inner::from_reader(Cursor::new(bytes), &DecodeOptions::default())?;
     let bits = decoder.file_len() * 8;
     let order = decoder.input_order(original)?;
@@ -262,5 +266,5 @@ pub fn compare_stream(original: &AnimatedMesh, bytes: Vec<u8>) -> mcgv_video::Re
     if let Some(inverse) = &order {
         decoded = decoded.permuted(inverse)?;
     }
-    Ok(compare(original, &decoded)?.with_bits(bits))
+    Ok(compare_sampled(original, &decoded, sampling)?.with_bits(bits))
 }

@@ -192,6 +192,18 @@ def test_eval_measures_a_stream_arrays_and_animations_alike():
     assert mcgv_video.eval(original, original)["rmse"] == 0.0
 
 
+def test_eval_samples_long_runs_as_the_command_does_and_every_frame_on_request():
+    positions, faces = cloth(n=12, frames=48)
+    stream = mcgv_video.encode(positions, faces, quality=40)
+    original = Animation(positions, faces)
+    sampled = mcgv_video.eval(original, stream)
+    every = mcgv_video.eval(original, stream, every_frame=True)
+    assert sampled["rmse"] == pytest.approx(every["rmse"], rel=0.01)
+    for key in ("vertex_rmse", "kg_error", "hausdorff", "bpvf"):
+        assert sampled[key] == every[key], key
+    assert every["frame_rmse"].shape == sampled["frame_rmse"].shape == (48,)
+
+
 def test_progress_reports_frames_and_a_raising_callback_stops_the_call():
     positions, faces = cloth(n=10, frames=30)
     reports = []

@@ -90,9 +90,21 @@ pub fn bpvf(bits: u64, vertices: usize, frames: usize) -> f64 {
     }
 }
 
-/// Compares `decoded` with `original`. Both need the same number of frames; the connectivity and
-/// vertex count may differ (then only the surface measures are given).
+/// Compares `decoded` with `original`, every frame measured in full. Both need the same number
+/// of frames; the connectivity and vertex count may differ (then only the surface measures are
+/// given).
 pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measures> {
+    compare_sampled(original, decoded, FrameSampling::Every)
+}
+
+/// [`compare`] measuring the frames `sampling` says in full (`eval`'s default: a converging sample,
+/// [`FrameSampling::Converged`] at [`DEFAULT_RELATIVE_ERROR`]); the vertex measures and the
+/// Hausdorff distance are exact either way.
+pub fn compare_sampled(
+    original: &AnimatedMesh,
+    decoded: &AnimatedMesh,
+    sampling: FrameSampling,
+) -> Result<Measures> {
     same_frame_count(original.frame_count(), decoded.frame_count())?;
     let mut comparison = Comparison::new(
         Surface {
@@ -103,7 +115,8 @@ pub fn compare(original: &AnimatedMesh, decoded: &AnimatedMesh) -> Result<Measur
             triangles: decoded.triangles(),
             positions: decoded.frame(0),
         },
-    )?;
+    )?
+    .with_frame_sampling(sampling);
     comparison.add(original.frames(), decoded.frames())?;
     Ok(comparison.finish())
 }
