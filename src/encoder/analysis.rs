@@ -226,6 +226,17 @@ pub fn predict_on(
             mesh, reference, partition, &track, weights,
         )?),
     };
+    prediction_with(mesh, reference, partition, track, weights)
+}
+
+/// The predictor of `track` blended by `weights` (skinning) and every frame's residuals against it.
+fn prediction_with(
+    mesh: &AnimatedMesh,
+    reference: &[Point],
+    partition: &Partition,
+    track: AffineTrack,
+    weights: Option<SkinningWeights>,
+) -> Result<Prediction> {
     let residuals = residuals_of(mesh, reference, partition, &track, weights.as_ref())?;
     Ok(Prediction {
         track,
@@ -305,12 +316,7 @@ pub fn redo(original: &AnimatedMesh, choices: &StreamChoices) -> Result<Redone> 
             Error::Usage("a skinning stream without skinning weights".into())
         })?),
     };
-    let residuals = residuals_of(mesh, reference, partition, &track, weights.as_ref())?;
-    let prediction = Prediction {
-        track,
-        weights,
-        residuals,
-    };
+    let prediction = prediction_with(mesh, reference, partition, track, weights)?;
     Ok(Redone {
         triangles: mesh.triangles().to_vec(),
         reference: ff.decoded_positions,

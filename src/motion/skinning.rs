@@ -355,7 +355,7 @@ fn bits_by_effect(
 }
 
 /// One vertex's fit: its weights, what an error of one in every weight moves it by (squared,
-/// summed over the frames), and the normal matrix without the ridge (row-major).
+/// summed over the frames), and the normal matrix without the ridge (`m × m`, symmetric).
 #[cfg(feature = "encode")]
 #[derive(Default)]
 struct Solved {

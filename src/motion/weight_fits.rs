@@ -4,9 +4,9 @@
 //! frames (`motion/skinning.rs`), so the squared prediction error of any other `β̂` exceeds the
 //! fit's by `(β̂ − β)ᵀ G (β̂ − β)`, `G = Σ_i D_iᵀ D_i` the fit's normal matrix (without its
 //! ridge): exactly for the plain least-squares `β`, up to a term of the ridge's size for the
-//! ridged (or clamped) `β` the fit keeps. Rounding each weight on its own ignores `G`'s off-diagonal terms; choosing the
-//! weights one after the other with this growth in view (and the bits each costs, in the encoder)
-//! lands nearer the fit for fewer bits.
+//! ridged (or clamped) `β` the fit keeps. Rounding each weight on its own ignores `G`'s
+//! off-diagonal terms; choosing the weights one after the other with this growth in view (and the
+//! bits each costs, in the encoder) lands nearer the fit for fewer bits.
 
 /// Each vertex's exact weights and the normal matrix of its fit (unit frame, summed over the
 /// frames), with the quantisation step of the weights they were quantised at.

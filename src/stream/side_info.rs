@@ -227,6 +227,21 @@ fn spread_class(spread: i64, zeros: bool) -> usize {
     }
 }
 
+/// [`code_weight_values`] over `partition`'s vertices, their neighbours and first copies on the
+/// decoded first frame: what the encoder, the encoder's choice and the decoder each go through.
+fn traverse_weights<C: SymbolCoder>(
+    c: &mut C,
+    w: &mut SkinningWeights,
+    partition: &Partition,
+    (triangles, reference): (&[Triangle], &[Point]),
+    choose: Option<ChooseWeight>,
+) -> Result<()> {
+    let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
+    let coincident = coincident_first(reference);
+    let mesh = (&adj, &coincident[..]);
+    code_weight_values(c, w, partition.labels(), mesh, choose)
+}
+
 /// Coded after the last skinning weight, checked by the decoder.
 const WEIGHTS_END: u32 = 0x5EED_C0DE;
 
@@ -238,13 +253,11 @@ pub fn encode_weights(
     (triangles, reference): (&[Triangle], &[Point]),
 ) -> Result<Vec<u8>> {
     weights.check(partition)?;
-    let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
-    let coincident = coincident_first(reference);
     let mut w = ByteWriter::new();
     w.u8(weights.bits).f32(weights.limit);
     let mut enc = Encoder::new();
-    let mesh = (&adj, &coincident[..]);
-    code_weight_values(&mut enc, &mut weights.clone(), partition.labels(), mesh, None)?;
+    let shape = (triangles, reference);
+    traverse_weights(&mut enc, &mut weights.clone(), partition, shape, None)?;
     w.raw(&enc.finish()?);
     Ok(w.into_bytes())
 }
@@ -260,11 +273,8 @@ pub fn choose_weights(
     choose: ChooseWeight,
 ) -> Result<()> {
     weights.check(partition)?;
-    let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
-    let coincident = coincident_first(reference);
-    let mesh = (&adj, &coincident[..]);
     let mut dry = Encoder::new();
-    code_weight_values(&mut dry, weights, partition.labels(), mesh, Some(choose))
+    traverse_weights(&mut dry, weights, partition, (triangles, reference), Some(choose))
 }
 
 /// Decodes the skinning weights of `partition` on the decoded first frame.
@@ -289,11 +299,8 @@ pub fn decode_weights(
     };
     // Bits and limit first: the coder's range check depends on them.
     weights.check(partition)?;
-    let adj = VertexAdjacency::new(partition.vertex_count(), triangles);
-    let coincident = coincident_first(reference);
     let mut dec = Decoder::new(rest)?;
-    let mesh = (&adj, &coincident[..]);
-    code_weight_values(&mut dec, &mut weights, partition.labels(), mesh, None)?;
+    traverse_weights(&mut dec, &mut weights, partition, (triangles, reference), None)?;
     weights.check(partition)?;
     Ok(weights)
 }
