@@ -550,7 +550,8 @@ export async function decodeWithWebCodecs(stream, info, onPicture) {
     } catch (e) {
       // Chromium 156 says so of 12-bit AV1 (profile 2), whose configuration it claims to support.
       decoder.close();
-      throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs refused frame ${f} (${e.message})`);
+      const hint = info.pictures.bitDepth > 10 ? '; `mcgv-video encode --bit-depth 10` makes pictures it can' : '';
+      throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs refused frame ${f} (${e.message})${hint}`);
     }
   }
   await decoder.flush().catch((e) => {

@@ -58,6 +58,8 @@ pub(crate) struct CodedResiduals {
     pub stage_seconds: Vec<(String, f64)>,
     /// Picture codecs: the residuals' spread (`geometry_image::quantise::Chosen::spread`).
     pub residual_spread: Option<f64>,
+    /// Picture codecs: the bits a sample of the pictures coded.
+    pub picture_depth: Option<u8>,
 }
 
 #[cfg(feature = "encode")]

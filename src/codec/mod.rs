@@ -369,11 +369,12 @@ impl CodecConfig {
         }
     }
 
-    /// The bits a sample of the pictures an encoding at `quality` codes: the option's, else the
-    /// automatic depth (`None` for codecs without deeper pictures).
+    /// The bits a sample of the pictures an encoding at `quality` plans: the option's, else the
+    /// automatic depth before the residuals turn it ([`pictures::deep::auto_depth`]; `None` for
+    /// codecs without deeper pictures).
     pub(crate) fn picture_depth(&self, quality: f64) -> Option<u8> {
         match self {
-            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(c.depth_at(quality)),
+            CodecConfig::Hevc(c) | CodecConfig::Av1(c) => Some(c.depth_at(self.codec(), quality)),
             _ => None,
         }
     }

@@ -61,6 +61,7 @@ impl ResidualEncoder for Encoder {
             setup: setup.into_bytes(),
             atlas: None,
             residual_spread: None,
+            picture_depth: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
                 Part::whole(Tag::FRAME_INDEX, index.to_bytes()?),

@@ -253,7 +253,14 @@ pub fn encode_to_budget_with_progress(
     let start = opts.fine_quality.unwrap_or(f64::from(opts.quality));
     let first_opts = at_quality(opts, start);
     let mut first = encode_with_progress(mesh, &first_opts, progress)?;
-    let pinned = pin_choices(opts, &first);
+    let mut pinned = pin_choices(opts, &first);
+    // Size budgets keep the first encode's depth: where the automatic one turns, the bytes jump
+    // (12-bit pictures hold errors a widened 10-bit step let through), and no size there lands.
+    if budget.is_size() {
+        if let Some(depth @ None) = pinned.codec.bit_depth_mut() {
+            *depth = first.report.picture_depth;
+        }
+    }
     search.model = model_name(&pinned, first.report.segmentation.clusters);
     // Error budgets only: where the depth turns, the bytes jump (HEVC's 12-bit pictures cost
     // 10 % more at the same quality on chickenCrossing), and no size there lands.
@@ -262,11 +269,17 @@ pub fn encode_to_budget_with_progress(
     }
     // The later encodes keep the first one's partition and atlas: no quality changes them.
     let reuse = Reuse::take(&mut first);
-    search.record(first, start, first_opts.codec.picture_depth(start))?;
+    let depth = first.report.picture_depth;
+    search.record(
+        first,
+        start,
+        first_opts.codec.picture_depth(start).and(depth),
+    )?;
     while let Some(quality) = search.next_quality()? {
         let at = search.options_at(&pinned, quality);
         let encoded = encode_reusing(mesh, &at, progress, Some(&reuse))?;
-        search.record(encoded, quality, at.codec.picture_depth(quality))?;
+        let depth = encoded.report.picture_depth;
+        search.record(encoded, quality, at.codec.picture_depth(quality).and(depth))?;
     }
     search.finish()
 }

@@ -435,6 +435,13 @@ fn code(
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
     let first_only = first_frame_only(mesh, analysed.prediction, settings.keep)?;
+    // HEVC and AV1 at the automatic depth take it from the clip's residuals, all of them even
+    // when the first frame alone is coded (a segmented stream's analysis clip, whose set-up every
+    // segment takes).
+    let plan = settings
+        .plan
+        .clone()
+        .at_depth_for(&analysed.prediction.residuals);
     let restricted;
     let (mesh, analysed) = match &first_only {
         Some((first, prediction)) => {
@@ -450,12 +457,13 @@ fn code(
         None => (mesh, analysed),
     };
     let (partition, prediction) = (analysed.partition, analysed.prediction);
-    let mut coded =
-        (settings.plan.encoder()?).encode(&residual_input(mesh, ff, analysed, progress))?;
+    let mut coded = plan
+        .encoder()?
+        .encode(&residual_input(mesh, ff, analysed, progress))?;
     clock.stages.extend(coded.stage_seconds.iter().cloned());
     clock.restart();
     let atlas = coded.atlas.take();
-    let residual_spread = coded.residual_spread;
+    let (residual_spread, picture_depth) = (coded.residual_spread, coded.picture_depth);
     let stats = atlas.as_ref().map(|(_, a)| a.stats());
     let model = analysed.model;
     let header = header(mesh, settings, model, partition);
@@ -478,6 +486,7 @@ fn code(
         choice: None,
         first_frame_trials: Vec::new(),
         residual_spread,
+        picture_depth,
         segments: 1,
         permutation: ff.permutation.clone(),
     };

@@ -82,7 +82,8 @@ impl Sample {
                 .map(|&f| prediction.residuals[f].clone())
                 .collect(),
         };
-        let mut plan = settings.plan.clone();
+        // The depth of the whole encoding, decided on every frame's residuals as it will be.
+        let mut plan = settings.plan.clone().at_depth_for(&prediction.residuals);
         if let (Some(gop), Some(pictures)) = (self.gop, plan.pictures.as_mut()) {
             pictures.gop = gop;
         }

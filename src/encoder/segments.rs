@@ -211,6 +211,7 @@ fn resumed_report(header: &Header, analysis: &Analysis, opts: &EncodeOptions) ->
         choice: None,
         first_frame_trials: Vec::new(),
         residual_spread: None,
+        picture_depth: None,
         segments: 0,
         permutation: analysis.permutation.clone(),
     }
@@ -330,7 +331,6 @@ impl SegmentedEncoder {
                 "segment analysis: its connectivity or vertex order does not fit its stream".into(),
             ));
         }
-        let plan = opts.plan(analysis.diagonal)?;
         // Every segment repeats the analysis clip's choices instead of making its own.
         let opts = EncodeOptions {
             predictor: PredictorChoice::Fixed(header.predictor),
@@ -353,6 +353,13 @@ impl SegmentedEncoder {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        // Every segment codes its pictures at the depth the analysis clip's set-up took.
+        let setup = shared.iter().find(|p| p.tag == Tag::CODEC_SETUP);
+        let plan = opts.plan(analysis.diagonal)?;
+        let plan = match setup {
+            Some(setup) => plan.pinned_to(&setup.bytes, header.vertices)?,
+            None => plan,
+        };
         let (reference, partition, weights) = (
             decoder.reference().to_vec(),
             decoder.partition().clone(),
@@ -463,6 +470,7 @@ impl SegmentedEncoder {
         // Known when every segment's is (one shipped as bytes does not carry it).
         let spreads: Option<Vec<f64>> = self.spreads.iter().copied().collect();
         report.residual_spread = spreads.and_then(|s| s.into_iter().reduce(f64::max));
+        report.picture_depth = self.plan.pictures.as_ref().map(|p| p.depth);
         report.header = header;
         Ok(Encoded {
             container,

@@ -363,3 +363,45 @@ fn a_segmented_encodings_progress_ends_at_the_total_it_told() {
         assert_eq!((total, done), (23 + 8, 23 + 8), "{:?}", opts.codec);
     }
 }
+
+/// A tube whose vertices jitter by up to `amplitude` on every axis: residuals no affine map
+/// predicts, as wide as the jitter.
+fn jittered(frames: usize, amplitude: f32) -> AnimatedMesh {
+    let (mut points, mut tris) = (Vec::new(), Vec::new());
+    tube(&mut points, &mut tris, -2.0, 2.0, 9, 8);
+    animate(&points, tris, frames, |t, i, p| {
+        let phase = (i as f32 * 12.9898 + t * 78.233).sin() * 43_758.547;
+        let jitter = amplitude * (2.0 * phase.fract() - 1.0);
+        [p[0] + jitter, p[1] - jitter, p[2] + 0.5 * jitter]
+    })
+}
+
+#[test]
+fn segments_take_the_depth_their_analysis_clip_took() {
+    // HEVC below quality 65 codes 10-bit pictures where the residuals fit them, 12-bit ones where
+    // they would widen a group's step, decided on every frame of the analysis clip (which codes
+    // its first frame alone, whose residuals are the first frame's rounding): every segment takes
+    // that depth, and a depth the caller gave stays.
+    let depths = |bytes: Vec<u8>| {
+        let mut dec = decoder(bytes).unwrap();
+        let mut depths = Vec::new();
+        for f in [0, 8, 16, 22] {
+            dec.decode_frame(f).unwrap();
+            depths.extend(dec.describe().and_then(|d| d.pictures).map(|p| p.bit_depth));
+        }
+        depths
+    };
+    for (amplitude, bit_depth, coded) in
+        [(1e-4f32, None, 10u8), (0.5, None, 12), (0.5, Some(10), 10)]
+    {
+        let mesh = jittered(23, amplitude);
+        let mut opts = EncodeOptions {
+            quality: 40,
+            ..options(Codec::Hevc, Some(8))
+        };
+        *opts.codec.bit_depth_mut().unwrap() = bit_depth;
+        let encoded = mcgv_video::encode(&mesh, &opts).unwrap();
+        assert_eq!(encoded.report.picture_depth, Some(coded), "{amplitude}");
+        assert_eq!(depths(encoded.to_bytes()), vec![coded; 4], "{amplitude}");
+    }
+}

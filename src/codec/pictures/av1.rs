@@ -230,29 +230,76 @@ mod coder {
 mod tests {
     use super::*;
 
+    fn rate(quality: u8) -> Rate {
+        Rate {
+            quality,
+            fine_quality: None,
+            step: None,
+            affine_precision: None,
+        }
+    }
+
+    fn plans(quality: u8, config: DeepConfig) -> (RatePlan, RatePlan) {
+        let rate = rate(quality);
+        let av1 = plan(&config, &rate, 1.0).unwrap();
+        let hevc = super::super::hevc::plan(&config, &rate, 1.0).unwrap();
+        (av1, hevc)
+    }
+
+    fn at(bit_depth: Option<u8>) -> DeepConfig {
+        DeepConfig {
+            bit_depth,
+            ..DeepConfig::default()
+        }
+    }
+
     #[test]
-    fn the_automatic_depth_is_12_bits_from_quality_90() {
-        let at = |quality, bit_depth| {
-            let config = DeepConfig {
-                bit_depth,
-                ..DeepConfig::default()
-            };
-            let rate = Rate {
-                quality,
-                fine_quality: None,
-                step: None,
-                affine_precision: None,
-            };
+    fn the_automatic_depth_is_12_bits_from_each_codecs_quality() {
+        let depth = |quality, bit_depth| {
+            let (av1, hevc) = plans(quality, at(bit_depth));
             let depth = |plan: RatePlan| plan.pictures.map_or(0, |p| p.depth);
-            (
-                depth(plan(&config, &rate, 1.0).unwrap()),
-                depth(super::super::hevc::plan(&config, &rate, 1.0).unwrap()),
-            )
+            (depth(av1), depth(hevc))
         };
-        assert_eq!(at(89, None), (10, 10));
-        assert_eq!(at(90, None), (12, 12));
-        assert_eq!(at(97, Some(10)), (10, 10));
-        assert_eq!(at(50, Some(12)), (12, 12));
+        assert_eq!(depth(59, None), (10, 10));
+        assert_eq!(depth(60, None), (12, 10));
+        assert_eq!(depth(64, None), (12, 10));
+        assert_eq!(depth(65, None), (12, 12));
+        assert_eq!(depth(97, Some(10)), (10, 10));
+        assert_eq!(depth(50, Some(12)), (12, 12));
+        // All-intra, unmeasured at the lower qualities, from 90 as before.
+        let intra = |quality| {
+            let (av1, hevc) = plans(quality, DeepConfig { gop: 1, ..at(None) });
+            let depth = |plan: RatePlan| plan.pictures.map_or(0, |p| p.depth);
+            (depth(av1), depth(hevc))
+        };
+        assert_eq!(intra(89), (10, 10));
+        assert_eq!(intra(90), (12, 12));
+    }
+
+    #[test]
+    fn residuals_that_widen_10_bit_samples_take_the_12_bit_plan() {
+        let widening = vec![vec![[0.0f32; 3], [0.5, -0.5, 0.5]]; 2];
+        let narrow = vec![vec![[0.0f32; 3], [1e-6, -1e-6, 0.0]]; 2];
+        for quality in [30, 50, 59] {
+            let (av1, hevc) = plans(quality, at(None));
+            let (ten_av1, ten_hevc) = plans(quality, at(Some(10)));
+            let (deep_av1, deep_hevc) = plans(quality, at(Some(12)));
+            // Exactly the plan a 12-bit encoding makes (the affine step does not depend on the
+            // depth): a stream turned deep is the one `--bit-depth 12` codes.
+            assert_eq!(av1.clone().at_depth_for(&widening), deep_av1, "{quality}");
+            assert_eq!(hevc.clone().at_depth_for(&widening), deep_hevc, "{quality}");
+            assert_eq!(av1.at_depth_for(&narrow), ten_av1, "{quality}");
+            assert_eq!(hevc.at_depth_for(&narrow), ten_hevc, "{quality}");
+        }
+        // A depth or a quantiser the caller gave does not turn.
+        let (ten, _) = plans(50, at(Some(10)));
+        assert_eq!(ten.clone().at_depth_for(&widening), ten);
+        let fixed_qp = DeepConfig {
+            qp: Some(30),
+            ..DeepConfig::default()
+        };
+        let (fixed, _) = plans(50, fixed_qp);
+        assert_eq!(fixed.clone().at_depth_for(&widening), fixed);
     }
 
     #[test]

@@ -64,10 +64,11 @@ impl DeepConfig {
         self.pictures.check(codec)
     }
 
-    /// The bits a sample of an encoding at `quality` (between the integers too): `bit_depth`,
-    /// else [`auto_depth`]'s.
-    pub(crate) fn depth_at(&self, quality: f64) -> u8 {
-        self.bit_depth.unwrap_or_else(|| auto_depth_at(quality))
+    /// The bits a sample of `codec`'s encoding at `quality` (between the integers too):
+    /// `bit_depth`, else [`auto_depth`]'s.
+    pub(crate) fn depth_at(&self, codec: Codec, quality: f64) -> u8 {
+        self.bit_depth
+            .unwrap_or_else(|| auto_depth_at(codec, self.gop, quality))
     }
 
     /// The plan of `rate` for `codec` on a first frame of bounding-box diagonal `diagonal`: the
@@ -80,8 +81,13 @@ impl DeepConfig {
         rate: &Rate,
         diagonal: f64,
     ) -> Result<RatePlan> {
-        let depth = self.depth_at(rate.level());
+        let depth = self.depth_at(codec, rate.level());
+        let deeper_law = law(rate.scale_percent(), 12);
         let law = law(rate.scale_percent(), depth);
+        // Only the automatic depth may turn, and only at the law's quantiser: a quantiser the
+        // caller gave means one thing at one depth.
+        let deeper = (self.bit_depth.is_none() && self.qp.is_none() && depth < 12)
+            .then_some((deeper_law.quantiser, deeper_law.step_factor));
         let resolved = Resolved {
             codec,
             step_factor: law.step_factor,
@@ -90,6 +96,7 @@ impl DeepConfig {
             depth,
             padding: deep_padding(self.gop),
             affine_precision,
+            deeper,
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }
@@ -97,21 +104,33 @@ impl DeepConfig {
 
 /// Sample depths the codecs take, in bits.
 pub const DEPTHS: [u8; 2] = [10, 12];
-/// The quality from which the automatic depth is 12 bits rather than 10 ([`auto_depth`]).
-pub const DEEPER_FROM_QUALITY: u8 = 90;
+/// The quality from which `codec`'s automatic depth is 12 bits whatever the residuals, with
+/// a key frame every `gop` frames ([`auto_depth`]): with P-frames the first quality measured at
+/// which 12-bit pictures cost less on average at equal error on the media sequences and none
+/// more than 5 % (AV1 60, HEVC 65; docs/design.md, "Sample depth"); all-intra, unmeasured since,
+/// 90 as both were until 2026-12-05.
+pub fn deeper_from_quality(codec: Codec, gop: usize) -> u8 {
+    match codec {
+        _ if gop <= 1 => 90,
+        Codec::Av1 => 60,
+        _ => 65,
+    }
+}
 
-/// The sample depth of an encoding at `quality` without `bit_depth`: 10 bits below quality
-/// [`DEEPER_FROM_QUALITY`], 12 from it. At equal error the finer rounding of 12 bits buys nothing
-/// at coarse steps; at fine ones it costs as much or less, and reaches errors 10 bits cannot where
-/// large residuals outgrow 1024 levels (docs/design.md, "Sample depth: 12 bits from quality 90").
+/// The sample depth of `codec`'s encoding at `quality`, with a key frame every `gop` frames and
+/// no `bit_depth`, before its residuals are known: 12 bits from [`deeper_from_quality`], else 10,
+/// which the encoder turns to 12 where its residuals would widen a group's step at 10
+/// (docs/design.md, "Sample depth"). At equal error the finer rounding of 12 bits buys nothing at
+/// coarse steps; at fine ones it costs less, and reaches errors 10 bits cannot where large
+/// residuals outgrow 1024 levels.
 #[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
-pub fn auto_depth(quality: u8) -> u8 {
-    auto_depth_at(f64::from(quality))
+pub fn auto_depth(codec: Codec, gop: usize, quality: u8) -> u8 {
+    auto_depth_at(codec, gop, f64::from(quality))
 }
 
 /// [`auto_depth`] at a quality between the integers too.
-fn auto_depth_at(quality: f64) -> u8 {
-    if quality >= f64::from(DEEPER_FROM_QUALITY) {
+fn auto_depth_at(codec: Codec, gop: usize, quality: f64) -> u8 {
+    if quality >= f64::from(deeper_from_quality(codec, gop)) {
         12
     } else {
         10

@@ -118,6 +118,7 @@ impl ResidualEncoder for Encoder {
         Ok(CodedResiduals {
             setup: setup.to_bytes(),
             residual_spread: Some(images.spread),
+            picture_depth: Some(self.plan.depth),
             atlas: Some((images.lattice, images.atlas)),
             before_predictor: vec![Part::whole(Tag::LATTICE, lattice_part)],
             after_predictor: vec![

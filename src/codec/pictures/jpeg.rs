@@ -142,6 +142,7 @@ impl JpegConfig {
             depth: 8,
             padding: padding::Method::Snap,
             affine_precision: AFFINE_PRECISION,
+            deeper: None,
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }

@@ -22,7 +22,7 @@ use super::rate::{Rate, RatePlan};
 use super::Codec;
 use crate::error::{Error, Result};
 pub use crate::geometry_image::Plane;
-use crate::geometry_image::{lattice, Lattice, RangeMode};
+use crate::geometry_image::{lattice, quantise, Lattice, RangeMode};
 use crate::stream::frame_index::FrameChunk;
 pub(crate) use setup::PictureSetup;
 
@@ -97,6 +97,21 @@ pub(crate) struct PicturePlan {
     pub padding: padding::Method,
     /// The lattice option.
     pub lattice: Lattice,
+    /// At the automatic depth, where it is 10 bits: the 12-bit pictures the coder takes instead
+    /// when 10-bit samples would widen a group's step ([`Deeper`]).
+    pub deeper: Option<Deeper>,
+}
+
+/// The 12-bit plan of an encoding whose automatic depth is 10 bits (HEVC and AV1 at the law's
+/// quantiser): the geometry-video coder codes these pictures when its residuals outgrow 10-bit
+/// samples at the pixel step, since a widened step is error the quality did not ask for and
+/// costs more bits at equal error than 12-bit samples do (docs/design.md, "Sample depth").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Deeper {
+    /// The codec's quantiser at 12 bits.
+    pub quantiser: u8,
+    /// The pixel step at 12 bits (the law's rest of the integer quantiser differs by depth).
+    pub step: f32,
 }
 
 impl PicturePlan {
@@ -107,6 +122,46 @@ impl PicturePlan {
             0 | 1 => RangeMode::PerFrame,
             n => RangeMode::PerGroup(n),
         }
+    }
+}
+
+impl RatePlan {
+    /// This plan at the depth its pictures of `residuals` want: at the automatic depth's 10 bits
+    /// with a 12-bit alternative ([`Deeper`]), the 12-bit plan where 10-bit samples would widen a
+    /// group's step at the pixel step, else the 10-bit one; other plans as they are. The encoder
+    /// decides on the clip's residuals, every frame of them, before coding any.
+    pub(crate) fn at_depth_for(mut self, residuals: &[Vec<[f32; 3]>]) -> Self {
+        let Some(pictures) = self.pictures.as_mut() else {
+            return self;
+        };
+        let Some(deeper) = pictures.deeper.take() else {
+            return self;
+        };
+        let spread = quantise::choose(residuals, pictures.ranges(), self.step, pictures.depth).spread;
+        if f64::from(self.step) < quantise::unwidened_step(spread, pictures.depth) {
+            pictures.depth = 12;
+            pictures.quantiser = deeper.quantiser;
+            self.step = deeper.step;
+        }
+        self
+    }
+
+    /// This plan as the set-up part `setup` of a stream of `vertices` vertices says its pictures
+    /// were coded: at the automatic depth, at the depth that stream took ([`Deeper`]), so that
+    /// the segments of a stream code what its analysis clip chose. Other plans stay as they are.
+    pub(crate) fn pinned_to(mut self, setup: &[u8], vertices: u32) -> Result<Self> {
+        let Some(pictures) = self.pictures.as_mut() else {
+            return Ok(self);
+        };
+        let Some(deeper) = pictures.deeper.take() else {
+            return Ok(self);
+        };
+        if setup::PictureSetup::from_bytes(setup, vertices)?.depth == 12 {
+            pictures.depth = 12;
+            pictures.quantiser = deeper.quantiser;
+            self.step = deeper.step;
+        }
+        Ok(self)
     }
 }
 
@@ -127,6 +182,8 @@ pub(crate) struct Resolved {
     pub padding: padding::Method,
     /// The affine precision the codec measured best, unless the caller asks another.
     pub affine_precision: f64,
+    /// The 12-bit quantiser and step factor of an automatic depth at 10 bits ([`Deeper`]).
+    pub deeper: Option<(u8, f64)>,
 }
 
 /// The rate plan of a picture codec: its pixel step from the law's factor, the lattice and
@@ -138,6 +195,13 @@ pub(crate) fn plan(
     resolved: Resolved,
 ) -> Result<RatePlan> {
     let step = rate.stored_step("pixel step", diagonal, resolved.step_factor)?;
+    let deeper = match resolved.deeper {
+        Some((quantiser, factor)) => Some(Deeper {
+            quantiser,
+            step: rate.stored_step("pixel step", diagonal, factor)?,
+        }),
+        None => None,
+    };
     let plan = PicturePlan {
         codec: resolved.codec,
         quantiser: resolved.quantiser,
@@ -145,6 +209,7 @@ pub(crate) fn plan(
         depth: resolved.depth,
         padding: options.padding.unwrap_or(resolved.padding),
         lattice: options.lattice,
+        deeper,
     };
     Ok(rate.plan(step, resolved.affine_precision, resolved.codec, Some(plan)))
 }

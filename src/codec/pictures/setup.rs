@@ -123,6 +123,7 @@ impl PictureSetup {
             depth: self.depth,
             padding: self.padding,
             lattice: Lattice::Fixed(self.lattice.0, self.lattice.1),
+            deeper: None,
         }
     }
 }

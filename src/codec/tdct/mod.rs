@@ -101,6 +101,7 @@ impl ResidualEncoder for Encoder {
             setup: vec![SETUP_VERSION],
             atlas: None,
             residual_spread: None,
+            picture_depth: None,
             before_predictor: Vec::new(),
             after_predictor: vec![
                 Part::whole(Tag::TDCT_INDEX, index.to_bytes()?),
