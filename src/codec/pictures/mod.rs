@@ -139,11 +139,18 @@ impl RatePlan {
         };
         let spread = quantise::choose(residuals, pictures.ranges(), self.step, pictures.depth).spread;
         if f64::from(self.step) < quantise::unwidened_step(spread, pictures.depth) {
+            self.deepen(deeper);
+        }
+        self
+    }
+
+    /// `deeper`'s 12-bit pictures in place of this plan's.
+    fn deepen(&mut self, deeper: Deeper) {
+        if let Some(pictures) = self.pictures.as_mut() {
             pictures.depth = 12;
             pictures.quantiser = deeper.quantiser;
             self.step = deeper.step;
         }
-        self
     }
 
     /// This plan as the set-up part `setup` of a stream of `vertices` vertices says its pictures
@@ -157,9 +164,7 @@ impl RatePlan {
             return Ok(self);
         };
         if setup::PictureSetup::from_bytes(setup, vertices)?.depth == 12 {
-            pictures.depth = 12;
-            pictures.quantiser = deeper.quantiser;
-            self.step = deeper.step;
+            self.deepen(deeper);
         }
         Ok(self)
     }
