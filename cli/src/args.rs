@@ -174,11 +174,10 @@ pub struct EncodeArgs {
     /// HEVC's QP 0..51, or libaom's constant-quality level (crf) 0..63 for av1.
     #[arg(long, value_parser = clap::value_parser!(u8).range(0..=63))]
     pub qp: Option<u8>,
-    /// hevc, av1: bits a sample of the residual pictures, 10, 12 or auto: 12 from --quality 60
-    /// (av1) or 65 (hevc; 90 for both with --gop 1), and below wherever the residuals would widen
-    /// a group's step in 10-bit samples; else 10 (at equal error 12 bits cost less from there,
-    /// and reach errors 10 bits cannot; docs/design.md, "Sample depth"). --json's picture_depth
-    /// says which was coded.
+    /// hevc, av1: bits a sample of the residual pictures, 10, 12 or auto: 12 from --quality 65
+    /// (hevc with P-frames) or 90, and below wherever the residuals would widen a group's step in
+    /// 10-bit samples; else 10 (at equal error 12 bits cost less there, and reach errors 10 bits
+    /// cannot; docs/design.md, "Sample depth"). --json's picture_depth says which was coded.
     /// With --target-error or --target-max-error, auto is 12 bits also from the quality where
     /// 10-bit pictures would widen a group's step; size budgets keep the first encode's depth
     /// (the report names each encode's depth; docs/design.md, "Budgets").
@@ -269,8 +268,8 @@ pub struct EncodeArgs {
 /// `--bit-depth`: a number of bits, or chosen from the quality.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BitDepth {
-    /// The measured rule: 12 bits from quality 60 (AV1) or 65 (HEVC; all-intra 90) and where
-    /// 10-bit samples would widen a group's step, else 10.
+    /// The measured rule: 12 bits from quality 65 (HEVC with P-frames) or 90, and where 10-bit
+    /// samples would widen a group's step; else 10.
     Auto,
     /// 10 or 12 bits.
     Bits(u8),

@@ -12,7 +12,8 @@ use crate::mesh::AnimatedMesh;
 /// hundredths, below the automatic depth's 12 bits) whose 10-bit pixel step is finer than residuals
 /// of `spread` fit in 10-bit samples ([`EncodeReport::residual_spread`]), from which a search whose
 /// first encode was at quality `start` codes 12-bit pictures — never at or below `start` (that
-/// encode was coded at 10 bits: a switch below it would flip back there). There groups' steps
+/// encode took the automatic depth on its own residuals: a switch below it would contradict it;
+/// an encode below `from` still takes 12 bits where its own residuals would widen 10-bit ones). There groups' steps
 /// widen, the error stops following the quality (pcow's AV1 vertex RMSE stayed at 1.22e-4 from
 /// quality 88.67 to 89.42, then fell to 4.4e-5 at 12 bits from 90) and no quality near the aim
 /// lands; where no group widens, 10 and 12 bits give about the same error and bytes
@@ -88,19 +89,18 @@ mod tests {
             *opts.codec.bit_depth_mut().expect("AV1 has a depth") = Some(10);
             f64::from(opts.plan(mesh.bbox_diagonal()).expect("a plan").step)
         };
-        // Residuals that 10-bit samples hold at quality 55's pixel step, not beyond (AV1's
-        // automatic depth is 12 bits from 60 whatever the residuals).
-        let spread = pixel_step(55.0) / unwidened_step(1.0, 10);
-        let from = deeper_from(&mesh, &av1, spread, 30.0).expect("a quality that widens");
-        assert!((30.0..=55.01).contains(&from), "{from}");
-        assert!(pixel_step(from) < pixel_step(55.0));
+        // Residuals that 10-bit samples hold at quality 75's pixel step, not beyond.
+        let spread = pixel_step(75.0) / unwidened_step(1.0, 10);
+        let from = deeper_from(&mesh, &av1, spread, 50.0).expect("a quality that widens");
+        assert!((50.0..=75.01).contains(&from), "{from}");
+        assert!(pixel_step(from) < pixel_step(75.0));
         let depth = |from: Option<f64>, opts: &EncodeOptions, quality| {
             let opts = deeper_at(at_quality(opts, quality), quality, from);
             opts.codec.picture_depth(quality)
         };
         // From there on, 12 bits, though the pixel step climbs back at a few qualities above.
         assert_eq!(depth(Some(from), &av1, from - 0.01), Some(10));
-        for quality in [from, from + 0.5, 59.99, 60.0, 95.0] {
+        for quality in [from, from + 0.5, 89.99, 95.0] {
             assert_eq!(depth(Some(from), &av1, quality), Some(12), "{quality}");
         }
         // A depth the caller gave stays, and has no quality to switch at.
@@ -108,22 +108,23 @@ mod tests {
         *ten.codec.bit_depth_mut().expect("AV1 has a depth") = Some(10);
         assert_eq!(depth(Some(from), &ten, 95.0), Some(10));
         assert_eq!(deeper_from(&mesh, &ten, spread, 50.0), None);
-        // Residuals 10 bits hold at every quality below 60, and tdct, which has no pictures.
+        // Residuals 10 bits hold at every quality below 90, and tdct, which has no pictures.
         assert_eq!(deeper_from(&mesh, &av1, 1e-9, 50.0), None);
         let tdct = EncodeOptions::default();
         assert_eq!(deeper_from(&mesh, &tdct, spread, 50.0), None);
         assert_eq!(depth(Some(from), &tdct, 80.0), None);
         // A search that started above the quality where 10 bits widen took its first encode's
-        // depth there: the depth turns just above it, never below (it would flip back at the
-        // start); one that started below keeps the lowest such quality, and one that started at
-        // 60 or more, at 12 bits, has nothing to turn.
-        assert_eq!(deeper_from(&mesh, &av1, spread, 57.5), Some(57.51));
+        // own depth there: the depth turns just above it, never below (it would flip back at the
+        // start);
+        // one that started below keeps the lowest such quality, and one that started at 90 or
+        // more, at 12 bits, has nothing to turn.
+        assert_eq!(deeper_from(&mesh, &av1, spread, 80.0), Some(80.01));
         assert_eq!(
-            deeper_from(&mesh, &av1, spread, 50.0),
-            Some(from.max(50.01))
+            deeper_from(&mesh, &av1, spread, 62.5),
+            Some(from.max(62.51))
         );
-        assert_eq!(deeper_from(&mesh, &av1, spread, 10.0), Some(from));
-        assert_eq!(deeper_from(&mesh, &av1, spread, 60.0), None);
-        assert_eq!(deeper_from(&mesh, &av1, spread, 59.995), None);
+        assert_eq!(deeper_from(&mesh, &av1, spread, 30.0), Some(from));
+        assert_eq!(deeper_from(&mesh, &av1, spread, 90.0), None);
+        assert_eq!(deeper_from(&mesh, &av1, spread, 89.995), None);
     }
 }

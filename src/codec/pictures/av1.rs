@@ -260,13 +260,13 @@ mod tests {
             let depth = |plan: RatePlan| plan.pictures.map_or(0, |p| p.depth);
             (depth(av1), depth(hevc))
         };
-        assert_eq!(depth(59, None), (10, 10));
-        assert_eq!(depth(60, None), (12, 10));
-        assert_eq!(depth(64, None), (12, 10));
-        assert_eq!(depth(65, None), (12, 12));
+        assert_eq!(depth(64, None), (10, 10));
+        assert_eq!(depth(65, None), (10, 12));
+        assert_eq!(depth(89, None), (10, 12));
+        assert_eq!(depth(90, None), (12, 12));
         assert_eq!(depth(97, Some(10)), (10, 10));
         assert_eq!(depth(50, Some(12)), (12, 12));
-        // All-intra, unmeasured at the lower qualities, from 90 as before.
+        // All-intra HEVC, unmeasured at the lower qualities, from 90 as before.
         let intra = |quality| {
             let (av1, hevc) = plans(quality, DeepConfig { gop: 1, ..at(None) });
             let depth = |plan: RatePlan| plan.pictures.map_or(0, |p| p.depth);

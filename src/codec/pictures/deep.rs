@@ -105,15 +105,15 @@ impl DeepConfig {
 /// Sample depths the codecs take, in bits.
 pub const DEPTHS: [u8; 2] = [10, 12];
 /// The quality from which `codec`'s automatic depth is 12 bits whatever the residuals, with
-/// a key frame every `gop` frames ([`auto_depth`]): with P-frames the first quality measured at
-/// which 12-bit pictures cost less on average at equal error on the media sequences and none
-/// more than 5 % (AV1 60, HEVC 65; docs/design.md, "Sample depth"); all-intra, unmeasured since,
-/// 90 as both were until 2026-12-05.
+/// a key frame every `gop` frames ([`auto_depth`]): HEVC with P-frames from 65, the first quality
+/// measured at which 12-bit pictures cost less on average at equal error on the media sequences
+/// and none more than 5 %; AV1 and all-intra HEVC from 90, as until 2026-12-05 (AV1's 12-bit
+/// pictures cost up to 2× the bytes at quality 75 on the small glTF characters, though less on
+/// the captured and simulated sequences; all-intra unmeasured; docs/design.md, "Sample depth").
 pub fn deeper_from_quality(codec: Codec, gop: usize) -> u8 {
     match codec {
-        _ if gop <= 1 => 90,
-        Codec::Av1 => 60,
-        _ => 65,
+        Codec::Hevc if gop > 1 => 65,
+        _ => 90,
     }
 }
 
