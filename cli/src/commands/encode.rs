@@ -398,6 +398,14 @@ fn report_text(
     search: Option<&BudgetReport>,
     achieved: Option<Achieved>,
 ) -> String {
+    // HEVC's and AV1's depth: the automatic one turns with the residuals (JPEG's and MPEG-4's 8
+    // bits go unsaid).
+    let charts = match r.picture_depth {
+        Some(depth) if depth > 8 => {
+            format!("{}, {depth}-bit pictures", count(r.charts as u64, "chart"))
+        }
+        _ => count(r.charts as u64, "chart"),
+    };
     let line = format!(
         "{}: {} bytes, {:.3} bpvf ({} vertices x {}, {} by {} in {:.2} s, {} predictor, {}), {:.1} s ({:.1} frames/s)",
         place,
@@ -409,7 +417,7 @@ fn report_text(
         r.segmentation.method,
         r.segmentation.seconds,
         r.header.predictor.name(),
-        count(r.charts as u64, "chart"),
+        charts,
         seconds,
         r.header.frames as f64 / seconds.max(1e-9)
     );

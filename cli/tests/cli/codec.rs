@@ -422,6 +422,32 @@ fn deep_codec_flags_encode_decode_and_random_access() {
             assert!(m["rmse"].as_f64().unwrap() < 1e-3, "{codec}: {m}");
         }
     }
+    // The automatic depth, as the reports say it: HEVC with P-frames at 12 bits from quality 65.
+    let auto = dir.path().join("auto.mcgv");
+    let a = auto.to_str().unwrap();
+    for (quality, depth) in [("60", 10), ("70", 12)] {
+        let args = [
+            "encode",
+            &sample,
+            "-o",
+            a,
+            "--codec",
+            "hevc",
+            "--quality",
+            quality,
+        ];
+        let text = run(&[&args[..], &["--force"]].concat());
+        ok(&text);
+        let said = format!("{depth}-bit pictures");
+        assert!(
+            String::from_utf8_lossy(&text.stdout).contains(&said),
+            "{quality}"
+        );
+        let report = json(&run(
+            &[&args[..], &["--force", "--json", "--quiet"]].concat()
+        ));
+        assert_eq!(report["picture_depth"], depth, "{quality}");
+    }
     let o = dir.path().join("x.mcgv");
     let o = o.to_str().unwrap();
     for extra in [
