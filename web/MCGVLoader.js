@@ -503,6 +503,11 @@ export class MCGVAnimation extends EventDispatcher {
   }
 }
 
+/** What to do about pictures deeper than WebCodecs takes (Chromium decodes 10-bit AV1, not 12-bit). */
+function deepHint(info) {
+  return info.pictures?.bitDepth > 10 ? '; `mcgv-video encode --bit-depth 10` makes pictures it can' : '';
+}
+
 /** WebCodecs' codec strings of the picture codecs (4:4:4 pictures). */
 function codecString(info) {
   const depth = info.pictures.bitDepth;
@@ -550,8 +555,7 @@ export async function decodeWithWebCodecs(stream, info, onPicture) {
     } catch (e) {
       // Chromium 156 says so of 12-bit AV1 (profile 2), whose configuration it claims to support.
       decoder.close();
-      const hint = info.pictures.bitDepth > 10 ? '; `mcgv-video encode --bit-depth 10` makes pictures it can' : '';
-      throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs refused frame ${f} (${e.message})${hint}`);
+      throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs refused frame ${f} (${e.message})${deepHint(info)}`);
     }
   }
   await decoder.flush().catch((e) => {
@@ -559,7 +563,7 @@ export async function decodeWithWebCodecs(stream, info, onPicture) {
   });
   decoder.close();
   try {
-    if (failure) throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs failed (${failure.message ?? failure})`);
+    if (failure) throw new MCGVError(`this browser cannot decode ${what} pictures: WebCodecs failed (${failure.message ?? failure})${deepHint(info)}`);
     for (let f = 0; f < frames; f++) {
       const frame = pending.get(f);
       if (!frame) throw new MCGVError(`WebCodecs gave no picture for frame ${f}`);

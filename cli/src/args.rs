@@ -179,8 +179,9 @@ pub struct EncodeArgs {
     /// 10-bit samples; else 10 (at equal error 12 bits cost less there, and reach errors 10 bits
     /// cannot; docs/design.md, "Sample depth"). --json's picture_depth says which was coded.
     /// With --target-error or --target-max-error, auto is 12 bits also from the quality where
-    /// 10-bit pictures would widen a group's step; size budgets keep the first encode's depth
-    /// (the report names each encode's depth; docs/design.md, "Budgets").
+    /// 10-bit pictures would widen a group's step, 10 below it; size budgets keep the depth the
+    /// first encode's residuals turned to (the report names each encode's depth; docs/design.md,
+    /// "Budgets").
     #[arg(long, default_value = "auto", value_parser = parse_bit_depth)]
     pub bit_depth: BitDepth,
     /// JPEG's own quality 1..100 for the residual pictures; overrides the one --quality sets.

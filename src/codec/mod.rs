@@ -236,6 +236,12 @@ impl Codec {
     /// The residual encoder of `plan` (a plan of this codec).
     #[cfg(feature = "encode")]
     pub(crate) fn encoder(self, plan: &RatePlan) -> Result<Box<dyn ResidualEncoder>> {
+        // The automatic depth is decided before coding (`RatePlan::at_depth_for`, `pinned_to`):
+        // an open 12-bit alternative here would be coded at 10 bits unasked.
+        debug_assert!(
+            plan.pictures.as_ref().is_none_or(|p| p.deeper.is_none()),
+            "a picture plan whose depth is still open"
+        );
         let step = plan.step;
         Ok(match (self.pictures()?, &plan.pictures) {
             (Some(pictures), Some(settings)) => Box::new(geometry_video::Encoder::new(

@@ -13,7 +13,7 @@
 //! ([`super::budget_depth`]). It never returns a stream over the budget (docs/design.md,
 //! "Budgets").
 
-use super::budget_depth::{deeper_at, deeper_from};
+use super::budget_depth::{deeper_at, deeper_from, keep_turned_depth};
 use super::budget_line::{interpolated, jumps, log_scale, next_log_scale, quality_of, Bend};
 use super::{
     encode_reusing, encode_with_progress, EncodeOptions, Encoded, PredictorChoice, Reuse,
@@ -198,8 +198,9 @@ pub struct BudgetReport {
     /// HEVC and AV1: the kept stream's bits a sample.
     pub bit_depth: Option<u8>,
     /// HEVC and AV1 at the automatic depth under an error budget: the quality from which the
-    /// search codes 12-bit pictures, as 10-bit ones would widen a group's step there (`None`: from
-    /// the automatic depth's 90, a size budget, or a depth the caller gave).
+    /// search codes 12-bit pictures, as 10-bit ones would widen a group's step there, and below
+    /// which 10-bit ones (`None`: the automatic depth at every quality, for a size budget, a depth
+    /// or quantiser the caller gave, or residuals that do not widen below the codec's threshold).
     pub deeper_from: Option<f64>,
     /// The stream kept's measure (bytes, or its error).
     pub achieved: f64,
@@ -254,26 +255,22 @@ pub fn encode_to_budget_with_progress(
     let first_opts = at_quality(opts, start);
     let mut first = encode_with_progress(mesh, &first_opts, progress)?;
     let mut pinned = pin_choices(opts, &first);
-    // Size budgets keep the first encode's depth: where the automatic one turns, the bytes jump
-    // (12-bit pictures hold errors a widened 10-bit step let through), and no size there lands.
+    let first_depth = first.report.picture_depth;
     if budget.is_size() {
-        if let Some(depth @ None) = pinned.codec.bit_depth_mut() {
-            *depth = first.report.picture_depth;
-        }
+        keep_turned_depth(&mut pinned, (&first_opts, start), first_depth);
     }
     search.model = model_name(&pinned, first.report.segmentation.clusters);
     // Error budgets only: where the depth turns, the bytes jump (HEVC's 12-bit pictures cost
     // 10 % more at the same quality on chickenCrossing), and no size there lands.
     if let Some(spread) = first.report.residual_spread.filter(|_| !budget.is_size()) {
-        search.deeper_from = deeper_from(mesh, &pinned, spread, start);
+        search.deeper_from = deeper_from(mesh, &pinned, spread, (start, first_depth));
     }
     // The later encodes keep the first one's partition and atlas: no quality changes them.
     let reuse = Reuse::take(&mut first);
-    let depth = first.report.picture_depth;
     search.record(
         first,
         start,
-        first_opts.codec.picture_depth(start).and(depth),
+        first_opts.codec.picture_depth(start).and(first_depth),
     )?;
     while let Some(quality) = search.next_quality()? {
         let at = search.options_at(&pinned, quality);

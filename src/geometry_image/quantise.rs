@@ -186,23 +186,12 @@ fn group_range(
     pixel_step: f32,
     depth: u8,
 ) -> (AxisRange, f64) {
-    let mut values: Vec<f64> = group
-        .iter()
-        .flatten()
-        .map(|r| f64::from(r[a]) / f64::from(pixel_step))
-        .filter(|v| v.is_finite())
-        .collect();
+    let values = sorted_levels(group, a, pixel_step);
     if values.is_empty() {
         return (AxisRange::at_depth(pixel_step, 0, depth), 0.0);
     }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    let keep = n - (n as f64 * CORRECTION_SHARE).floor() as usize;
+    let (keep, narrowest) = narrowest_window(&values);
     let (held, lo, hi) = fullest_window(&values, span(depth));
-    let narrowest = (0..=n - keep)
-        .map(|i| (values[i], values[i + keep - 1]))
-        .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
-        .unwrap_or((values[0], values[n - 1]));
     let width = (narrowest.1 - narrowest.0) * f64::from(pixel_step);
     let (lo, hi) = if held >= keep { (lo, hi) } else { narrowest };
     let scale = ((hi - lo) / span(depth)).max(1.0);
@@ -214,6 +203,46 @@ fn group_range(
     let mid = 0.5 * (lo + hi) * f64::from(pixel_step) / f64::from(step);
     let offset = mid.round().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
     (AxisRange::at_depth(step, offset, depth), width)
+}
+
+/// Axis `a` of a group's residuals in pixel steps, finite ones, sorted.
+fn sorted_levels(group: &[Vec<[f32; 3]>], a: usize, pixel_step: f32) -> Vec<f64> {
+    let mut values: Vec<f64> = group
+        .iter()
+        .flatten()
+        .map(|r| f64::from(r[a]) / f64::from(pixel_step))
+        .filter(|v| v.is_finite())
+        .collect();
+    values.sort_by(f64::total_cmp);
+    values
+}
+
+/// How many of the sorted, non-empty `values` a range must hold (all but [`CORRECTION_SHARE`]),
+/// and the narrowest window that holds that many: its lowest and highest value.
+fn narrowest_window(values: &[f64]) -> (usize, (f64, f64)) {
+    let n = values.len();
+    let keep = n - (n as f64 * CORRECTION_SHARE).floor() as usize;
+    let narrowest = (0..=n - keep)
+        .map(|i| (values[i], values[i + keep - 1]))
+        .min_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+        .unwrap_or((values[0], values[n - 1]));
+    (keep, narrowest)
+}
+
+/// The residuals' [`spread`](Chosen::spread) alone, as [`choose`] finds it (it does not depend on
+/// the depth): what deciding a depth needs, without building ranges and corrections.
+pub fn spread(residuals: &[Vec<[f32; 3]>], mode: RangeMode, pixel_step: f32) -> f64 {
+    let mut spread = 0.0f64;
+    for group in residuals.chunks(mode.group()) {
+        for a in 0..3 {
+            let values = sorted_levels(group, a, pixel_step);
+            if !values.is_empty() {
+                let (_, (lo, hi)) = narrowest_window(&values);
+                spread = spread.max((hi - lo) * f64::from(pixel_step));
+            }
+        }
+    }
+    spread
 }
 
 /// The window of at most `span` pixel steps that holds most of the sorted `values` (in pixel
@@ -250,6 +279,27 @@ mod tests {
             assert!((back - v).abs() <= 0.005 + 1e-6, "{v} -> {back}");
         }
         assert!(!r.fits(0.07 + 1.3) && r.quantise(0.07 + 1.3) == max_level(8));
+    }
+
+    #[test]
+    fn the_spread_alone_is_the_one_choose_finds() {
+        let residuals: Vec<Vec<[f32; 3]>> = (0..7)
+            .map(|f| {
+                (0..300)
+                    .map(|i| {
+                        let x = ((i * 37 + f * 11) % 101) as f32 / 50.0 - 1.0;
+                        [x * (f + 1) as f32, 0.01 * x, if i == 7 { 40.0 } else { 0.0 }]
+                    })
+                    .collect()
+            })
+            .collect();
+        for mode in [RangeMode::PerFrame, RangeMode::PerGroup(3)] {
+            for depth in [8, 10, 12] {
+                let chosen = choose(&residuals, mode, 0.001, depth);
+                assert_eq!(spread(&residuals, mode, 0.001), chosen.spread, "{depth}");
+            }
+        }
+        assert_eq!(spread(&[], RangeMode::PerFrame, 0.001), 0.0);
     }
 
     #[test]

@@ -138,7 +138,7 @@ before(async () => {
     jpeg: ['--codec', 'jpeg'],
     'tdct-segments': ['--segment-frames', '16'],
     'jpeg-segments': ['--codec', 'jpeg', '--segment-frames', '16'],
-    av1: ['--codec', 'av1'],
+    av1: ['--codec', 'av1', '--bit-depth', '10'],
     'av1-12': ['--codec', 'av1', '--bit-depth', '12'],
     // A fine stream baked at 120 frames/s in one segment (189 KB): its first frame is 5 % of it,
     // so the page streams it over many chunks at 1 MB/s (docs/web.md, "Streaming").
@@ -208,6 +208,7 @@ test('AV1 pictures decode through WebCodecs; HEVC and MPEG-4 name the codec the 
   } else {
     console.log(`12-bit av1: ${d.error}`);
     assert.match(d.error, /cannot decode 12-bit av1 pictures/, d.error);
+    assert.match(d.error, /--bit-depth 10/, d.error);
   }
   await deep.close();
   for (const codec of ['hevc', 'mpeg4']) {

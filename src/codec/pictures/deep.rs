@@ -8,6 +8,10 @@
 //! threads), which makes one key frame, then P-frames, one packet per frame in order; headers are
 //! in-band, so that decoding can start at any key frame.
 
+#[cfg(any(test, feature = "internals"))]
+pub use super::depth::auto_depth;
+pub use super::depth::{deeper_from_quality, DEPTHS};
+use super::depth::auto_depth_at;
 use super::{PictureOptions, Resolved, DEFAULT_GOP};
 use crate::codec::rate::{PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
@@ -28,7 +32,9 @@ pub struct DeepConfig {
     /// Frames per group of pictures: a key frame, then `gop − 1` P-frames (1: all-intra, every
     /// frame decodes alone).
     pub gop: usize,
-    /// Bits a sample, 10 or 12; `None` picks it from the quality (12 bits from quality 90).
+    /// Bits a sample, 10 or 12; `None` picks it from the quality and the residuals (12 bits from
+    /// quality 65 for HEVC with P-frames, 90 otherwise, and below where 10 would widen a group's
+    /// step; docs/design.md, "Sample depth").
     pub bit_depth: Option<u8>,
     /// The lattice and padding (default: `pushpull` all-intra, `biharmonic` with P-frames).
     pub pictures: PictureOptions,
@@ -102,40 +108,6 @@ impl DeepConfig {
     }
 }
 
-/// Sample depths the codecs take, in bits.
-pub const DEPTHS: [u8; 2] = [10, 12];
-/// The quality from which `codec`'s automatic depth is 12 bits whatever the residuals, with
-/// a key frame every `gop` frames ([`auto_depth`]): HEVC with P-frames from 65, the first quality
-/// measured at which 12-bit pictures cost less on average at equal error on the media sequences
-/// and none more than 5 %; AV1 and all-intra HEVC from 90, as until 2026-12-05 (AV1's 12-bit
-/// pictures cost up to 2× the bytes at quality 75 on the small glTF characters, though less on
-/// the captured and simulated sequences; all-intra unmeasured; docs/design.md, "Sample depth").
-pub fn deeper_from_quality(codec: Codec, gop: usize) -> u8 {
-    match codec {
-        Codec::Hevc if gop > 1 => 65,
-        _ => 90,
-    }
-}
-
-/// The sample depth of `codec`'s encoding at `quality`, with a key frame every `gop` frames and
-/// no `bit_depth`, before its residuals are known: 12 bits from [`deeper_from_quality`], else 10,
-/// which the encoder turns to 12 where its residuals would widen a group's step at 10
-/// (docs/design.md, "Sample depth"). At equal error the finer rounding of 12 bits buys nothing at
-/// coarse steps; at fine ones it costs less, and reaches errors 10 bits cannot where large
-/// residuals outgrow 1024 levels.
-#[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
-pub fn auto_depth(codec: Codec, gop: usize, quality: u8) -> u8 {
-    auto_depth_at(codec, gop, f64::from(quality))
-}
-
-/// [`auto_depth`] at a quality between the integers too.
-fn auto_depth_at(codec: Codec, gop: usize, quality: f64) -> u8 {
-    if quality >= f64::from(deeper_from_quality(codec, gop)) {
-        12
-    } else {
-        10
-    }
-}
 /// The padding of HEVC's and AV1's geometry images with a key frame every `gop` frames.
 /// P-frame groups: `biharmonic`, smooth across chart borders, what a transform codec codes cheaply.
 /// All-intra (`gop` 1): `pushpull`, which needs fewer bits there at equal error; in P-frame groups

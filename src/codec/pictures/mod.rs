@@ -10,6 +10,7 @@
 pub mod abbreviated;
 pub mod av1;
 pub mod deep;
+mod depth;
 pub mod geometry_video;
 pub mod hevc;
 pub mod jpeg;
@@ -22,8 +23,9 @@ use super::rate::{Rate, RatePlan};
 use super::Codec;
 use crate::error::{Error, Result};
 pub use crate::geometry_image::Plane;
-use crate::geometry_image::{lattice, quantise, Lattice, RangeMode};
+use crate::geometry_image::{lattice, Lattice, RangeMode};
 use crate::stream::frame_index::FrameChunk;
+pub(crate) use depth::Deeper;
 pub(crate) use setup::PictureSetup;
 
 /// The affine precision of JPEG and HEVC: 3/16 of the residual step, as tdct's (a quarter until
@@ -102,18 +104,6 @@ pub(crate) struct PicturePlan {
     pub deeper: Option<Deeper>,
 }
 
-/// The 12-bit plan of an encoding whose automatic depth is 10 bits (HEVC and AV1 at the law's
-/// quantiser): the geometry-video coder codes these pictures when its residuals outgrow 10-bit
-/// samples at the pixel step, since a widened step is error the quality did not ask for and
-/// costs more bits at equal error than 12-bit samples do (docs/design.md, "Sample depth").
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Deeper {
-    /// The codec's quantiser at 12 bits.
-    pub quantiser: u8,
-    /// The pixel step at 12 bits (the law's rest of the integer quantiser differs by depth).
-    pub step: f32,
-}
-
 impl PicturePlan {
     /// How residual ranges are shared: by the frames of a group of pictures, so that P-frames
     /// predict like from like (one frame a group for intra coding).
@@ -122,51 +112,6 @@ impl PicturePlan {
             0 | 1 => RangeMode::PerFrame,
             n => RangeMode::PerGroup(n),
         }
-    }
-}
-
-impl RatePlan {
-    /// This plan at the depth its pictures of `residuals` want: at the automatic depth's 10 bits
-    /// with a 12-bit alternative ([`Deeper`]), the 12-bit plan where 10-bit samples would widen a
-    /// group's step at the pixel step, else the 10-bit one; other plans as they are. The encoder
-    /// decides on the clip's residuals, every frame of them, before coding any.
-    pub(crate) fn at_depth_for(mut self, residuals: &[Vec<[f32; 3]>]) -> Self {
-        let Some(pictures) = self.pictures.as_mut() else {
-            return self;
-        };
-        let Some(deeper) = pictures.deeper.take() else {
-            return self;
-        };
-        let spread = quantise::choose(residuals, pictures.ranges(), self.step, pictures.depth).spread;
-        if f64::from(self.step) < quantise::unwidened_step(spread, pictures.depth) {
-            self.deepen(deeper);
-        }
-        self
-    }
-
-    /// `deeper`'s 12-bit pictures in place of this plan's.
-    fn deepen(&mut self, deeper: Deeper) {
-        if let Some(pictures) = self.pictures.as_mut() {
-            pictures.depth = 12;
-            pictures.quantiser = deeper.quantiser;
-            self.step = deeper.step;
-        }
-    }
-
-    /// This plan as the set-up part `setup` of a stream of `vertices` vertices says its pictures
-    /// were coded: at the automatic depth, at the depth that stream took ([`Deeper`]), so that
-    /// the segments of a stream code what its analysis clip chose. Other plans stay as they are.
-    pub(crate) fn pinned_to(mut self, setup: &[u8], vertices: u32) -> Result<Self> {
-        let Some(pictures) = self.pictures.as_mut() else {
-            return Ok(self);
-        };
-        let Some(deeper) = pictures.deeper.take() else {
-            return Ok(self);
-        };
-        if setup::PictureSetup::from_bytes(setup, vertices)?.depth == 12 {
-            self.deepen(deeper);
-        }
-        Ok(self)
     }
 }
 
