@@ -175,7 +175,7 @@ pub struct EncodeArgs {
     #[arg(long, value_parser = clap::value_parser!(u8).range(0..=63))]
     pub qp: Option<u8>,
     /// hevc, av1: bits a sample of the residual pictures, 10, 12 or auto: 12 from --quality 65
-    /// (hevc with P-frames) or 90, and below wherever the residuals would widen a group's step in
+    /// (hevc) or 90 (av1), and below wherever the residuals would widen a group's step in
     /// 10-bit samples; else 10 (at equal error 12 bits cost less there, and reach errors 10 bits
     /// cannot; docs/design.md, "Sample depth"). --json's picture_depth says which was coded.
     /// With --target-error or --target-max-error, auto is 12 bits also from the quality where
@@ -269,7 +269,7 @@ pub struct EncodeArgs {
 /// `--bit-depth`: a number of bits, or chosen from the quality.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BitDepth {
-    /// The measured rule: 12 bits from quality 65 (HEVC with P-frames) or 90, and where 10-bit
+    /// The measured rule: 12 bits from quality 65 (HEVC) or 90 (AV1), and where 10-bit
     /// samples would widen a group's step; else 10.
     Auto,
     /// 10 or 12 bits.

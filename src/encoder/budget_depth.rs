@@ -43,8 +43,7 @@ pub(super) fn deeper_from(
     let unwidened = unwidened_step(spread, 10);
     let diagonal = mesh.bbox_diagonal();
     let start = (start * 100.0).floor() as u32;
-    let gop = ten.codec.gop_mut().map_or(1, |g| *g);
-    let deepest = 100 * u32::from(deeper_from_quality(opts.codec.codec(), gop));
+    let deepest = 100 * u32::from(deeper_from_quality(opts.codec.codec()));
     let widens = |hundredths: u32| {
         let quality = f64::from(hundredths) / 100.0;
         // A quality without a plan (a step too fine for the diagonal) is left to its encode.

@@ -46,7 +46,7 @@ pub struct EncodeReport {
     /// one of whose segments came in as bytes ([`super::CodedSegment::from_bytes`]).
     pub residual_spread: Option<f64>,
     /// Picture codecs: the bits a sample of the pictures coded (8 for JPEG and MPEG-4; HEVC and
-    /// AV1 at the automatic depth: 12 from quality 65 for HEVC with P-frames, 90 otherwise, and
+    /// AV1 at the automatic depth: 12 from quality 65 for HEVC, 90 for AV1, and
     /// below where 10-bit samples would widen a group's step); `None` for tdct.
     pub picture_depth: Option<u8>,
     /// Temporal segments the stream is cut into (1: not cut). The choices above were made on the

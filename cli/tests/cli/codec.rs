@@ -422,7 +422,7 @@ fn deep_codec_flags_encode_decode_and_random_access() {
             assert!(m["rmse"].as_f64().unwrap() < 1e-3, "{codec}: {m}");
         }
     }
-    // The automatic depth, as the reports say it: HEVC with P-frames at 12 bits from quality 65.
+    // The automatic depth, as the reports say it: HEVC at 12 bits from quality 65.
     let auto = dir.path().join("auto.mcgv");
     let a = auto.to_str().unwrap();
     for (quality, depth) in [("60", 10), ("70", 12)] {

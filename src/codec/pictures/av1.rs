@@ -266,13 +266,14 @@ mod tests {
         assert_eq!(depth(90, None), (12, 12));
         assert_eq!(depth(97, Some(10)), (10, 10));
         assert_eq!(depth(50, Some(12)), (12, 12));
-        // All-intra HEVC, unmeasured at the lower qualities, from 90 as before.
+        // All-intra alike.
         let intra = |quality| {
             let (av1, hevc) = plans(quality, DeepConfig { gop: 1, ..at(None) });
             let depth = |plan: RatePlan| plan.pictures.map_or(0, |p| p.depth);
             (depth(av1), depth(hevc))
         };
-        assert_eq!(intra(89), (10, 10));
+        assert_eq!(intra(64), (10, 10));
+        assert_eq!(intra(65), (10, 12));
         assert_eq!(intra(90), (12, 12));
     }
 

@@ -33,7 +33,7 @@ pub struct DeepConfig {
     /// frame decodes alone).
     pub gop: usize,
     /// Bits a sample, 10 or 12; `None` picks it from the quality and the residuals (12 bits from
-    /// quality 65 for HEVC with P-frames, 90 otherwise, and below where 10 would widen a group's
+    /// quality 65 for HEVC, 90 for AV1, and below where 10 would widen a group's
     /// step; docs/design.md, "Sample depth").
     pub bit_depth: Option<u8>,
     /// The lattice and padding (default: `pushpull` all-intra, `biharmonic` with P-frames).
@@ -74,7 +74,7 @@ impl DeepConfig {
     /// `bit_depth`, else [`auto_depth`]'s.
     pub(crate) fn depth_at(&self, codec: Codec, quality: f64) -> u8 {
         self.bit_depth
-            .unwrap_or_else(|| auto_depth_at(codec, self.gop, quality))
+            .unwrap_or_else(|| auto_depth_at(codec, quality))
     }
 
     /// The plan of `rate` for `codec` on a first frame of bounding-box diagonal `diagonal`: the
