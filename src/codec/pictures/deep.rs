@@ -88,12 +88,11 @@ impl DeepConfig {
         diagonal: f64,
     ) -> Result<RatePlan> {
         let depth = self.depth_at(codec, rate.level());
-        let deeper_law = law(rate.scale_percent(), 12);
-        let law = law(rate.scale_percent(), depth);
         // Only the automatic depth may turn, and only at the law's quantiser: a quantiser the
         // caller gave means one thing at one depth.
         let deeper = (self.bit_depth.is_none() && self.qp.is_none() && depth < 12)
-            .then_some((deeper_law.quantiser, deeper_law.step_factor));
+            .then(|| law(rate.scale_percent(), 12));
+        let law = law(rate.scale_percent(), depth);
         let resolved = Resolved {
             codec,
             step_factor: law.step_factor,

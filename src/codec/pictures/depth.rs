@@ -12,9 +12,9 @@ use crate::geometry_image::quantise;
 /// Sample depths the codecs take, in bits.
 pub const DEPTHS: [u8; 2] = [10, 12];
 /// The quality from which `codec`'s automatic depth is 12 bits whatever the residuals
-/// ([`auto_depth`]): HEVC from 65, the first quality measured at
-/// which 12-bit pictures cost less on average at equal error on the media sequences and none more
-/// than 5 % (with P-frames and all-intra); AV1 from 90, as until 2026-12-05 (its 12-bit pictures
+/// ([`auto_depth`]): HEVC from 65, the first quality measured at which 12-bit pictures cost less
+/// on average at equal error on the media sequences and none more than 5 % (with P-frames and
+/// all-intra); AV1 from 90, as until 2026-12-05 (its 12-bit pictures
 /// cost up to 2× the bytes at quality 75 on the small glTF characters, though less on the
 /// captured and simulated sequences; docs/design.md, "Sample depth").
 pub fn deeper_from_quality(codec: Codec) -> u8 {
@@ -26,9 +26,9 @@ pub fn deeper_from_quality(codec: Codec) -> u8 {
 
 /// The sample depth of `codec`'s encoding at `quality` with no `bit_depth`, before its residuals
 /// are known: 12 bits from [`deeper_from_quality`], else 10, which the encoder turns to 12 where
-/// its residuals would widen a group's step at 10 (docs/design.md, "Sample depth"). At equal error the finer rounding of 12 bits buys nothing at
-/// coarse steps; at fine ones it costs less, and reaches errors 10 bits cannot where large
-/// residuals outgrow 1024 levels.
+/// its residuals would widen a group's step at 10 (docs/design.md, "Sample depth"). At equal
+/// error the finer rounding of 12 bits buys nothing at coarse steps; at fine ones it costs less,
+/// and reaches errors 10 bits cannot where large residuals outgrow 1024 levels.
 #[cfg_attr(not(any(test, feature = "internals")), allow(dead_code))]
 pub fn auto_depth(codec: Codec, quality: u8) -> u8 {
     auto_depth_at(codec, f64::from(quality))

@@ -19,7 +19,7 @@ mod libav;
 pub mod mpeg4;
 mod setup;
 
-use super::rate::{Rate, RatePlan};
+use super::rate::{PictureLaw, Rate, RatePlan};
 use super::Codec;
 use crate::error::{Error, Result};
 pub use crate::geometry_image::Plane;
@@ -132,8 +132,8 @@ pub(crate) struct Resolved {
     pub padding: padding::Method,
     /// The affine precision the codec measured best, unless the caller asks another.
     pub affine_precision: f64,
-    /// The 12-bit quantiser and step factor of an automatic depth at 10 bits ([`Deeper`]).
-    pub deeper: Option<(u8, f64)>,
+    /// The 12-bit law of an automatic depth at 10 bits ([`Deeper`]).
+    pub deeper: Option<PictureLaw>,
 }
 
 /// The rate plan of a picture codec: its pixel step from the law's factor, the lattice and
@@ -146,9 +146,9 @@ pub(crate) fn plan(
 ) -> Result<RatePlan> {
     let step = rate.stored_step("pixel step", diagonal, resolved.step_factor)?;
     let deeper = match resolved.deeper {
-        Some((quantiser, factor)) => Some(Deeper {
-            quantiser,
-            step: rate.stored_step("pixel step", diagonal, factor)?,
+        Some(law) => Some(Deeper {
+            quantiser: law.quantiser,
+            step: rate.stored_step("pixel step", diagonal, law.step_factor)?,
         }),
         None => None,
     };
