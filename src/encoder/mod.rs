@@ -13,6 +13,7 @@ mod budget;
 mod budget_depth;
 mod budget_line;
 mod choice_reason;
+mod crf_split;
 mod options;
 mod report;
 internal! {
@@ -36,6 +37,7 @@ pub use budget::{
     encode_to_budget, encode_to_budget_with_progress, Budget, BudgetReport, BudgetTrial, Budgeted,
     MAX_BUDGET_ENCODES,
 };
+use crf_split::code;
 pub use first_frame_bits::FirstFrameTrial;
 #[cfg(feature = "internals")]
 pub use options::kmeans_ladder;
@@ -422,12 +424,13 @@ struct Analysed<'a> {
     atlas: Option<&'a AtlasCache>,
 }
 
-/// Codes the residuals of `analysed` and assembles the stream behind the `leading` parts; the
-/// report's stages are the `clock`'s and the coder's. Every frame, or the first alone when the
-/// caller keeps the shared parts ([`Keep::SharedParts`]).
-fn code(
-    mesh: &AnimatedMesh,
-    ff: &EncodedFirstFrame,
+/// Codes the residuals of `analysed` at `plan` (the settings' plan at its depth,
+/// [`code`]) and assembles the stream behind the `leading` parts; the report's stages
+/// are the `clock`'s and the coder's. Every frame, or the first alone when the caller keeps the
+/// shared parts ([`Keep::SharedParts`]).
+fn code_at(
+    plan: &RatePlan,
+    (mesh, ff): (&AnimatedMesh, &EncodedFirstFrame),
     leading: Vec<Part>,
     settings: Settings,
     analysed: &Analysed,
@@ -435,13 +438,6 @@ fn code(
     mut clock: Stopwatch,
 ) -> Result<Encoded> {
     let first_only = first_frame_only(mesh, analysed.prediction, settings.keep)?;
-    // HEVC and AV1 at the automatic depth take it from the clip's residuals, all of them even
-    // when the first frame alone is coded (a segmented stream's analysis clip, whose set-up every
-    // segment takes).
-    let plan = settings
-        .plan
-        .clone()
-        .at_depth_for(&analysed.prediction.residuals);
     let restricted;
     let (mesh, analysed) = match &first_only {
         Some((first, prediction)) => {

@@ -1,7 +1,9 @@
 //! End-to-end: encode media samples with both codecs, decode, and check connectivity, error bounds,
 //! random access and the handling of damaged streams.
 
-use crate::common::{canonical, config, decode_all, decoder, encode_bytes, read_media};
+use crate::common::{
+    canonical, config, decode_all, decoder, encode_bytes, read_media, vertex_rmse,
+};
 use mcgv_video::codec::Codec;
 use mcgv_video::encoder::{EncodeOptions, Segmentation};
 use mcgv_video::metrics::compare;
@@ -174,6 +176,37 @@ fn deep_codecs_round_trip_random_access_and_determinism() {
             assert_eq!(alone, decoded.frame(f), "{what}");
         }
     }
+}
+
+/// AV1's 12-bit pictures on a small mesh cost no more than its 10-bit ones at no more error: the
+/// encoder codes the law's low `crf` and a coarser one over finer samples, and keeps the fewer bits
+/// at equal error. With the law's `crf` alone, Fox at quality 75 cost 2.6× the bytes (lossless key
+/// frames), and with `qmin` 1 still 37 417 bytes at vertex RMSE 6.1e-5 against 33 979 at 5.4e-5.
+#[test]
+fn twelve_bit_av1_on_a_small_mesh_costs_no_more_than_ten_bit() {
+    let mesh = read_media("Fox.glb");
+    let coded = |depth: u8| {
+        let mut options = EncodeOptions {
+            codec: Codec::Av1.into(),
+            quality: 75,
+            predictor: PredictorKind::Skinning.into(),
+            segmentation: Segmentation::KMeans.into(),
+            ..EncodeOptions::default()
+        };
+        *options.codec.bit_depth_mut().expect("AV1 has a depth") = Some(depth);
+        let bytes = encode_bytes(&mesh, &options);
+        let error = vertex_rmse(&mesh, &decode_all(bytes.clone()).unwrap());
+        (bytes.len() as f64, error)
+    };
+    let ((ten_bytes, ten_error), (bytes, error)) = (coded(10), coded(12));
+    assert!(
+        bytes <= 1.05 * ten_bytes,
+        "{bytes} bytes against {ten_bytes}"
+    );
+    assert!(
+        error <= 1.05 * ten_error,
+        "RMSE {error} against {ten_error}"
+    );
 }
 
 /// All-intra HEVC and AV1 (`gop` 1): a frame decodes when every other frame's chunk is destroyed.

@@ -11,7 +11,7 @@
 //!
 //! `cpu-used` `CPU_USED` trades compression for speed (docs/design.md, "AV1 settings").
 
-use super::deep::DeepConfig;
+use super::deep::{DeepConfig, DeepLaws};
 use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::Result;
@@ -35,8 +35,12 @@ pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<Ra
         1 => DEFAULT_AFFINE_PRECISION,
         _ => super::p_frame_affine_precision(rate),
     };
-    let law = (av1_law_at as fn(f64, u8) -> PictureLaw, affine_precision);
-    config.plan(Codec::Av1, law, rate, diagonal)
+    let laws = DeepLaws {
+        law: av1_law_at,
+        deep: av1_laws_12,
+        affine_precision,
+    };
+    config.plan(Codec::Av1, laws, rate, diagonal)
 }
 
 /// AV1's law at 10 bits a sample, made as HEVC's: a pixel step of [`AV1_STEP_FACTOR`] × the target
@@ -150,6 +154,28 @@ pub(crate) fn av1_law_at(scale_percent: f64, depth: u8) -> PictureLaw {
     }
 }
 
+/// AV1's 12-bit laws at the IJG scale `scale_percent` of a quality: [`av1_law_at`]'s, then each
+/// coarser `crf` up to the one whose step is 4 × its step (two bits of headroom; at most
+/// [`AV1_MAX_QP`]) at a pixel step as much finer, the same quantiser step in model units. Where
+/// the residuals leave room in 12-bit samples, the encoder codes the coarsest beside the law's own
+/// and keeps the fewer bits at equal error ([`RatePlan::depth_choices`]): at the law's low `crf`
+/// libaom's finer quantisers for key frames and alternate references stop at `qmin`, which cost
+/// the small glTF characters up to 67 % more bits than 10-bit pictures at quality 90 (Fox), while
+/// the larger meshes gain up to 38 % there; over finer samples the coarser `crf` codes them as
+/// 10-bit pictures with two more bits of range (docs/design.md, "Sample depth").
+pub(crate) fn av1_laws_12(scale_percent: f64) -> Vec<PictureLaw> {
+    let own = av1_law_at(scale_percent, 12);
+    let own_step = av1_log2_step(f64::from(own.quantiser), 12);
+    let coarsest = av1_crf_of(own_step + 2.0, 12)
+        .floor()
+        .min(f64::from(AV1_MAX_QP)) as u8;
+    let coarser = (own.quantiser + 1..=coarsest).map(|crf| PictureLaw {
+        step_factor: own.step_factor * 2f64.powf(own_step - av1_log2_step(f64::from(crf), 12)),
+        quantiser: crf,
+    });
+    std::iter::once(own).chain(coarser).collect()
+}
+
 /// libaom as a [`deep::Flavour`].
 #[cfg(feature = "ffmpeg")]
 mod coder {
@@ -169,8 +195,9 @@ mod coder {
     /// P-frame group: 1, not libaom's 0, which the finer quantisers libaom gives key frames and
     /// alternate references reach from the low `crf`s of 12-bit pictures — index 0, lossless
     /// coding. At quality 90, 5–31 % fewer bytes for a vertex RMSE 0.5–11 % higher, fewer at equal
-    /// error on all ten sequences measured; at 10 bits (quality 75) it changed little and is not
-    /// taken there (docs/design.md, "AV1 settings").
+    /// error on all ten sequences measured; at 10 bits it changed only the small glTF characters'
+    /// streams (Fox 23 % fewer bytes at quality 85, 1 % more at equal error at 75) and is not taken
+    /// there yet (docs/design.md, "AV1 settings").
     pub const DEEP_P_FRAME_QMIN: u8 = 1;
     /// Strength of the temporal filter libaom runs over the frames an alternate reference stands for:
     /// 0, no filtering (docs/design.md, "AV1 settings").
@@ -299,6 +326,7 @@ mod tests {
             let (deep_av1, deep_hevc) = plans(quality, at(Some(12)));
             // Exactly the plan a 12-bit encoding makes (the affine step does not depend on the
             // depth): a stream turned deep is the one `--bit-depth 12` codes.
+            let deep_av1 = deep_av1.at_depth_for(&widening);
             assert_eq!(av1.clone().at_depth_for(&widening), deep_av1, "{quality}");
             assert_eq!(hevc.clone().at_depth_for(&widening), deep_hevc, "{quality}");
             assert_eq!(av1.at_depth_for(&narrow), ten_av1, "{quality}");
@@ -313,6 +341,44 @@ mod tests {
         };
         let (fixed, _) = plans(50, fixed_qp);
         assert_eq!(fixed.clone().at_depth_for(&widening), fixed);
+    }
+
+    #[test]
+    fn twelve_bit_av1_trades_its_crf_for_the_room_the_residuals_leave() {
+        let quantiser_step = |plan: &RatePlan| {
+            let pictures = plan.pictures.as_ref().expect("pictures");
+            let crf = f64::from(pictures.quantiser);
+            f64::from(plan.step) * 2f64.powf(av1_log2_step(crf, pictures.depth))
+        };
+        for quality in [30, 60, 75, 90] {
+            let (deep, _) = plans(quality, at(Some(12)));
+            let (ten, _) = plans(quality, at(Some(10)));
+            let step = f64::from(deep.step);
+            // Residuals that fill 12-bit samples at the law's own pixel step keep it; ones that
+            // fill a quarter of them take a coarser `crf` over finer samples, at about 10-bit
+            // pictures' `crf` and the same quantiser step in model units.
+            let span = |levels: f64| vec![vec![[0.0f32; 3], [(levels * step) as f32, 0.0, 0.0]]];
+            let (own, none) = deep.clone().depth_choices(&span(4000.0));
+            let quantiser = |plan: &RatePlan| plan.pictures.as_ref().map(|p| p.quantiser);
+            assert_eq!((own.step, quantiser(&own)), (deep.step, quantiser(&deep)));
+            assert_eq!(none, None, "{quality}");
+            let (same, roomy) = deep.clone().depth_choices(&span(1000.0));
+            assert_eq!(same, own, "{quality}");
+            let roomy = roomy.expect("room for a coarser crf");
+            let (roomy_crf, ten_crf) = (roomy.pictures.as_ref(), ten.pictures.as_ref());
+            let (roomy_crf, ten_crf) = (roomy_crf.unwrap().quantiser, ten_crf.unwrap().quantiser);
+            assert!(roomy_crf.abs_diff(ten_crf) <= 1, "{quality}: {roomy_crf} {ten_crf}");
+            assert!(roomy.step < own.step && 4.0 * roomy.step >= own.step, "{quality}");
+            let ratio = quantiser_step(&roomy) / quantiser_step(&own);
+            assert!((ratio - 1.0).abs() < 1e-6, "{quality}: {ratio}");
+        }
+        // A `crf` the caller gave stays.
+        let fixed = DeepConfig {
+            qp: Some(7),
+            ..at(Some(12))
+        };
+        let (fixed, _) = plans(75, fixed);
+        assert_eq!(fixed.clone().at_depth_for(&[]), fixed);
     }
 
     #[test]

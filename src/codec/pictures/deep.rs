@@ -78,21 +78,27 @@ impl DeepConfig {
     }
 
     /// The plan of `rate` for `codec` on a first frame of bounding-box diagonal `diagonal`: the
-    /// depth ([`auto_depth`] unless given), `law`'s pixel step and quantiser at that depth, ranges
-    /// per group, [`deep_padding`], and the codec's `affine_precision` unless asked otherwise.
+    /// depth ([`auto_depth`] unless given), `laws`' pixel step and quantiser at that depth, ranges
+    /// per group, [`deep_padding`], and the codec's affine precision unless asked otherwise.
     pub(crate) fn plan(
         &self,
         codec: Codec,
-        (law, affine_precision): (fn(f64, u8) -> PictureLaw, f64),
+        laws: DeepLaws,
         rate: &Rate,
         diagonal: f64,
     ) -> Result<RatePlan> {
         let depth = self.depth_at(codec, rate.level());
         // Only the automatic depth may turn, and only at the law's quantiser: a quantiser the
-        // caller gave means one thing at one depth.
-        let deeper = (self.bit_depth.is_none() && self.qp.is_none() && depth < 12)
-            .then(|| law(rate.scale_percent(), 12));
-        let law = law(rate.scale_percent(), depth);
+        // caller gave means one thing at one depth. At 12 bits, the residuals pick among the
+        // codec's 12-bit laws where it has more than one.
+        let scale = rate.scale_percent();
+        let deeper = match (self.qp, depth) {
+            (None, 12) => Some((laws.deep)(scale)).filter(|laws| laws.len() > 1),
+            (None, _) if self.bit_depth.is_none() => Some((laws.deep)(scale)),
+            _ => None,
+        };
+        let affine_precision = laws.affine_precision;
+        let law = (laws.law)(scale, depth);
         let resolved = Resolved {
             codec,
             step_factor: law.step_factor,
@@ -101,10 +107,21 @@ impl DeepConfig {
             depth,
             padding: deep_padding(self.gop),
             affine_precision,
-            deeper,
+            deeper: deeper.unwrap_or_default(),
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }
+}
+
+/// What a quality means for one deep-sample codec.
+pub(crate) struct DeepLaws {
+    /// Its pixel step factor and quantiser at a quality's IJG scale (percent) and a sample depth.
+    pub law: fn(f64, u8) -> PictureLaw,
+    /// Its 12-bit laws at a quality's IJG scale: `law`'s own at 12 bits first, then any the coder
+    /// may take instead where the residuals leave room ([`super::depth::Deeper`]).
+    pub deep: fn(f64) -> Vec<PictureLaw>,
+    /// The affine maps' precision (over the residual step) it measured best.
+    pub affine_precision: f64,
 }
 
 /// The padding of HEVC's and AV1's geometry images with a key frame every `gop` frames.

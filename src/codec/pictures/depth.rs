@@ -43,49 +43,81 @@ pub(crate) fn auto_depth_at(codec: Codec, quality: f64) -> u8 {
     }
 }
 
-/// The 12-bit plan of an encoding whose automatic depth is 10 bits (HEVC and AV1 at the law's
-/// quantiser): the geometry-video coder codes these pictures when its residuals outgrow 10-bit
-/// samples at the pixel step, since a widened step is error the quality did not ask for and
-/// costs more bits at equal error than 12-bit samples do (docs/design.md, "Sample depth").
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The 12-bit pictures a plan may code, decided on its residuals ([`RatePlan::depth_choices`]):
+/// at the automatic depth's 10 bits (HEVC and AV1 at the law's quantiser), the pictures the
+/// geometry-video coder takes where its residuals outgrow 10-bit samples at the pixel step, since
+/// a widened step is error the quality did not ask for and costs more bits at equal error than
+/// 12-bit samples do; and the codec's other 12-bit laws, which the encoder tries where the
+/// residuals leave room for them (AV1's, `av1::av1_laws_12`; docs/design.md, "Sample depth").
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Deeper {
-    /// The codec's quantiser at 12 bits.
-    pub quantiser: u8,
-    /// The pixel step at 12 bits (the law's rest of the integer quantiser differs by depth).
-    pub step: f32,
+    /// The codec's quantiser and pixel step at 12 bits: the law's own first, then coarser
+    /// quantisers at finer pixel steps (the same quantiser step in model units).
+    pub rungs: Vec<(u8, f32)>,
+}
+
+impl Deeper {
+    /// The law's own rung.
+    fn own(&self) -> (u8, f32) {
+        self.rungs.first().copied().unwrap_or_default()
+    }
+
+    /// The rung of the coarsest quantiser whose pixel step is not finer than `unwidened` (the
+    /// finest step at which the residuals fit 12-bit samples), where that is not the law's own.
+    fn roomiest(&self, unwidened: f64) -> Option<(u8, f32)> {
+        let fits = |&&(_, step): &&(u8, f32)| f64::from(step) >= unwidened;
+        let rung = self.rungs.iter().skip(1).rev().find(fits);
+        rung.copied()
+    }
 }
 
 impl RatePlan {
-    /// This plan at the depth its pictures of `residuals` want: at the automatic depth's 10 bits
-    /// with a 12-bit alternative ([`Deeper`]), the 12-bit plan where 10-bit samples would widen a
-    /// group's step at the pixel step, else the 10-bit one; other plans as they are. The encoder
-    /// decides on the clip's residuals, every frame of them, before coding any.
-    pub(crate) fn at_depth_for(mut self, residuals: &[Vec<[f32; 3]>]) -> Self {
-        let Some(pictures) = self.pictures.as_mut() else {
-            return self;
-        };
-        let Some(deeper) = pictures.deeper.take() else {
-            return self;
-        };
-        let spread = quantise::spread(residuals, pictures.ranges(), self.step);
-        if f64::from(self.step) < quantise::unwidened_step(spread, pictures.depth) {
-            self.deepen(deeper);
-        }
-        self
+    /// This plan at the depth its pictures of `residuals` want ([`Self::depth_choices`]).
+    pub(crate) fn at_depth_for(self, residuals: &[Vec<[f32; 3]>]) -> Self {
+        self.depth_choices(residuals).0
     }
 
-    /// `deeper`'s 12-bit pictures in place of this plan's.
-    fn deepen(&mut self, deeper: Deeper) {
+    /// This plan at the depth its pictures of `residuals` want, and the other 12-bit plan the
+    /// encoder may code beside it. At the automatic depth's 10 bits with a 12-bit alternative
+    /// ([`Deeper`]), the 12-bit plan where 10-bit samples would widen a group's step at the pixel
+    /// step, else the 10-bit one; other plans as they are. At 12 bits with the law's quantiser,
+    /// also the codec's coarsest other 12-bit law the residuals leave room for (AV1's): the
+    /// encoder codes both and keeps the fewer bits at equal error. The encoder decides on the
+    /// clip's residuals, every frame of them, before coding any.
+    pub(crate) fn depth_choices(mut self, residuals: &[Vec<[f32; 3]>]) -> (Self, Option<Self>) {
+        let Some(pictures) = self.pictures.as_mut() else {
+            return (self, None);
+        };
+        let Some(deeper) = pictures.deeper.take() else {
+            return (self, None);
+        };
+        let spread = quantise::spread(residuals, pictures.ranges(), self.step);
+        let widens = f64::from(self.step) < quantise::unwidened_step(spread, pictures.depth);
+        if pictures.depth < 12 && !widens {
+            return (self, None);
+        }
+        self.deepen(deeper.own());
+        let roomiest = deeper.roomiest(quantise::unwidened_step(spread, 12));
+        let other = roomiest.map(|rung| {
+            let mut other = self.clone();
+            other.deepen(rung);
+            other
+        });
+        (self, other)
+    }
+
+    /// 12-bit pictures at `quantiser` and pixel step `step` in place of this plan's.
+    fn deepen(&mut self, (quantiser, step): (u8, f32)) {
         if let Some(pictures) = self.pictures.as_mut() {
             pictures.depth = 12;
-            pictures.quantiser = deeper.quantiser;
-            self.step = deeper.step;
+            pictures.quantiser = quantiser;
+            self.step = step;
         }
     }
 
     /// This plan as the set-up part `setup` of a stream of `vertices` vertices says its pictures
-    /// were coded: at the automatic depth, at the depth that stream took ([`Deeper`]), so that
-    /// the segments of a stream code what its analysis clip chose. Other plans stay as they are.
+    /// were coded: where the residuals decide ([`Deeper`]), at the depth and quantiser that stream
+    /// took, so that the segments of a stream code what its analysis clip chose. Other plans stay as they are.
     pub(crate) fn pinned_to(mut self, setup: &[u8], vertices: u32) -> Result<Self> {
         let Some(pictures) = self.pictures.as_mut() else {
             return Ok(self);
@@ -93,8 +125,10 @@ impl RatePlan {
         let Some(deeper) = pictures.deeper.take() else {
             return Ok(self);
         };
-        if PictureSetup::from_bytes(setup, vertices)?.depth == 12 {
-            self.deepen(deeper);
+        let setup = PictureSetup::from_bytes(setup, vertices)?;
+        let taken = deeper.rungs.iter().find(|rung| rung.0 == setup.quantiser);
+        if let (12, Some(&rung)) = (setup.depth, taken) {
+            self.deepen(rung);
         }
         Ok(self)
     }

@@ -18,7 +18,7 @@
 //! The stream's codec set-up part holds the sample depth and the planes (one byte each), which the
 //! decoder needs before any picture (the depth to read the residual ranges).
 
-use super::deep::DeepConfig;
+use super::deep::{DeepConfig, DeepLaws};
 use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::Result;
@@ -39,11 +39,12 @@ pub(crate) fn check(config: &DeepConfig) -> Result<()> {
 /// maps at [`AFFINE_PRECISION`] of the residual step in P-frame groups too
 /// (docs/design.md, "Affine precision per codec").
 pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
-    let law = (
-        hevc_law_at as fn(f64, u8) -> PictureLaw,
-        AFFINE_PRECISION,
-    );
-    config.plan(Codec::Hevc, law, rate, diagonal)
+    let laws = DeepLaws {
+        law: hevc_law_at,
+        deep: |scale| vec![hevc_law_at(scale, 12)],
+        affine_precision: AFFINE_PRECISION,
+    };
+    config.plan(Codec::Hevc, laws, rate, diagonal)
 }
 
 /// HEVC's law at 10 bits a sample: a pixel step of [`HEVC_STEP_FACTOR`] × the target step and the

@@ -142,7 +142,7 @@ impl JpegConfig {
             depth: 8,
             padding: padding::Method::Snap,
             affine_precision: AFFINE_PRECISION,
-            deeper: None,
+            deeper: Vec::new(),
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }

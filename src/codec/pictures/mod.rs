@@ -99,8 +99,9 @@ pub(crate) struct PicturePlan {
     pub padding: padding::Method,
     /// The lattice option.
     pub lattice: Lattice,
-    /// At the automatic depth, where it is 10 bits: the 12-bit pictures the coder takes instead
-    /// when 10-bit samples would widen a group's step ([`Deeper`]).
+    /// The 12-bit pictures the coder takes by the residuals ([`Deeper`]): at the automatic depth
+    /// at 10 bits, where 10-bit samples would widen a group's step; at 12 bits, the law the
+    /// residuals leave room for.
     pub deeper: Option<Deeper>,
 }
 
@@ -132,8 +133,9 @@ pub(crate) struct Resolved {
     pub padding: padding::Method,
     /// The affine precision the codec measured best, unless the caller asks another.
     pub affine_precision: f64,
-    /// The 12-bit law of an automatic depth at 10 bits ([`Deeper`]).
-    pub deeper: Option<PictureLaw>,
+    /// The 12-bit laws the residuals choose from ([`Deeper`]), the law's own first; none where
+    /// the plan is fixed.
+    pub deeper: Vec<PictureLaw>,
 }
 
 /// The rate plan of a picture codec: its pixel step from the law's factor, the lattice and
@@ -145,13 +147,12 @@ pub(crate) fn plan(
     resolved: Resolved,
 ) -> Result<RatePlan> {
     let step = rate.stored_step("pixel step", diagonal, resolved.step_factor)?;
-    let deeper = match resolved.deeper {
-        Some(law) => Some(Deeper {
-            quantiser: law.quantiser,
-            step: rate.stored_step("pixel step", diagonal, law.step_factor)?,
-        }),
-        None => None,
-    };
+    let rungs = resolved.deeper.iter().map(|law| {
+        let step = rate.stored_step("pixel step", diagonal, law.step_factor)?;
+        Ok((law.quantiser, step))
+    });
+    let rungs = rungs.collect::<Result<Vec<_>>>()?;
+    let deeper = (!rungs.is_empty()).then_some(Deeper { rungs });
     let plan = PicturePlan {
         codec: resolved.codec,
         quantiser: resolved.quantiser,

@@ -68,7 +68,7 @@ impl Mpeg4Config {
                 1 => 1.0 / 16.0,
                 _ => super::p_frame_affine_precision(rate),
             },
-            deeper: None,
+            deeper: Vec::new(),
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }
