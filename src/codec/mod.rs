@@ -236,8 +236,8 @@ impl Codec {
     /// The residual encoder of `plan` (a plan of this codec).
     #[cfg(feature = "encode")]
     pub(crate) fn encoder(self, plan: &RatePlan) -> Result<Box<dyn ResidualEncoder>> {
-        // The automatic depth is decided before coding (`RatePlan::at_depth_for`, `pinned_to`):
-        // an open 12-bit alternative here would be coded at 10 bits unasked.
+        // The depth and 12-bit law are decided before coding (`RatePlan::depth_choices`,
+        // `pinned_to`): a plan still open here would code its first choice unasked.
         debug_assert!(
             plan.pictures.as_ref().is_none_or(|p| p.deeper.is_none()),
             "a picture plan whose depth is still open"

@@ -11,7 +11,8 @@
 //!
 //! `cpu-used` `CPU_USED` trades compression for speed (docs/design.md, "AV1 settings").
 
-use super::deep::{DeepConfig, DeepLaws};
+use super::deep::DeepConfig;
+use super::depth::DeepLaws;
 use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::Result;
@@ -35,9 +36,13 @@ pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<Ra
         1 => DEFAULT_AFFINE_PRECISION,
         _ => super::p_frame_affine_precision(rate),
     };
+    // The two splits were measured with P-frames only (all-intra streams: `qmin` changed none).
     let laws = DeepLaws {
         law: av1_law_at,
-        deep: av1_laws_12,
+        deep: match config.gop {
+            1 => |scale| vec![av1_law_at(scale, 12)],
+            _ => av1_laws_12,
+        },
         affine_precision,
     };
     config.plan(Codec::Av1, laws, rate, diagonal)
@@ -372,13 +377,23 @@ mod tests {
             let ratio = quantiser_step(&roomy) / quantiser_step(&own);
             assert!((ratio - 1.0).abs() < 1e-6, "{quality}: {ratio}");
         }
-        // A `crf` the caller gave stays.
+        // A `crf` the caller gave stays; so do all-intra pictures (measured with P-frames only)
+        // and a pixel step the caller gave (the coarser laws would keep it, coarsening the
+        // quantiser step).
         let fixed = DeepConfig {
             qp: Some(7),
             ..at(Some(12))
         };
         let (fixed, _) = plans(75, fixed);
         assert_eq!(fixed.clone().at_depth_for(&[]), fixed);
+        let (intra, _) = plans(75, DeepConfig { gop: 1, ..at(Some(12)) });
+        assert!(intra.pictures.as_ref().is_some_and(|p| p.deeper.is_none()));
+        let given_step = Rate {
+            step: Some(1e-3),
+            ..rate(75)
+        };
+        let given = plan(&at(Some(12)), &given_step, 1.0).unwrap();
+        assert!(given.pictures.as_ref().is_some_and(|p| p.deeper.is_none()));
     }
 
     #[test]

@@ -11,9 +11,9 @@
 #[cfg(any(test, feature = "internals"))]
 pub use super::depth::auto_depth;
 pub use super::depth::{deeper_from_quality, DEPTHS};
-use super::depth::auto_depth_at;
+use super::depth::{auto_depth_at, DeepLaws};
 use super::{PictureOptions, Resolved, DEFAULT_GOP};
-use crate::codec::rate::{PictureLaw, Rate, RatePlan};
+use crate::codec::rate::{Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::{Error, Result};
 
@@ -89,12 +89,17 @@ impl DeepConfig {
     ) -> Result<RatePlan> {
         let depth = self.depth_at(codec, rate.level());
         // Only the automatic depth may turn, and only at the law's quantiser: a quantiser the
-        // caller gave means one thing at one depth. At 12 bits, the residuals pick among the
-        // codec's 12-bit laws where it has more than one.
+        // caller gave means one thing at one depth. At 12 bits the residuals pick among the
+        // codec's 12-bit laws where it has more than one, unless the caller gave the pixel step
+        // (the laws' other steps would not be taken: a coarser quantiser over the same samples).
         let scale = rate.scale_percent();
+        let deep = |scale| match rate.step {
+            Some(_) => vec![(laws.law)(scale, 12)],
+            None => (laws.deep)(scale),
+        };
         let deeper = match (self.qp, depth) {
-            (None, 12) => Some((laws.deep)(scale)).filter(|laws| laws.len() > 1),
-            (None, _) if self.bit_depth.is_none() => Some((laws.deep)(scale)),
+            (None, 12) => Some(deep(scale)).filter(|laws| laws.len() > 1),
+            (None, _) if self.bit_depth.is_none() => Some(deep(scale)),
             _ => None,
         };
         let affine_precision = laws.affine_precision;
@@ -111,17 +116,6 @@ impl DeepConfig {
         };
         super::plan(rate, diagonal, &self.pictures, resolved)
     }
-}
-
-/// What a quality means for one deep-sample codec.
-pub(crate) struct DeepLaws {
-    /// Its pixel step factor and quantiser at a quality's IJG scale (percent) and a sample depth.
-    pub law: fn(f64, u8) -> PictureLaw,
-    /// Its 12-bit laws at a quality's IJG scale: `law`'s own at 12 bits first, then any the coder
-    /// may take instead where the residuals leave room ([`super::depth::Deeper`]).
-    pub deep: fn(f64) -> Vec<PictureLaw>,
-    /// The affine maps' precision (over the residual step) it measured best.
-    pub affine_precision: f64,
 }
 
 /// The padding of HEVC's and AV1's geometry images with a key frame every `gop` frames.

@@ -1,10 +1,10 @@
 //! The sample depth of HEVC's and AV1's pictures: 10 or 12 bits, from the quality and, below
-//! the codec's threshold, from the residuals — a plan carries its 12-bit alternative ([`Deeper`]),
-//! which the encoder takes where the clip's residuals would widen a group's step in 10-bit
-//! samples (docs/design.md, "Sample depth").
+//! the codec's threshold, from the residuals — a plan carries its 12-bit laws ([`Deeper`]): the
+//! encoder takes them where the clip's residuals would widen a group's step in 10-bit samples,
+//! and codes AV1's second split where they leave room (docs/design.md, "Sample depth").
 
 use super::setup::PictureSetup;
-use crate::codec::rate::RatePlan;
+use crate::codec::rate::{PictureLaw, RatePlan};
 use crate::codec::Codec;
 use crate::error::Result;
 use crate::geometry_image::quantise;
@@ -41,6 +41,17 @@ pub(crate) fn auto_depth_at(codec: Codec, quality: f64) -> u8 {
     } else {
         10
     }
+}
+
+/// What a quality means for one deep-sample codec.
+pub(crate) struct DeepLaws {
+    /// Its pixel step factor and quantiser at a quality's IJG scale (percent) and a sample depth.
+    pub law: fn(f64, u8) -> PictureLaw,
+    /// Its 12-bit laws at a quality's IJG scale: `law`'s own at 12 bits first, then any the coder
+    /// may take instead where the residuals leave room ([`Deeper`]).
+    pub deep: fn(f64) -> Vec<PictureLaw>,
+    /// The affine maps' precision (over the residual step) it measured best.
+    pub affine_precision: f64,
 }
 
 /// The 12-bit pictures a plan may code, decided on its residuals ([`RatePlan::depth_choices`]):
@@ -116,8 +127,9 @@ impl RatePlan {
     }
 
     /// This plan as the set-up part `setup` of a stream of `vertices` vertices says its pictures
-    /// were coded: where the residuals decide ([`Deeper`]), at the depth and quantiser that stream
-    /// took, so that the segments of a stream code what its analysis clip chose. Other plans stay as they are.
+    /// were coded: where the residuals decide ([`Deeper`]), at the depth and quantiser that
+    /// stream took (the law's own at 12 bits where no law has that quantiser), so that the
+    /// segments of a stream code what its analysis clip chose. Other plans stay as they are.
     pub(crate) fn pinned_to(mut self, setup: &[u8], vertices: u32) -> Result<Self> {
         let Some(pictures) = self.pictures.as_mut() else {
             return Ok(self);
@@ -127,8 +139,8 @@ impl RatePlan {
         };
         let setup = PictureSetup::from_bytes(setup, vertices)?;
         let taken = deeper.rungs.iter().find(|rung| rung.0 == setup.quantiser);
-        if let (12, Some(&rung)) = (setup.depth, taken) {
-            self.deepen(rung);
+        if setup.depth == 12 {
+            self.deepen(taken.copied().unwrap_or(deeper.own()));
         }
         Ok(self)
     }

@@ -18,7 +18,8 @@
 //! The stream's codec set-up part holds the sample depth and the planes (one byte each), which the
 //! decoder needs before any picture (the depth to read the residual ranges).
 
-use super::deep::{DeepConfig, DeepLaws};
+use super::deep::DeepConfig;
+use super::depth::DeepLaws;
 use crate::codec::rate::{ijg_scale_percent, PictureLaw, Rate, RatePlan};
 use crate::codec::Codec;
 use crate::error::Result;
