@@ -73,8 +73,7 @@ pub(super) fn settle(
     let whole = |(b, at): (Best, usize), clock: Stopwatch| -> Result<Whole> {
         let model = models[b.index];
         let encoded = keep(shared, model, b.kept, progress, clock)?;
-        let rmse = distortion::vertex_rmse(shared.mesh, &encoded)?;
-        let cost = distortion::cost(8.0 * encoded.report.bytes as f64, Some(rmse));
+        let (cost, rmse) = distortion::whole_cost(shared.mesh, &encoded)?;
         Ok(Whole {
             encoded,
             model,

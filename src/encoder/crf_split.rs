@@ -53,13 +53,7 @@ pub(super) fn code(
     // The bar has counted the clip's frames once: the second coding shows as a stage of its own.
     progress.stage("12-bit pictures at a coarser crf");
     let roomy = coded(&other, leading, &Silent, clock)?;
-    let cost = |encoded: &Encoded| -> Result<f64> {
-        let rmse = distortion::vertex_rmse(mesh, encoded)?;
-        Ok(distortion::cost(
-            8.0 * encoded.report.bytes as f64,
-            Some(rmse),
-        ))
-    };
+    let cost = |encoded: &Encoded| distortion::whole_cost(mesh, encoded).map(|(cost, _)| cost);
     let mut kept = match cost(&roomy)? < cost(&own)? {
         true => roomy,
         false => own,

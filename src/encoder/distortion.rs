@@ -22,6 +22,13 @@ use crate::metrics;
 /// (docs/design.md, "Automatic choice: bits at equal error").
 pub const RD_SLOPE: f64 = 2.0;
 
+/// The vertex RMSE of a whole encoding of `mesh` ([`vertex_rmse`]) and its [`cost`]: what two
+/// encodings coded whole are compared by.
+pub fn whole_cost(mesh: &AnimatedMesh, encoded: &Encoded) -> Result<(f64, f64)> {
+    let rmse = vertex_rmse(mesh, encoded)?;
+    Ok((cost(8.0 * encoded.report.bytes as f64, Some(rmse)), rmse))
+}
+
 /// RMS distance over frames and vertices between `mesh` (in the stream's vertex order) and
 /// `encoded` as the decoder reconstructs it, in model units ([`metrics::vertex_errors`], what
 /// `eval` reports as vertex RMSE before normalising).

@@ -39,10 +39,7 @@ pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<Ra
     // The two splits were measured with P-frames only (all-intra streams: `qmin` changed none).
     let laws = DeepLaws {
         law: av1_law_at,
-        deep: match config.gop {
-            1 => |scale| vec![av1_law_at(scale, 12)],
-            _ => av1_laws_12,
-        },
+        coarser_12: (config.gop > 1).then_some(av1_coarser_laws_12),
         affine_precision,
     };
     config.plan(Codec::Av1, laws, rate, diagonal)
@@ -159,17 +156,16 @@ pub(crate) fn av1_law_at(scale_percent: f64, depth: u8) -> PictureLaw {
     }
 }
 
-/// AV1's 12-bit laws at the IJG scale `scale_percent` of a quality: [`av1_law_at`]'s, then each
-/// coarser `crf` up to the one whose step is 4 × its step (two bits of headroom; at most
-/// [`AV1_MAX_QP`]) at a pixel step as much finer, the same quantiser step in model units. Where
+/// AV1's other 12-bit laws beside `own`, [`av1_law_at`]'s at 12 bits: each coarser `crf` up to
+/// the one whose step is 4 × its step (two bits of headroom; at most [`AV1_MAX_QP`]) at a pixel
+/// step as much finer, the same quantiser step in model units. Where
 /// the residuals leave room in 12-bit samples, the encoder codes the coarsest beside the law's own
 /// and keeps the fewer bits at equal error ([`RatePlan::depth_choices`]): at the law's low `crf`
 /// libaom's finer quantisers for key frames and alternate references stop at `qmin`, which cost
 /// the small glTF characters up to 67 % more bits than 10-bit pictures at quality 90 (Fox), while
 /// the larger meshes gain up to 38 % there; over finer samples the coarser `crf` codes them as
 /// 10-bit pictures with two more bits of range (docs/design.md, "Sample depth").
-pub(crate) fn av1_laws_12(scale_percent: f64) -> Vec<PictureLaw> {
-    let own = av1_law_at(scale_percent, 12);
+pub(crate) fn av1_coarser_laws_12(own: PictureLaw) -> Vec<PictureLaw> {
     let own_step = av1_log2_step(f64::from(own.quantiser), 12);
     let coarsest = av1_crf_of(own_step + 2.0, 12)
         .floor()
@@ -178,7 +174,7 @@ pub(crate) fn av1_laws_12(scale_percent: f64) -> Vec<PictureLaw> {
         step_factor: own.step_factor * 2f64.powf(own_step - av1_log2_step(f64::from(crf), 12)),
         quantiser: crf,
     });
-    std::iter::once(own).chain(coarser).collect()
+    coarser.collect()
 }
 
 /// libaom as a [`deep::Flavour`].

@@ -93,13 +93,15 @@ impl DeepConfig {
         // codec's 12-bit laws where it has more than one, unless the caller gave the pixel step
         // (the laws' other steps would not be taken: a coarser quantiser over the same samples).
         let scale = rate.scale_percent();
-        let deep = |scale| match rate.step {
-            Some(_) => vec![(laws.law)(scale, 12)],
-            None => (laws.deep)(scale),
+        let laws_12 = || {
+            let own = (laws.law)(scale, 12);
+            let coarser = laws.coarser_12.filter(|_| rate.step.is_none());
+            let coarser = coarser.map_or_else(Vec::new, |coarser| coarser(own));
+            std::iter::once(own).chain(coarser).collect::<Vec<_>>()
         };
         let deeper = match (self.qp, depth) {
-            (None, 12) => Some(deep(scale)).filter(|laws| laws.len() > 1),
-            (None, _) if self.bit_depth.is_none() => Some(deep(scale)),
+            (None, 12) => Some(laws_12()).filter(|laws| laws.len() > 1),
+            (None, _) if self.bit_depth.is_none() => Some(laws_12()),
             _ => None,
         };
         let affine_precision = laws.affine_precision;

@@ -47,9 +47,9 @@ pub(crate) fn auto_depth_at(codec: Codec, quality: f64) -> u8 {
 pub(crate) struct DeepLaws {
     /// Its pixel step factor and quantiser at a quality's IJG scale (percent) and a sample depth.
     pub law: fn(f64, u8) -> PictureLaw,
-    /// Its 12-bit laws at a quality's IJG scale: `law`'s own at 12 bits first, then any the coder
-    /// may take instead where the residuals leave room ([`Deeper`]).
-    pub deep: fn(f64) -> Vec<PictureLaw>,
+    /// Its other 12-bit laws beside `law`'s own at 12 bits, made from that one, which the coder
+    /// may take instead where the residuals leave room ([`Deeper`]); `None`: the own alone.
+    pub coarser_12: Option<fn(PictureLaw) -> Vec<PictureLaw>>,
     /// The affine maps' precision (over the residual step) it measured best.
     pub affine_precision: f64,
 }
@@ -59,7 +59,7 @@ pub(crate) struct DeepLaws {
 /// geometry-video coder takes where its residuals outgrow 10-bit samples at the pixel step, since
 /// a widened step is error the quality did not ask for and costs more bits at equal error than
 /// 12-bit samples do; and the codec's other 12-bit laws, which the encoder tries where the
-/// residuals leave room for them (AV1's, `av1::av1_laws_12`; docs/design.md, "Sample depth").
+/// residuals leave room for them (AV1's, `av1::av1_coarser_laws_12`; docs/design.md, "Sample depth").
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Deeper {
     /// The codec's quantiser and pixel step at 12 bits: the law's own first, then coarser

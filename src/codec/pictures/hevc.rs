@@ -42,7 +42,7 @@ pub(crate) fn check(config: &DeepConfig) -> Result<()> {
 pub(crate) fn plan(config: &DeepConfig, rate: &Rate, diagonal: f64) -> Result<RatePlan> {
     let laws = DeepLaws {
         law: hevc_law_at,
-        deep: |scale| vec![hevc_law_at(scale, 12)],
+        coarser_12: None,
         affine_precision: AFFINE_PRECISION,
     };
     config.plan(Codec::Hevc, laws, rate, diagonal)
