@@ -135,7 +135,8 @@ pub struct InputArgs {
 pub struct EncodeArgs {
     /// Input animation: a folder or glob of .obj files, a .pc2 (with --base), or a .gltf/.glb.
     pub input: String,
-    /// Output .mcgv file, or `-` for stdout. Missing parent folders are created.
+    /// Output .mcgv file, or `-` for stdout. Missing parent folders are created. A folder or a
+    /// mesh's name (.glb, .gltf, .obj, .pc2) is refused: those are what `decode` writes.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Replace the output file if it exists.

@@ -241,8 +241,38 @@ fn check_output(args: &EncodeArgs, read: &ReadOptions, output: &Path) -> Result<
     if output.as_os_str() == "-" {
         return Ok(());
     }
+    refuse_mesh_name(output)?;
     crate::staging::Inputs::of(&[&args.input], read).refuse(output)?;
     crate::staging::check_file(output, args.force)
+}
+
+/// `encode` writes one stream file. An output named as a folder (`out/`) or as an animation
+/// (`walk.glb`, `walk.obj`, `walk.pc2`) is a slip for `decode` or `convert`, or a missing file
+/// name: refused before any work instead of an `.mcgv` stream under a mesh's name, or a failure
+/// to write once the encode is done.
+fn refuse_mesh_name(output: &Path) -> Result<()> {
+    let text = output.to_string_lossy();
+    if text.ends_with('/') || text.ends_with(std::path::MAIN_SEPARATOR) {
+        return Err(Error::option(
+            "output",
+            format!("{text} names a folder; encode writes one stream file: name it, e.g. {text}walk.mcgv"),
+        ));
+    }
+    let extension = output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match extension.as_deref() {
+        Some(mesh @ ("glb" | "gltf" | "obj" | "pc2")) => Err(Error::option(
+            "output",
+            format!(
+                "{}: encode writes an .mcgv stream, not a .{mesh}; name the output {}, and \
+                 `mcgv-video decode` it to a .{mesh}",
+                output.display(),
+                output.with_extension("mcgv").display()
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// One distinct output per clip. Cleaned names can clash (two unnamed clips named by index beside

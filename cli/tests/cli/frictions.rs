@@ -427,3 +427,23 @@ fn f10_inspect_pictures_are_labelled() {
     .unwrap()
     .contains("model units"));
 }
+
+#[test]
+fn f11_encode_to_a_mesh_name_or_a_folder_is_refused_before_any_work() {
+    let d = tempfile::tempdir().unwrap();
+    let sample = media_path("RiggedSimple.glb");
+    for name in ["walk.glb", "walk.OBJ", "walk.pc2", "walk.gltf"] {
+        let out_path = d.path().join(name);
+        let out = run(&["encode", &sample, "-o", out_path.to_str().unwrap(), "-q"]);
+        fails(
+            &out,
+            2,
+            &["encode writes an .mcgv stream", "walk.mcgv", "decode"],
+        );
+        assert!(!out_path.exists(), "{name} was written");
+    }
+    let folder = format!("{}/", d.path().join("frames").display());
+    let out = run(&["encode", &sample, "-o", &folder, "-q"]);
+    fails(&out, 2, &["names a folder", "walk.mcgv"]);
+    assert_eq!(file_names(d.path()), Vec::<String>::new());
+}
