@@ -12,8 +12,9 @@ use crate::stream::bytes::{ByteReader, ByteWriter};
 
 /// The version of the set-up part this build writes and reads (2: the ranges part entropy-coded,
 /// `geometry_image::range_coding`; 3: lattice coordinates guessed from the nearest group of
-/// coded neighbours, `stream::lattice_coding`).
-const VERSION: u8 = 3;
+/// coded neighbours, `stream::lattice_coding`; 4: a guessed vertex coded as its rank among the free
+/// pixels around the guess).
+const VERSION: u8 = 4;
 
 /// A geometry-video stream's set-up.
 #[derive(Debug, Clone, PartialEq)]
