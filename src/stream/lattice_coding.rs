@@ -16,6 +16,7 @@
 //! guessed from the nearest group of neighbours").
 
 use crate::error::{Error, Result};
+use crate::geometry_image::lattice;
 use crate::mesh::topology::VertexAdjacency;
 use crate::mesh::Triangle;
 use crate::stream::entropy::{
@@ -93,7 +94,8 @@ impl Occupancy {
     }
 }
 
-/// Ranks plus one below this are symbols of their own; the last symbol stands for the rest.
+/// Coded ranks (a rank plus one, 0 for an escape) below `RANKED_SYMBOLS - 1` are symbols of
+/// their own (ranks 0 to 29); the last symbol stands for the rest, followed by the remainder.
 const RANKED_SYMBOLS: usize = 32;
 
 /// The models of a rank: its symbol, and what lies beyond the last.
@@ -199,10 +201,13 @@ fn code_difference<C: SymbolCoder>(
 fn code_rank<C: SymbolCoder>(c: &mut C, value: u64, models: &mut RankModels) -> Result<u64> {
     let last = RANKED_SYMBOLS as u64 - 1;
     let symbol = c.symbol(value.min(last) as usize, &mut models.0)? as u64;
-    match symbol {
-        s if s < last => Ok(s),
-        _ => Ok(last + c.unsigned(value.saturating_sub(last), &mut models.1)?),
+    if symbol < last {
+        return Ok(symbol);
     }
+    // A forged remainder may be any u64: past the spiral, it is refused by the caller's `nth`.
+    let beyond = c.unsigned(value.saturating_sub(last), &mut models.1)?;
+    last.checked_add(beyond)
+        .ok_or_else(|| Error::Stream("lattice coordinates: a rank past any lattice".into()))
 }
 
 /// Codes `own` as its rank among the free pixels around `guess` (plus one), or 0 and the escaped
@@ -215,7 +220,8 @@ fn code_ranked<C: SymbolCoder>(
     (spiral, taken): (&Spiral, &Occupancy),
 ) -> Result<[i64; 2]> {
     let rank = own.and_then(|own| spiral.free(guess, taken).position(|p| p == own));
-    let coded = code_rank(c, rank.map_or(0, |r| r as u64 + 1), &mut models.rank[usize::from(several)])?;
+    let model = &mut models.rank[usize::from(several)];
+    let coded = code_rank(c, rank.map_or(0, |r| r as u64 + 1), model)?;
     if coded == 0 {
         let axes = match several {
             false => &mut models.single,
@@ -283,13 +289,15 @@ pub fn encode_lattice(
     enc.finish()
 }
 
-/// Decodes `vertices` lattice pixels inside a `size` lattice.
+/// Decodes `vertices` lattice pixels inside a `size` lattice (one the stream can carry: at most
+/// [`lattice::MAX_LATTICE_SIDE`] a side, since the decoder keeps a bit per pixel).
 pub fn decode_lattice(
     bytes: &[u8],
     vertices: usize,
     size: (u16, u16),
     triangles: &[Triangle],
 ) -> Result<Vec<[u16; 2]>> {
+    lattice::check(size.0, size.1)?;
     entropy::check_capacity(2 * vertices as u64, bytes.len(), "lattice coordinates")?;
     let adj = VertexAdjacency::new(vertices, triangles);
     let mut dec = Decoder::new(bytes)?;
@@ -338,7 +346,7 @@ mod tests {
         assert_eq!(nearest(&[[0, 0], [10, 10], [3, 3]], [4, 4]), 2);
     }
 
-    /// A grid of `columns × rows` vertices cut into triangles, vertex (x, y) at pixel `place(x, y)`.
+    /// A grid of `columns × rows` vertices cut into triangles, (x, y) at pixel `place(x, y)`.
     fn quads(
         (columns, rows): (u32, u32),
         place: impl Fn(u32, u32) -> [u16; 2],

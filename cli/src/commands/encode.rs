@@ -204,6 +204,10 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
             "cannot share stdout with the stream of -o -; write the stream to a file",
         ));
     }
+    if !to_stdout {
+        // The name given, not each clip's name made of it (`--clip all`).
+        refuse_mesh_name(&args.output)?;
+    }
     if read_options.clip.as_deref() != Some("all") {
         check_output(args, &read_options, &args.output)?;
         let encoded = encode_one(args, &opts, &read_options, quiet)?;
@@ -241,7 +245,6 @@ fn check_output(args: &EncodeArgs, read: &ReadOptions, output: &Path) -> Result<
     if output.as_os_str() == "-" {
         return Ok(());
     }
-    refuse_mesh_name(output)?;
     crate::staging::Inputs::of(&[&args.input], read).refuse(output)?;
     crate::staging::check_file(output, args.force)
 }
@@ -255,7 +258,10 @@ fn refuse_mesh_name(output: &Path) -> Result<()> {
     if text.ends_with('/') || text.ends_with(std::path::MAIN_SEPARATOR) {
         return Err(Error::option(
             "output",
-            format!("{text} names a folder; encode writes one stream file: name it, e.g. {text}walk.mcgv"),
+            format!(
+                "{text} names a folder; encode writes one stream file: name it, e.g. \
+                 {text}walk.mcgv"
+            ),
         ));
     }
     let extension = output
