@@ -205,7 +205,9 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
         ));
     }
     if !to_stdout {
-        // The name given, not each clip's name made of it (`--clip all`).
+        // The name given, not each clip's name made of it (`--clip all`); an input named as the
+        // output is the graver slip, so it is the one reported.
+        crate::staging::Inputs::of(&[&args.input], &read_options).refuse(&args.output)?;
         refuse_mesh_name(&args.output)?;
     }
     if read_options.clip.as_deref() != Some("all") {
