@@ -17,8 +17,9 @@ use std::path::Path;
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
-/// The container version this build writes and reads: 12, the frame index entropy-coded and a
-/// part's length in 4 bytes (issue 35; 11: a translation's trajectory may follow
+/// The container version this build writes and reads: 13, a missed partition label named among
+/// the neighbours' other labels and its hit bit in contexts of their agreement (issue 35; 12: the
+/// frame index entropy-coded and a part's length in 4 bytes; 11: a translation's trajectory may follow
 /// its reference cluster's whole map at its own centroid; 10: the first frame's version 4, a kept
 /// vertex order names the free corners of the triangles last used, escapes by rank among the free
 /// vertices; issue 35; 9: the first frame's version 3, a copy per corner said at once, seams cut
@@ -29,7 +30,7 @@ pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 /// header holds what every codec shares and each codec its own fields in its set-up part;
 /// docs/history.md lists the versions).
 /// A reader refuses any other version, so an older reader says "update" instead of misreading.
-pub const VERSION: u16 = 12;
+pub const VERSION: u16 = 13;
 
 /// Bytes of a part header: tag (4), checksum kind (1), payload length (`u32`: 4), CRC (4). Until
 /// container version 11 the length took 8 bytes; a part of 4 GiB or more is refused when added

@@ -43,41 +43,101 @@ fn predicted_label(
         .map(|&(l, _)| l)
 }
 
+/// How far `guess` is the neighbours' verdict: how many labels the coded neighbours carry (0, 1, 2,
+/// 3 or more) and whether the guess is all of them, most of them or fewer; a vertex among
+/// neighbours of one label almost always shares it, one on a border often does not.
+fn agreement(counts: &[(u32, u32)], guess: u32) -> (usize, usize) {
+    let total: u32 = counts.iter().map(|&(_, n)| n).sum();
+    let votes = counts.iter().find(|&&(l, _)| l == guess).map_or(0, |&(_, n)| n);
+    let share = match votes {
+        n if n > 0 && n == total => 2,
+        n if 2 * n > total => 1,
+        _ => 0,
+    };
+    (counts.len().min(3), share)
+}
+
+/// Other labels a missed guess is tried against: the neighbours' other labels, commonest first
+/// (lowest on ties), at most [`MISS_CANDIDATES`].
+const MISS_CANDIDATES: usize = 4;
+
+/// The adaptive models of the partition part.
+struct PartitionModels {
+    /// Whether the guess is right, by kind of guess and [`agreement`].
+    hit: [[[BitModel; 3]; 4]; 3],
+    /// Which of n candidates a missed label is, or n for none (`candidate[n - 1]`).
+    candidate: Vec<SymbolModel>,
+    /// A label that is no candidate: up to 256 clusters a symbol, more an integer.
+    small: SymbolModel,
+    large: UIntModel,
+}
+
+/// Codes a label that is not `guess` (the encoder's `label`) as one of `candidates` or, failing
+/// that, in full; the decoder refuses a full label that a shorter code would have named.
+fn code_missed_label<C: SymbolCoder>(
+    c: &mut C,
+    (label, guess, v): (u32, u32, usize),
+    candidates: &[u32],
+    clusters: usize,
+    models: &mut PartitionModels,
+) -> Result<u32> {
+    if let Some(model) = candidates.len().checked_sub(1).map(|n| &mut models.candidate[n]) {
+        let k = candidates.iter().position(|&l| l == label);
+        let k = c.symbol(k.unwrap_or(candidates.len()), model)?;
+        if let Some(&l) = candidates.get(k) {
+            return Ok(l);
+        }
+    }
+    let l = if clusters <= 256 {
+        c.symbol(label as usize, &mut models.small)? as u64
+    } else {
+        c.unsigned(u64::from(label), &mut models.large)?
+    };
+    let named = l == u64::from(guess) || candidates.iter().any(|&x| u64::from(x) == l);
+    if l >= clusters as u64 || named {
+        return Err(Error::Stream(format!(
+            "partition: vertex {v} has an impossible label"
+        )));
+    }
+    Ok(l as u32)
+}
+
 /// Labels are guessed, in this order of trust, from the vertex's first copy at its first-frame
 /// position (a seam or hard-edge copy moves with it), its already-coded neighbours' commonest
-/// label, or the previous vertex's; one hit bit per vertex, a context per kind of guess.
+/// label, or the previous vertex's; one hit bit per vertex, a context per kind of guess and
+/// [`agreement`] (container version 13). A miss names one of the neighbours' other labels, or
+/// the label in full.
 fn code_partition<C: SymbolCoder>(
     c: &mut C,
     labels: &mut [u32],
     clusters: usize,
     (adj, coincident): (&VertexAdjacency, &[Option<u32>]),
 ) -> Result<()> {
-    let mut hit: [BitModel; 3] = Default::default();
-    let mut small = SymbolModel::new(clusters);
-    let mut large = UIntModel::default();
-    let mut counts = Vec::new();
+    let mut models = PartitionModels {
+        hit: Default::default(),
+        candidate: (1..=MISS_CANDIDATES).map(|n| SymbolModel::new(n + 1)).collect(),
+        small: SymbolModel::new(clusters),
+        large: UIntModel::default(),
+    };
+    let (mut counts, mut candidates) = (Vec::new(), Vec::with_capacity(MISS_CANDIDATES));
     for v in 0..labels.len() {
         let copy_of = coincident.get(v).copied().flatten();
-        let (ctx, guess) = match (copy_of, predicted_label(adj, labels, v, &mut counts)) {
+        let (kind, guess) = match (copy_of, predicted_label(adj, labels, v, &mut counts)) {
             (Some(f), _) => (2, labels[f as usize]),
             (None, Some(l)) => (0, l),
             (None, None) => (1, if v > 0 { labels[v - 1] } else { 0 }),
         };
-        if c.bit(labels[v] == guess, &mut hit[ctx])? {
+        let (distinct, share) = agreement(&counts, guess);
+        if c.bit(labels[v] == guess, &mut models.hit[kind][distinct][share])? {
             labels[v] = guess;
             continue;
         }
-        let l = if clusters <= 256 {
-            c.symbol(labels[v] as usize, &mut small)? as u64
-        } else {
-            c.unsigned(labels[v] as u64, &mut large)?
-        };
-        if l >= clusters as u64 || l == guess as u64 {
-            return Err(Error::Stream(format!(
-                "partition: vertex {v} has an impossible label"
-            )));
-        }
-        labels[v] = l as u32;
+        counts.sort_by_key(|&(l, n)| (std::cmp::Reverse(n), l));
+        candidates.clear();
+        let others = counts.iter().map(|&(l, _)| l).filter(|&l| l != guess);
+        candidates.extend(others.take(MISS_CANDIDATES));
+        let missed = (labels[v], guess, v);
+        labels[v] = code_missed_label(c, missed, &candidates, clusters, &mut models)?;
     }
     Ok(())
 }
@@ -303,4 +363,50 @@ pub fn decode_weights(
     traverse_weights(&mut dec, &mut weights, partition, (triangles, reference), None)?;
     weights.check(partition)?;
     Ok(weights)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of quads cut into triangles, with flat positions (no two coincide).
+    fn grid(n: u32) -> (Vec<Triangle>, Vec<Point>) {
+        let index = |x: u32, y: u32| y * n + x;
+        let mut triangles = Vec::new();
+        for y in 0..n - 1 {
+            for x in 0..n - 1 {
+                triangles.push([index(x, y), index(x + 1, y), index(x, y + 1)]);
+                triangles.push([index(x + 1, y), index(x + 1, y + 1), index(x, y + 1)]);
+            }
+        }
+        let points = (0..n * n).map(|i| [(i % n) as f32, (i / n) as f32, 0.0]);
+        (triangles, points.collect())
+    }
+
+    /// Labels in three regions meeting at ragged borders, a few lone vertices of a fourth and of
+    /// labels no neighbour has: every path of the coder (hits, candidates, full labels) comes back,
+    /// and a cut part is an error, never a panic.
+    #[test]
+    fn partition_labels_round_trip_through_candidates_and_full_labels() {
+        let n = 24;
+        let (triangles, points) = grid(n);
+        let labels: Vec<u32> = (0..n * n)
+            .map(|i| {
+                let (x, y) = (i % n, i / n);
+                match (x * 7 + y * 3) % 37 {
+                    0 => 3,
+                    1 => 4 + i % 5,
+                    _ if x + (y * y) % 5 < 10 => 0,
+                    _ if y < 12 => 1,
+                    _ => 2,
+                }
+            })
+            .collect();
+        let bytes = encode_partition(&labels, 9, (&triangles, &points)).unwrap();
+        let back = decode_partition(&bytes, labels.len(), 9, (&triangles, &points)).unwrap();
+        assert_eq!(back, labels);
+        for cut in [0, 4, bytes.len() / 2] {
+            let _ = decode_partition(&bytes[..cut], labels.len(), 9, (&triangles, &points));
+        }
+    }
 }
