@@ -307,7 +307,7 @@ pub fn decode_lattice(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A strip of quads cut into two charts placed apart in the atlas: every vertex comes back,
@@ -347,7 +347,7 @@ mod tests {
     }
 
     /// A grid of `columns × rows` vertices cut into triangles, (x, y) at pixel `place(x, y)`.
-    fn quads(
+    pub(crate) fn quads(
         (columns, rows): (u32, u32),
         place: impl Fn(u32, u32) -> [u16; 2],
     ) -> (Vec<Triangle>, Vec<[u16; 2]>) {

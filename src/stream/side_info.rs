@@ -371,15 +371,9 @@ mod tests {
 
     /// A grid of quads cut into triangles, with flat positions (no two coincide).
     fn grid(n: u32) -> (Vec<Triangle>, Vec<Point>) {
-        let index = |x: u32, y: u32| y * n + x;
-        let mut triangles = Vec::new();
-        for y in 0..n - 1 {
-            for x in 0..n - 1 {
-                triangles.push([index(x, y), index(x + 1, y), index(x, y + 1)]);
-                triangles.push([index(x + 1, y), index(x + 1, y + 1), index(x, y + 1)]);
-            }
-        }
-        let points = (0..n * n).map(|i| [(i % n) as f32, (i / n) as f32, 0.0]);
+        let (triangles, pixels) =
+            crate::stream::lattice_coding::tests::quads((n, n), |x, y| [x as u16, y as u16]);
+        let points = pixels.iter().map(|p| [p[0] as f32, p[1] as f32, 0.0]);
         (triangles, points.collect())
     }
 
