@@ -204,16 +204,15 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
             "cannot share stdout with the stream of -o -; write the stream to a file",
         ));
     }
-    if !to_stdout {
-        // The name given, not each clip's name made of it (`--clip all`); an input named as the
-        // output is the graver slip, so it is the one reported.
-        crate::staging::Inputs::of(&[&args.input], &read_options).refuse(&args.output)?;
-        refuse_mesh_name(&args.output)?;
-    }
     if read_options.clip.as_deref() != Some("all") {
         check_output(args, &read_options, &args.output)?;
         let encoded = encode_one(args, &opts, &read_options, quiet)?;
         return write_and_report(args, &read_options, encoded, &args.output, quiet);
+    }
+    if !to_stdout {
+        // The name given: each clip's name made of it drops a trailing `/` (`-o clips/` would
+        // write `clips-NAME.mcgv` beside the folder).
+        refuse_mesh_name(&args.output)?;
     }
     let clips = mcgv_video::mesh::clips(&args.input, read_options.fps)?;
     if clips.is_empty() || to_stdout {
@@ -241,13 +240,16 @@ pub fn run(args: &EncodeArgs, quiet: bool, threads: Option<u64>) -> Result<()> {
     Ok(())
 }
 
-/// Checks `output` before any work: not an input file, not a file that exists unless `--force`,
+/// Checks `output` before any work: not an input file, not a mesh's name or a folder
+/// ([`refuse_mesh_name`]), not a file that exists unless `--force`,
 /// in a folder that takes files (stdout needs no check).
 fn check_output(args: &EncodeArgs, read: &ReadOptions, output: &Path) -> Result<()> {
     if output.as_os_str() == "-" {
         return Ok(());
     }
+    // An input named as the output is the graver slip, so it is the one reported.
     crate::staging::Inputs::of(&[&args.input], read).refuse(output)?;
+    refuse_mesh_name(output)?;
     crate::staging::check_file(output, args.force)
 }
 
