@@ -9,7 +9,8 @@
 //! as a whole), so a trajectory may also add the innovation of the same coefficient of an earlier
 //! coded cluster nearby, in its own units (container version 8), or, for a translation, the
 //! innovation of that cluster's whole map at its own centroid (version 11: a turning thigh moves
-//! the shin's centroid by the turn times the lever between them).
+//! the shin's centroid by the turn times the lever between them). The reference is any of the
+//! [`REFERENCES`] nearest, and its innovation is taken at the follower's own order (version 14).
 
 /// Predictor orders a trajectory may use (1..=ORDERS).
 pub const ORDERS: usize = 3;
@@ -32,7 +33,11 @@ pub const CHOICES: usize = 3 * ORDERS;
 /// Symbols of a linear coefficient's [`Choice`], which never follows a [`Follow::Map`].
 pub const LINEAR_CHOICES: usize = 2 * ORDERS;
 
-/// How a trajectory is predicted: its extrapolation order, and what it adds from its reference
+/// Earlier clusters a trajectory may follow: the nearest few (by centroid on the decoded frame 0),
+/// nearest first; a following trajectory names its reference by this rank (container version 14).
+pub const REFERENCES: usize = 4;
+
+/// How a trajectory is predicted: its extrapolation order, and what it adds from which reference
 /// cluster.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Choice {
@@ -40,6 +45,8 @@ pub struct Choice {
     pub order: usize,
     /// What the reference cluster adds.
     pub follows: Follow,
+    /// Which of the nearest earlier clusters it follows (0: the nearest; 0 when not following).
+    pub reference: usize,
 }
 
 impl Choice {
@@ -47,21 +54,40 @@ impl Choice {
     pub const FIRST: Choice = Choice {
         order: 1,
         follows: Follow::No,
+        reference: 0,
     };
 
-    /// The coded symbol, `0..CHOICES` (`0..LINEAR_CHOICES` unless it follows a map).
+    /// The coded symbol of the order and what it follows, `0..CHOICES` (`0..LINEAR_CHOICES`
+    /// unless it follows a map); the reference is coded apart.
     pub fn symbol(self) -> usize {
         (self.order.clamp(1, ORDERS) - 1) + ORDERS * self.follows as usize
     }
 
-    /// The choice of symbol `s` (`s % CHOICES`).
-    pub fn of_symbol(s: usize) -> Self {
+    /// The choice of symbol `s` (`s % CHOICES`), following reference `reference`.
+    pub fn of_symbol(s: usize, reference: usize) -> Self {
         let s = s % CHOICES;
+        let follows = [Follow::No, Follow::Coefficient, Follow::Map][s / ORDERS];
         Choice {
             order: 1 + s % ORDERS,
-            follows: [Follow::No, Follow::Coefficient, Follow::Map][s / ORDERS],
+            follows,
+            reference: if follows == Follow::No { 0 } else { reference },
         }
     }
+}
+
+/// One way a trajectory may follow a reference: what it adds at each frame, in this trajectory's
+/// levels, when the reference's innovation is taken under `order` — the trajectory's own order, so
+/// that what the two do not share is extrapolated as one smooth difference.
+#[derive(Debug, Clone, Copy)]
+pub struct Way<'a> {
+    /// How it follows.
+    pub follows: Follow,
+    /// Rank of the reference among the nearest earlier clusters.
+    pub reference: usize,
+    /// The trajectory's order this lift was computed for.
+    pub order: usize,
+    /// What it adds at each frame.
+    pub lift: &'a [i64],
 }
 
 /// The level `order` predicts from `history` (most recent last; shorter histories lower the
@@ -111,18 +137,40 @@ pub fn best_order(trajectory: &[i64]) -> (usize, f64) {
     (choice.order, bits)
 }
 
-/// The [`Choice`] that codes `trajectory` smallest by the estimate, and its bits; `lifts` are what
-/// each way of following adds at each frame, in this trajectory's levels (none without a
-/// reference). Ties keep the lower order, and the earlier way (not following first).
-pub fn best_choice(trajectory: &[i64], lifts: &[(Follow, &[i64])]) -> (Choice, f64) {
+/// Estimated bits of naming a reference other than the nearest (a rough price for its symbol).
+const FARTHER_REFERENCE_BITS: f64 = 2.0;
+
+/// The [`Choice`] that codes `trajectory` smallest by the estimate, and its bits: its own
+/// extrapolation at every order, or one of `ways` of following a reference (each at its own
+/// order). Ties keep the lower order, and the earlier way (not following first).
+pub fn best_choice(trajectory: &[i64], ways: &[Way]) -> (Choice, f64) {
     let mut best = (Choice::FIRST, f64::INFINITY);
-    let ways = std::iter::once((Follow::No, None)).chain(lifts.iter().map(|&(f, l)| (f, Some(l))));
-    for (follows, lift) in ways {
-        for order in 1..=ORDERS {
-            let bits = bits_with(order, trajectory, lift);
-            if bits < best.1 {
-                best = (Choice { order, follows }, bits);
-            }
+    for order in 1..=ORDERS {
+        let bits = bits_with(order, trajectory, None);
+        if bits < best.1 {
+            best = (
+                Choice {
+                    order,
+                    ..Choice::FIRST
+                },
+                bits,
+            );
+        }
+    }
+    for way in ways {
+        let price = if way.reference > 0 {
+            FARTHER_REFERENCE_BITS
+        } else {
+            0.0
+        };
+        let bits = bits_with(way.order, trajectory, Some(way.lift)) + price;
+        if bits < best.1 {
+            let choice = Choice {
+                order: way.order,
+                follows: way.follows,
+                reference: way.reference,
+            };
+            best = (choice, bits);
         }
     }
     best
@@ -166,21 +214,34 @@ mod tests {
             .collect();
         assert_eq!(reference[0], 0);
         assert_eq!(reference[3], 8);
-        let lifts = [(Follow::Coefficient, &reference[..])];
-        let (choice, bits) = best_choice(&own, &lifts);
+        let way = |follows, lift| Way {
+            follows,
+            reference: 0,
+            order: 1,
+            lift,
+        };
+        let (choice, bits) = best_choice(&own, &[way(Follow::Coefficient, &reference[..])]);
         assert_eq!(choice.follows, Follow::Coefficient, "{choice:?}");
         assert!(bits < best_choice(&own, &[]).1);
         // Without a reference, or one that does not help, it does not follow.
         assert_eq!(best_choice(&own, &[]).0.follows, Follow::No);
-        let (still, _) = best_choice(&[4, 4, 4, 4], &[(Follow::Coefficient, &[0, 9, -9, 9])]);
+        let noise = [0, 9, -9, 9];
+        let (still, _) = best_choice(&[4, 4, 4, 4], &[way(Follow::Coefficient, &noise)]);
         assert_eq!(still, Choice::FIRST);
-        // Of two ways, the one that predicts.
+        // Of two ways, the one that predicts; a farther reference when it predicts better.
         let worse = vec![1; own.len()];
-        let both = [(Follow::Coefficient, &worse[..]), (Follow::Map, &reference[..])];
+        let both = [way(Follow::Coefficient, &worse[..]), way(Follow::Map, &reference[..])];
         assert_eq!(best_choice(&own, &both).0.follows, Follow::Map);
+        let farther = Way {
+            reference: 2,
+            ..way(Follow::Coefficient, &reference[..])
+        };
+        let picked = best_choice(&own, &[way(Follow::Coefficient, &worse[..]), farther]).0;
+        assert_eq!((picked.follows, picked.reference), (Follow::Coefficient, 2));
         for s in 0..CHOICES {
-            assert_eq!(Choice::of_symbol(s).symbol(), s);
+            assert_eq!(Choice::of_symbol(s, 1).symbol(), s);
         }
+        assert_eq!(Choice::of_symbol(0, 3).reference, 0, "not following names no reference");
         assert_eq!(scaled(-7, 1.0), -7);
         assert_eq!(scaled(5, 0.5), 3);
         assert_eq!(scaled(-5, 0.5), -3);

@@ -5,13 +5,16 @@
 //! Each cluster starts with its [`LinearForm`] (entries, or rotation and stretch), one adaptive
 //! symbol. Per trajectory the encoder picks a choice (`motion/trajectory.rs`), one adaptive
 //! symbol: the predictor order that codes smallest (1: the previous level, 2: linear
-//! extrapolation, 3: quadratic), and whether the prediction adds the *innovation* (level less its
-//! own extrapolation) of the same coefficient of the trajectory's reference cluster: the nearest
-//! earlier-coded cluster (by centroid on the decoded frame 0; for the linear part, the nearest of
-//! the same form), scaled to this cluster's step (container version 8), or, for a translation,
-//! the innovation of the reference's whole map at this cluster's centroid (version 11: the
-//! reference's turn times the lever between the centroids, which a chain of limbs shares as
-//! their translations do not). The first frame is
+//! extrapolation, 3: quadratic), and whether the prediction adds the *innovation* of the same
+//! coefficient of a reference cluster, scaled to this cluster's step (container version 8), or,
+//! for a translation, the innovation of the reference's whole map at this cluster's centroid
+//! (version 11: the reference's turn times the lever between the centroids, which a chain of limbs
+//! shares as their translations do not). The reference is one of the `REFERENCES` (4) nearest
+//! earlier-coded clusters (by centroid on the decoded frame 0; for the linear part, of the same
+//! form), named by its rank, nearest first, in a second adaptive symbol; its innovation is its
+//! level less its extrapolation at the *following trajectory's* order, so that the difference of
+//! the two is what that order extrapolates (container version 14; before, the nearest alone, at
+//! its own order). The first frame is
 //! predicted by the identity map (frame 0 is fitted from the decoded frame 0 itself). Residuals go
 //! through adaptive integer models chosen by the coefficient's kind (entry, rotation, stretch or
 //! translation) and the size of the trajectory's previous residual, which tracks how busy the
@@ -24,7 +27,8 @@
 use crate::error::{Error, Result};
 use crate::mesh::Point;
 use crate::motion::trajectory::{
-    best_choice, extrapolate, innovation, scaled, Choice, Follow, CHOICES, LINEAR_CHOICES, ORDERS,
+    best_choice, extrapolate, innovation, scaled, Choice, Follow, Way, CHOICES, LINEAR_CHOICES,
+    ORDERS, REFERENCES,
 };
 use crate::motion::{
     identity_levels, AffineTrack, ClusterGeometry, LinearForm, Partition, QuantisedAffine,
@@ -78,6 +82,8 @@ impl Kind {
 struct Models {
     form: SymbolModel,
     choice: [SymbolModel; KINDS],
+    /// A following trajectory's reference, by its rank among the nearest.
+    reference: [SymbolModel; KINDS],
     first: [IntModel; KINDS],
     residual: [[IntModel; MAGNITUDES]; KINDS],
 }
@@ -94,6 +100,7 @@ impl Models {
                     LINEAR_CHOICES
                 })
             }),
+            reference: std::array::from_fn(|_| SymbolModel::new(REFERENCES)),
             first: Default::default(),
             residual: Default::default(),
         }
@@ -111,13 +118,13 @@ struct Reference {
     steps: [f64; 12],
 }
 
-/// Each cluster's reference clusters, by the decoded frame 0's centroids: for its translations,
-/// the nearest of the earlier clusters (the last [`REFERENCE_WINDOW`]); for its linear part, the
-/// nearest of those of the same form (their numbers mean the same only then). Ties go to the
-/// lower number.
+/// Each cluster's reference clusters, by the decoded frame 0's centroids, nearest first (at
+/// most [`REFERENCES`]): for its translations, among the earlier clusters (the last
+/// [`REFERENCE_WINDOW`]); for its linear part, among those of the same form (their numbers mean
+/// the same only then). Ties go to the lower number.
 struct References {
-    translation: Option<Reference>,
-    linear: Option<Reference>,
+    translation: Vec<Reference>,
+    linear: Vec<Reference>,
 }
 
 impl References {
@@ -128,38 +135,37 @@ impl References {
             let c = geometry.centroid(j);
             (0..3).map(|a| (c[a] - here[a]) * (c[a] - here[a])).sum::<f64>()
         };
-        // (cluster, squared distance) of the nearest so far.
-        let mut translation: Option<(usize, f64)> = None;
-        let mut linear: Option<(usize, f64)> = None;
-        for j in k.saturating_sub(REFERENCE_WINDOW)..k {
-            let d = distance(j);
-            if translation.is_none_or(|(_, b)| d < b) {
-                translation = Some((j, d));
-            }
-            if forms.get(j) == forms.get(k) && linear.is_none_or(|(_, b)| d < b) {
-                linear = Some((j, d));
-            }
-        }
-        let reference = |found: Option<(usize, f64)>| {
-            found.map(|(j, _)| Reference {
-                cluster: j,
-                steps: geometry.steps(j, step, forms[j]),
-            })
+        let mut earlier: Vec<(f64, usize)> = (k.saturating_sub(REFERENCE_WINDOW)..k)
+            .map(|j| (distance(j), j))
+            .collect();
+        earlier.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let reference = |j: usize| Reference {
+            cluster: j,
+            steps: geometry.steps(j, step, forms[j]),
         };
+        let translation = earlier.iter().take(REFERENCES).map(|&(_, j)| reference(j));
+        let same_form = earlier.iter().filter(|&&(_, j)| forms.get(j) == forms.get(k));
+        let linear = same_form.take(REFERENCES).map(|&(_, j)| reference(j));
         Self {
-            translation: reference(translation),
-            linear: reference(linear),
+            translation: translation.collect(),
+            linear: linear.collect(),
         }
     }
 
-    /// The reference of stored coefficient `coeff` of a cluster in `form` whose steps are `own`,
-    /// and the ratio of the reference's step to its own (what its innovation is scaled by).
-    fn for_coeff(&self, coeff: usize, form: LinearForm, own: &[f64; 12]) -> Option<(usize, f64)> {
-        let reference = match Kind::of(coeff, form) {
-            Kind::Translation => self.translation.as_ref(),
-            _ => self.linear.as_ref(),
-        };
-        reference.map(|r| (r.cluster, r.steps[coeff] / own[coeff]))
+    /// The references of stored coefficient `coeff` of a cluster in `form`, nearest first.
+    fn of_coeff(&self, coeff: usize, form: LinearForm) -> &[Reference] {
+        match Kind::of(coeff, form) {
+            Kind::Translation => &self.translation,
+            _ => &self.linear,
+        }
+    }
+
+    /// The references of stored coefficient `coeff` of a cluster in `form` whose steps are `own`,
+    /// nearest first, each with the ratio of its step to the cluster's own (what its innovation
+    /// is scaled by).
+    fn for_coeff(&self, coeff: usize, form: LinearForm, own: &[f64; 12]) -> Vec<(usize, f64)> {
+        let of = |r: &Reference| (r.cluster, r.steps[coeff] / own[coeff]);
+        self.of_coeff(coeff, form).iter().map(of).collect()
     }
 }
 
@@ -198,7 +204,7 @@ fn code_trajectories<C: SymbolCoder>(
                 coeff,
                 first,
                 kind: Kind::of(coeff, form),
-                reference: references.for_coeff(coeff, form, &steps),
+                references: references.for_coeff(coeff, form, &steps),
             };
             code_trajectory(c, q, choices, &trajectory, geometry, &mut models)?;
         }
@@ -212,14 +218,14 @@ fn code_trajectories<C: SymbolCoder>(
     Ok(())
 }
 
-/// One coefficient's trajectory: where it is, its identity level (frame 0's prediction), and its
-/// reference cluster with the ratio of that cluster's step to its own.
+/// One coefficient's trajectory: where it is, its identity level (frame 0's prediction), and the
+/// clusters it may follow, nearest first, each with the ratio of its step to this one's.
 struct Trajectory {
     cluster: usize,
     coeff: usize,
     first: i64,
     kind: Kind,
-    reference: Option<(usize, f64)>,
+    references: Vec<(usize, f64)>,
 }
 
 /// Trajectory (`cluster`, `coeff`)'s innovation at frame `f` under `order`, from its levels in
@@ -290,8 +296,8 @@ fn map_innovation(
 }
 
 /// What following reference `j` the way `follows` adds to trajectory (`k`, `coeff`) at frame `f`,
-/// `j`'s own trajectory extrapolated by `order` and its steps `ratio` times this one's: the one
-/// definition the encoder's choice and the coder share.
+/// `j`'s trajectory extrapolated by `order` (the follower's own) and its steps `ratio` times this
+/// one's: the one definition the encoder's choice and the coder share.
 fn lift(
     q: &QuantisedAffine,
     geometry: &ClusterGeometry,
@@ -308,10 +314,11 @@ fn lift(
     }
 }
 
-/// Codes `t`'s choice (`choices[cluster * 12 + coeff]`), then its level at every frame as the
+/// Codes `t`'s choice (`choices[cluster * 12 + coeff]`: order and way, then, when it follows
+/// and has more than one reference, the reference's rank), then its level at every frame as the
 /// residual of the prediction. With the levels kept (`q.values` not empty) a trajectory that
 /// follows its reference adds the reference's innovation, recomputed from the reference's levels
-/// and choice; a dry run reads the same symbols.
+/// at this trajectory's order; a dry run reads the same symbols.
 fn code_trajectory<C: SymbolCoder>(
     c: &mut C,
     q: &mut QuantisedAffine,
@@ -323,9 +330,12 @@ fn code_trajectory<C: SymbolCoder>(
     let (frames, clusters, kind) = (q.frames, q.clusters, t.kind as usize);
     let slot = t.cluster * 12 + t.coeff;
     let coded = c.symbol(choices[slot].symbol(), &mut models.choice[kind])?;
-    let choice = Choice::of_symbol(coded);
+    let mut choice = Choice::of_symbol(coded, 0);
+    if choice.follows != Follow::No && t.references.len() > 1 {
+        choice.reference = c.symbol(choices[slot].reference, &mut models.reference[kind])?;
+    }
     choices[slot] = choice;
-    let reference = match (choice.follows, t.reference) {
+    let reference = match (choice.follows, t.references.get(choice.reference)) {
         (Follow::No, _) => None,
         (Follow::Map, _) if t.kind != Kind::Translation => {
             return Err(Error::Stream(format!(
@@ -334,12 +344,15 @@ fn code_trajectory<C: SymbolCoder>(
                 t.cluster, t.coeff
             )))
         }
-        (follows, Some((j, ratio))) => Some((j, choices[j * 12 + t.coeff].order, ratio, follows)),
+        (follows, Some(&(j, ratio))) => Some((j, ratio, follows)),
         (_, None) => {
             return Err(Error::Stream(format!(
-                "affine coefficients: cluster {}, coefficient {} follows a reference cluster it \
-                 does not have",
-                t.cluster, t.coeff
+                "affine coefficients: cluster {}, coefficient {} follows reference {} of the {} it \
+                 has",
+                t.cluster,
+                t.coeff,
+                choice.reference,
+                t.references.len()
             )))
         }
     };
@@ -357,13 +370,13 @@ fn code_trajectory<C: SymbolCoder>(
             ),
         };
         let lift = match reference {
-            Some((j, order, ratio, follows)) if f > 0 && keep => lift(
+            Some((j, ratio, follows)) if f > 0 && keep => lift(
                 q,
                 geometry,
                 follows,
                 (t.cluster, j),
                 t.coeff,
-                (order, ratio),
+                (choice.order, ratio),
                 f,
             ),
             _ => 0,
@@ -395,8 +408,8 @@ fn code_trajectory<C: SymbolCoder>(
     Ok(())
 }
 
-/// Each trajectory's [`Choice`] by the estimate, cluster by cluster as the coder goes: a
-/// trajectory's reference innovations are those of the choices already made.
+/// Each trajectory's [`Choice`] by the estimate: its own extrapolation, or following one of its
+/// references in one of the ways its kind may, at each order.
 fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
     let (frames, clusters) = (q.frames, q.clusters);
     let step = f64::from(q.step);
@@ -408,20 +421,31 @@ fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
             let levels: Vec<i64> = (0..frames)
                 .map(|f| q.values[(f * clusters + k) * 12 + coeff])
                 .collect();
-            let mut lifts: Vec<(Follow, Vec<i64>)> = Vec::new();
-            if let Some((j, ratio)) = references.for_coeff(coeff, q.forms[k], &steps) {
-                let order = choices[j * 12 + coeff].order;
-                let ways: &[Follow] = if Kind::of(coeff, q.forms[k]) == Kind::Translation {
-                    &[Follow::Coefficient, Follow::Map]
-                } else {
-                    &[Follow::Coefficient]
-                };
-                for &follows in ways {
-                    let at = |f| lift(q, geometry, follows, (k, j), coeff, (order, ratio), f);
-                    lifts.push((follows, (0..frames).map(at).collect()));
+            let follows: &[Follow] = if Kind::of(coeff, q.forms[k]) == Kind::Translation {
+                &[Follow::Coefficient, Follow::Map]
+            } else {
+                &[Follow::Coefficient]
+            };
+            // (follows, rank, order, lift) of every way to follow.
+            let mut lifts: Vec<(Follow, usize, usize, Vec<i64>)> = Vec::new();
+            let found = references.for_coeff(coeff, q.forms[k], &steps);
+            for (rank, &(j, ratio)) in found.iter().enumerate() {
+                for &way in follows {
+                    for order in 1..=ORDERS {
+                        let at = |f| lift(q, geometry, way, (k, j), coeff, (order, ratio), f);
+                        lifts.push((way, rank, order, (0..frames).map(at).collect()));
+                    }
                 }
             }
-            let ways: Vec<(Follow, &[i64])> = lifts.iter().map(|(f, l)| (*f, &l[..])).collect();
+            let ways: Vec<Way> = lifts
+                .iter()
+                .map(|(follows, reference, order, lift)| Way {
+                    follows: *follows,
+                    reference: *reference,
+                    order: *order,
+                    lift,
+                })
+                .collect();
             choices[k * 12 + coeff] = best_choice(&levels, &ways).0;
         }
     }

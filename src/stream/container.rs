@@ -30,7 +30,7 @@ pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 /// header holds what every codec shares and each codec its own fields in its set-up part;
 /// docs/history.md lists the versions).
 /// A reader refuses any other version, so an older reader says "update" instead of misreading.
-pub const VERSION: u16 = 13;
+pub const VERSION: u16 = 14;
 
 /// Bytes of a part header: tag (4), checksum kind (1), payload length (`u32`: 4), CRC (4). Until
 /// container version 11 the length took 8 bytes; a part of 4 GiB or more is refused when added
