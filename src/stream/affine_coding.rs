@@ -131,9 +131,16 @@ impl References {
     /// Cluster `k`'s, given the forms of clusters `0..=k` and the base step.
     fn of(geometry: &ClusterGeometry, k: usize, forms: &[LinearForm], step: f64) -> Self {
         let here = geometry.centroid(k);
+        // A NaN (non-finite centroids of a forged first frame) sorts last whatever its sign bit,
+        // which differs between machines.
         let distance = |j: usize| {
             let c = geometry.centroid(j);
-            (0..3).map(|a| (c[a] - here[a]) * (c[a] - here[a])).sum::<f64>()
+            let d = (0..3).map(|a| (c[a] - here[a]) * (c[a] - here[a])).sum::<f64>();
+            if d.is_nan() {
+                f64::INFINITY
+            } else {
+                d
+            }
         };
         let mut earlier: Vec<(f64, usize)> = (k.saturating_sub(REFERENCE_WINDOW)..k)
             .map(|j| (distance(j), j))

@@ -17,8 +17,10 @@ use std::path::Path;
 /// First bytes of every `.mcgv` file; the CR-LF and ^Z catch text-mode transfers, as PNG's magic does.
 pub const MAGIC: [u8; 8] = *b"MCGV\r\n\x1a\n";
 
-/// The container version this build writes and reads: 13, a missed partition label named among
-/// the neighbours' other labels and its hit bit in contexts of their agreement (issue 35; 12: the
+/// The container version this build writes and reads: 14, an affine trajectory may follow any of
+/// the four nearest earlier clusters, named by rank, their innovation taken at its own order
+/// (issue 35; 13: a missed partition label named among
+/// the neighbours' other labels and its hit bit in contexts of their agreement; 12: the
 /// frame index entropy-coded and a part's length in 4 bytes; 11: a translation's trajectory may follow
 /// its reference cluster's whole map at its own centroid; 10: the first frame's version 4, a kept
 /// vertex order names the free corners of the triangles last used, escapes by rank among the free
