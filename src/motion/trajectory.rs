@@ -63,14 +63,14 @@ impl Choice {
         (self.order.clamp(1, ORDERS) - 1) + ORDERS * self.follows as usize
     }
 
-    /// The choice of symbol `s` (`s % CHOICES`), following reference `reference`.
-    pub fn of_symbol(s: usize, reference: usize) -> Self {
+    /// The choice of symbol `s` (`s % CHOICES`), following the nearest reference if any: a
+    /// following trajectory's rank is coded after its symbol.
+    pub fn of_symbol(s: usize) -> Self {
         let s = s % CHOICES;
-        let follows = [Follow::No, Follow::Coefficient, Follow::Map][s / ORDERS];
         Choice {
             order: 1 + s % ORDERS,
-            follows,
-            reference: if follows == Follow::No { 0 } else { reference },
+            follows: [Follow::No, Follow::Coefficient, Follow::Map][s / ORDERS],
+            reference: 0,
         }
     }
 }
@@ -78,8 +78,8 @@ impl Choice {
 /// One way a trajectory may follow a reference: what it adds at each frame, in this trajectory's
 /// levels, when the reference's innovation is taken under `order` — the trajectory's own order, so
 /// that what the two do not share is extrapolated as one smooth difference.
-#[derive(Debug, Clone, Copy)]
-pub struct Way<'a> {
+#[derive(Debug, Clone)]
+pub struct Way {
     /// How it follows.
     pub follows: Follow,
     /// Rank of the reference among the nearest earlier clusters.
@@ -87,7 +87,7 @@ pub struct Way<'a> {
     /// The trajectory's order this lift was computed for.
     pub order: usize,
     /// What it adds at each frame.
-    pub lift: &'a [i64],
+    pub lift: Vec<i64>,
 }
 
 /// The level `order` predicts from `history` (most recent last; shorter histories lower the
@@ -163,7 +163,7 @@ pub fn best_choice(trajectory: &[i64], ways: &[Way]) -> (Choice, f64) {
         } else {
             0.0
         };
-        let bits = bits_with(way.order, trajectory, Some(way.lift)) + price;
+        let bits = bits_with(way.order, trajectory, Some(&way.lift)) + price;
         if bits < best.1 {
             let choice = Choice {
                 order: way.order,
@@ -214,11 +214,11 @@ mod tests {
             .collect();
         assert_eq!(reference[0], 0);
         assert_eq!(reference[3], 8);
-        let way = |follows, lift| Way {
+        let way = |follows, lift: &[i64]| Way {
             follows,
             reference: 0,
             order: 1,
-            lift,
+            lift: lift.to_vec(),
         };
         let (choice, bits) = best_choice(&own, &[way(Follow::Coefficient, &reference[..])]);
         assert_eq!(choice.follows, Follow::Coefficient, "{choice:?}");
@@ -239,9 +239,9 @@ mod tests {
         let picked = best_choice(&own, &[way(Follow::Coefficient, &worse[..]), farther]).0;
         assert_eq!((picked.follows, picked.reference), (Follow::Coefficient, 2));
         for s in 0..CHOICES {
-            assert_eq!(Choice::of_symbol(s, 1).symbol(), s);
+            assert_eq!(Choice::of_symbol(s).symbol(), s);
         }
-        assert_eq!(Choice::of_symbol(0, 3).reference, 0, "not following names no reference");
+        assert_eq!(Choice::of_symbol(4).reference, 0, "the rank is coded apart");
         assert_eq!(scaled(-7, 1.0), -7);
         assert_eq!(scaled(5, 0.5), 3);
         assert_eq!(scaled(-5, 0.5), -3);

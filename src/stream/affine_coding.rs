@@ -337,7 +337,7 @@ fn code_trajectory<C: SymbolCoder>(
     let (frames, clusters, kind) = (q.frames, q.clusters, t.kind as usize);
     let slot = t.cluster * 12 + t.coeff;
     let coded = c.symbol(choices[slot].symbol(), &mut models.choice[kind])?;
-    let mut choice = Choice::of_symbol(coded, 0);
+    let mut choice = Choice::of_symbol(coded);
     if choice.follows != Follow::No && t.references.len() > 1 {
         choice.reference = c.symbol(choices[slot].reference, &mut models.reference[kind])?;
     }
@@ -428,31 +428,22 @@ fn choose(q: &QuantisedAffine, geometry: &ClusterGeometry) -> Vec<Choice> {
             let levels: Vec<i64> = (0..frames)
                 .map(|f| q.values[(f * clusters + k) * 12 + coeff])
                 .collect();
-            let follows: &[Follow] = if Kind::of(coeff, q.forms[k]) == Kind::Translation {
+            let allowed: &[Follow] = if Kind::of(coeff, q.forms[k]) == Kind::Translation {
                 &[Follow::Coefficient, Follow::Map]
             } else {
                 &[Follow::Coefficient]
             };
-            // (follows, rank, order, lift) of every way to follow.
-            let mut lifts: Vec<(Follow, usize, usize, Vec<i64>)> = Vec::new();
+            let mut ways = Vec::new();
             let found = references.for_coeff(coeff, q.forms[k], &steps);
-            for (rank, &(j, ratio)) in found.iter().enumerate() {
-                for &way in follows {
+            for (reference, &(j, ratio)) in found.iter().enumerate() {
+                for &follows in allowed {
                     for order in 1..=ORDERS {
-                        let at = |f| lift(q, geometry, way, (k, j), coeff, (order, ratio), f);
-                        lifts.push((way, rank, order, (0..frames).map(at).collect()));
+                        let at = |f| lift(q, geometry, follows, (k, j), coeff, (order, ratio), f);
+                        let lift = (0..frames).map(at).collect();
+                        ways.push(Way { follows, reference, order, lift });
                     }
                 }
             }
-            let ways: Vec<Way> = lifts
-                .iter()
-                .map(|(follows, reference, order, lift)| Way {
-                    follows: *follows,
-                    reference: *reference,
-                    order: *order,
-                    lift,
-                })
-                .collect();
             choices[k * 12 + coeff] = best_choice(&levels, &ways).0;
         }
     }
