@@ -159,20 +159,16 @@ impl References {
         }
     }
 
-    /// The references of stored coefficient `coeff` of a cluster in `form`, nearest first.
-    fn of_coeff(&self, coeff: usize, form: LinearForm) -> &[Reference] {
-        match Kind::of(coeff, form) {
-            Kind::Translation => &self.translation,
-            _ => &self.linear,
-        }
-    }
-
     /// The references of stored coefficient `coeff` of a cluster in `form` whose steps are `own`,
     /// nearest first, each with the ratio of its step to the cluster's own (what its innovation
     /// is scaled by).
     fn for_coeff(&self, coeff: usize, form: LinearForm, own: &[f64; 12]) -> Vec<(usize, f64)> {
+        let found = match Kind::of(coeff, form) {
+            Kind::Translation => &self.translation,
+            _ => &self.linear,
+        };
         let of = |r: &Reference| (r.cluster, r.steps[coeff] / own[coeff]);
-        self.of_coeff(coeff, form).iter().map(of).collect()
+        found.iter().map(of).collect()
     }
 }
 
